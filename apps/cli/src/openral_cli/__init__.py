@@ -1,0 +1,1 @@
+"""The openral command line."""

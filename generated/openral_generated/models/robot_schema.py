@@ -1,0 +1,226 @@
+# GENERATED from schema/ by `just schema-export` -- do not edit.
+
+from __future__ import annotations
+
+from enum import StrEnum
+from typing import Annotated, Literal
+from pydantic import BaseModel, ConfigDict, Field
+from typing_extensions import TypeAliasType
+from . import sim_schema
+
+
+class Base(StrEnum):
+    """
+    How the robot stands: `fixed` is bolted to the world (or to a table); `mobile` drives around (odometry and cmd_vel apply).
+    """
+
+    fixed = "fixed"
+    mobile = "mobile"
+
+
+class Type(StrEnum):
+    """
+    Kinematic type: `revolute` (bounded rotation, radians), `prismatic` (linear, metres) or `continuous` (unbounded rotation, radians).
+    """
+
+    revolute = "revolute"
+    prismatic = "prismatic"
+    continuous = "continuous"
+
+
+PositionLimit = TypeAliasType(
+    "PositionLimit", Annotated[float, Field(ge=-1000.0, le=1000.0)]
+)
+
+
+class Joint(BaseModel):
+    """
+    One controllable joint.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    name: Annotated[
+        str,
+        Field(
+            examples=["panda_joint1", "shoulder_pan_joint"],
+            pattern="^[A-Za-z][A-Za-z0-9_]{0,62}$",
+        ),
+    ]
+    """
+    Canonical joint name: the name used on /joint_states, by the safety envelope and by real drivers. Never renamed for a simulator.
+    """
+    type: Type
+    """
+    Kinematic type: `revolute` (bounded rotation, radians), `prismatic` (linear, metres) or `continuous` (unbounded rotation, radians).
+    """
+    position_limits: Annotated[
+        list[PositionLimit] | None,
+        Field(examples=[[-2.8973, 2.8973]], max_length=2, min_length=2),
+    ] = None
+    """
+    Lower and upper position limit [rad for revolute, m for prismatic]. Required for revolute and prismatic joints, not allowed for continuous ones. The lower bound must be below the upper bound.
+    """
+    velocity_limit: Annotated[float, Field(gt=0.0, le=1000.0)]
+    """
+    Largest allowed speed [rad/s for revolute and continuous, m/s for prismatic].
+    """
+    effort_limit: Annotated[float, Field(gt=0.0, le=100000.0)]
+    """
+    Largest allowed effort [N·m for revolute and continuous, N for prismatic].
+    """
+    sim_joint_name: Annotated[
+        str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+    ] = None
+    """
+    The joint's name in the robot's native MJCF model where it differs from the canonical name (for example `joint1` for `panda_joint1`). Absent means the MJCF uses the canonical name. Robosuite's `robot0_` prefixes are stripped automatically and never written here.
+    """
+
+
+class Kind(StrEnum):
+    """
+    `rgb` (colour image), `depth` (depth image and point cloud) or `lidar` (planar laser scan).
+    """
+
+    rgb = "rgb"
+    depth = "depth"
+    lidar = "lidar"
+
+
+RangeMItem = TypeAliasType("RangeMItem", Annotated[float, Field(ge=0.0, le=1000.0)])
+
+
+AngleRangeDegItem = TypeAliasType(
+    "AngleRangeDegItem", Annotated[float, Field(ge=-360.0, le=360.0)]
+)
+
+
+class Sensor(BaseModel):
+    """
+    One camera, depth camera or lidar, read from the simulated scene.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    name: Annotated[
+        str, Field(examples=["agentview", "wrist"], pattern="^[a-z][a-z0-9_]{0,62}$")
+    ]
+    """
+    Sensor name, unique within the robot. Topics are derived from it (`/openral/cameras/<name>/image`).
+    """
+    kind: Kind
+    """
+    `rgb` (colour image), `depth` (depth image and point cloud) or `lidar` (planar laser scan).
+    """
+    camera: Annotated[str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")] = (
+        None
+    )
+    """
+    MJCF camera the sensor renders from (rgb and depth). Defaults to the sensor name.
+    """
+    site: Annotated[str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")] = (
+        None
+    )
+    """
+    MJCF site the lidar's rays start from (lidar only).
+    """
+    mount_body: Annotated[
+        str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+    ] = None
+    """
+    MJCF body (native name) the camera is rigidly attached to, such as the hand for a wrist camera. Absent means a fixed camera placed by the scene.
+    """
+    fovy_deg: Annotated[float, Field(gt=0.0, lt=180.0)] = 45
+    """
+    Vertical field of view [deg] of a camera the scene creates.
+    """
+    width: Annotated[int, Field(ge=1, le=4096)]
+    """
+    Image width [px] (for a lidar: number of rays).
+    """
+    height: Annotated[int, Field(ge=1, le=4096)]
+    """
+    Image height [px] (1 for a lidar).
+    """
+    rate_hz: Annotated[float, Field(gt=0.0, le=1000.0)]
+    """
+    Nominal publish rate [Hz] on a real robot; the sim bridge's camera rate is a runtime setting.
+    """
+    frame_id: Annotated[
+        str,
+        Field(
+            examples=["agentview_optical_frame"],
+            pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$",
+        ),
+    ]
+    """
+    TF frame of the sensor's optical centre, copied into message headers.
+    """
+    vla_feature_key: Annotated[
+        str | None,
+        Field(
+            examples=["observation.images.camera1"],
+            pattern="^observation\\.images\\.[a-z][a-z0-9_]{0,62}$",
+        ),
+    ] = None
+    """
+    LeRobot-style observation key a vision-language-action policy expects this camera under, `observation.images.<slot>`. Only for rgb sensors. The slot (the part after the last dot) is what policies look frames up by.
+    """
+    range_m: Annotated[
+        list[RangeMItem] | None,
+        Field(examples=[[0.05, 10.0]], max_length=2, min_length=2),
+    ] = None
+    """
+    Shortest and longest measured distance [m] (depth and lidar).
+    """
+    angle_range_deg: Annotated[
+        list[AngleRangeDegItem] | None,
+        Field(examples=[[-135.0, 135.0]], max_length=2, min_length=2),
+    ] = None
+    """
+    First and last ray angle [deg] of a lidar scan, counter-clockwise about the site's z axis.
+    """
+
+
+class RobotDescription(BaseModel):
+    """
+    Everything openral knows about one robot arm, written once in robots/<id>/robot.yaml. The HAL, the simulated scene and the ROS 2 graph are all derived from this document.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    schema_version: Literal["0.1"]
+    """
+    Version of this contract. Only "0.1" exists; additive fields keep the version.
+    """
+    name: Annotated[
+        str, Field(examples=["franka_panda", "ur5e"], pattern="^[a-z][a-z0-9_]{1,62}$")
+    ]
+    """
+    Robot id: lower-case snake case, equal to the name of the folder under robots/ that holds this file. Used on the command line (`openral robot show <name>`) and as the default ROS namespace.
+    """
+    display_name: Annotated[
+        str, Field(examples=["Franka Emika Panda"], max_length=80, min_length=1)
+    ]
+    """
+    Human-readable name shown in tables and docs.
+    """
+    joints: Annotated[list[Joint], Field(max_length=64, min_length=1)]
+    """
+    The robot's controllable joints in canonical order. This order is the order of JointState messages, of HAL state vectors and of joint-space actions. A gripper is listed as one joint (its driving finger or jaw).
+    """
+    sensors: Annotated[list[Sensor], Field(max_length=32, validate_default=True)] = []
+    """
+    Sensors the robot carries or that its scenes provide for it (cameras, depth cameras, lidars). Each becomes a ROS topic under deploy sim.
+    """
+    base: Base
+    """
+    How the robot stands: `fixed` is bolted to the world (or to a table); `mobile` drives around (odometry and cmd_vel apply).
+    """
+    sim: sim_schema.SimDescription | None = None
+    """
+    MuJoCo wiring: where the model comes from and how joints map to qpos, qvel and actuators. Absent for robots that have no simulation model.
+    """

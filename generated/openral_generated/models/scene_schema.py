@@ -1,0 +1,224 @@
+# GENERATED from schema/ by `just schema-export` -- do not edit.
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+from pydantic import BaseModel, ConfigDict, Field
+from typing_extensions import TypeAliasType
+from enum import StrEnum
+
+
+PositionMItem = TypeAliasType(
+    "PositionMItem", Annotated[float, Field(ge=-100.0, le=100.0)]
+)
+
+
+class BasePose(BaseModel):
+    """
+    Pose of the robot base in the world frame.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    position_m: Annotated[list[PositionMItem], Field(max_length=3, min_length=3)] = [
+        0.0,
+        0.0,
+        0.0,
+    ]
+    """
+    Base position x, y, z [m].
+    """
+    yaw_deg: Annotated[float, Field(ge=-360.0, le=360.0)] = 0.0
+    """
+    Base rotation about the world z axis [deg].
+    """
+
+
+class Observation(BaseModel):
+    """
+    Rendered image size shared by every camera of the scene.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    width: Annotated[int, Field(ge=8, le=4096)]
+    """
+    Image width [px].
+    """
+    height: Annotated[int, Field(ge=8, le=4096)]
+    """
+    Image height [px].
+    """
+
+
+class Shape(StrEnum):
+    """
+    Primitive geometry.
+    """
+
+    box = "box"
+    sphere = "sphere"
+    cylinder = "cylinder"
+
+
+SizeMItem = TypeAliasType("SizeMItem", Annotated[float, Field(gt=0.0, le=10.0)])
+
+
+RgbaItem = TypeAliasType("RgbaItem", Annotated[float, Field(ge=0.0, le=1.0)])
+
+
+class SceneObject(BaseModel):
+    """
+    A simple primitive object placed in a native scene.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    name: Annotated[str, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
+    """
+    Body name of the object in the composed model.
+    """
+    shape: Shape
+    """
+    Primitive geometry.
+    """
+    size_m: Annotated[list[SizeMItem], Field(max_length=3, min_length=1)]
+    """
+    MuJoCo geom size [m]: half-extents (box, 3 values), radius (sphere, 1) or radius and half-height (cylinder, 2).
+    """
+    position_m: Annotated[list[PositionMItem], Field(max_length=3, min_length=3)]
+    """
+    Initial position x, y, z [m] in the world frame.
+    """
+    rgba: Annotated[list[RgbaItem], Field(max_length=4, min_length=4)] = [
+        0.8,
+        0.2,
+        0.2,
+        1.0,
+    ]
+    """
+    Colour, each channel in [0, 1].
+    """
+    mass_kg: Annotated[float, Field(gt=0.0, le=1000.0)] = 0.1
+    """
+    Mass [kg].
+    """
+    free: bool = True
+    """
+    True: the object is loose (free joint); false: fixed to the world.
+    """
+
+
+class SceneOptions(BaseModel):
+    """
+    Backend options. Each backend reads the fields that apply to it and ignores none silently: a field another backend owns is an error when the scene is built.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    control_freq_hz: Annotated[float, Field(gt=0.0, le=1000.0)] = 20
+    """
+    How often an action is applied [Hz]; each env.step advances 1/control_freq_hz seconds of physics.
+    """
+    horizon: Annotated[int | None, Field(ge=1, le=100000000)] = None
+    """
+    Steps after which an episode is truncated (robosuite); native scenes never end on their own.
+    """
+    controller: Annotated[str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_]{0,62}$")] = (
+        None
+    )
+    """
+    robosuite controller config name (robosuite only), such as `BASIC`.
+    """
+    table_height_m: Annotated[float | None, Field(gt=0.0, le=3.0)] = None
+    """
+    Height of the table top [m] (native tabletop only).
+    """
+    objects: Annotated[list[SceneObject] | None, Field(max_length=64)] = None
+    """
+    Objects placed on the table (native only).
+    """
+
+
+class Backend(StrEnum):
+    """
+    Simulator backend that owns physics and rendering: `native` (a scene composed with mujoco.MjSpec around the robot's own MJCF) or `robosuite` (a robosuite environment).
+    """
+
+    native = "native"
+    robosuite = "robosuite"
+
+
+Camera = TypeAliasType(
+    "Camera", Annotated[str, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
+)
+
+
+class SceneSpec(BaseModel):
+    """
+    Scene identity, backend, assets, image size and cameras.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    id: Annotated[str, Field(examples=["tabletop"], pattern="^[a-z][a-z0-9_]{0,62}$")]
+    """
+    Scene id, used in logs and output folder names.
+    """
+    backend: Backend
+    """
+    Simulator backend that owns physics and rendering: `native` (a scene composed with mujoco.MjSpec around the robot's own MJCF) or `robosuite` (a robosuite environment).
+    """
+    assets: Annotated[str, Field(pattern="^[A-Za-z0-9_:./-]{1,255}$")] = "tabletop"
+    """
+    What the backend builds the scene from: for `native` a built-in layout (`tabletop`) or a `file:` MJCF relative to the scene file; for `robosuite` the environment name (`Lift`).
+    """
+    observation: Observation
+    """
+    Rendered image size.
+    """
+    cameras: Annotated[list[Camera], Field(max_length=16)]
+    """
+    Cameras to render, by sensor name of the robot's manifest.
+    """
+    options: SceneOptions | None = None
+    """
+    Backend options.
+    """
+
+
+class DeployScene(BaseModel):
+    """
+    A deploy scene: the file passed as `--config` to `openral sim run` and `openral deploy sim`. It names the robot, the simulator backend that owns physics and pixels, the cameras to render and where the robot stands.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    schema_version: Literal["0.1"]
+    """
+    Version of this contract. Only "0.1" exists.
+    """
+    robot_id: Annotated[
+        str | None, Field(examples=["franka_panda"], pattern="^[a-z][a-z0-9_]{1,62}$")
+    ] = None
+    """
+    Id of the robot (a folder under robots/) placed in the scene. May be left out in a robot-agnostic scene; the caller then supplies the robot.
+    """
+    seed: Annotated[int, Field(ge=0, le=2147483647)] = 0
+    """
+    Seed for the backend's episode reset (object placement, noise). The same seed gives the same first frame.
+    """
+    base_pose: BasePose | None = None
+    """
+    Where the robot's base is placed in the world.
+    """
+    scene: SceneSpec
+    """
+    The scene itself.
+    """

