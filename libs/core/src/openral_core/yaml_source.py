@@ -17,6 +17,7 @@ from ruamel.yaml import YAML
 from ruamel.yaml.comments import CommentedMap, CommentedSeq
 from ruamel.yaml.constructor import DuplicateKeyError
 from ruamel.yaml.error import MarkedYAMLError
+from ruamel.yaml.nodes import MappingNode, Node, SequenceNode
 
 from openral_core.errors import Issue, ManifestError
 
@@ -67,8 +68,8 @@ def load_located(file: Path) -> LocatedDocument:
     yaml = YAML(typ="rt")
     try:
         raw = yaml.load(text)
-    except DuplicateKeyError as exc:
-        raise ManifestError(file, [_duplicate_key_issue(file, exc)]) from None
+    except DuplicateKeyError:
+        raise ManifestError(file, _duplicate_key_issues(file, yaml, text)) from None
     except MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line, col = (mark.line + 1, mark.column + 1) if mark else (0, 0)
@@ -82,13 +83,34 @@ def load_located(file: Path) -> LocatedDocument:
     return document
 
 
-def _duplicate_key_issue(file: Path, exc: DuplicateKeyError) -> Issue:
-    first, second = exc.context_mark, exc.problem_mark
-    problem = str(exc.problem or "duplicate key")
-    line = second.line + 1 if second else 0
-    col = second.column + 1 if second else 0
-    where_first = f" (first defined on line {first.line + 1})" if first else ""
-    return Issue(file, line, col, "", f"{problem}{where_first}; each key may appear once")
+def _duplicate_key_issues(file: Path, yaml: YAML, text: str) -> list[Issue]:
+    """Every repeated key in the document, naming the line of its first occurrence."""
+    issues: list[Issue] = []
+    pending: list[tuple[Node, PathKey]] = [(yaml.compose(text), ())]
+    while pending:
+        node, path = pending.pop()
+        if isinstance(node, MappingNode):
+            first_line: dict[str, int] = {}
+            for key_node, value_node in node.value:
+                key = str(key_node.value)
+                mark = key_node.start_mark
+                if key in first_line:
+                    issues.append(
+                        Issue(
+                            file,
+                            mark.line + 1,
+                            mark.column + 1,
+                            format_field((*path, key)),
+                            f"duplicate key {key!r}: also defined on line {first_line[key]}; "
+                            "each key may appear once",
+                        )
+                    )
+                else:
+                    first_line[key] = mark.line + 1
+                pending.append((value_node, (*path, key)))
+        elif isinstance(node, SequenceNode):
+            pending.extend((item, (*path, i)) for i, item in enumerate(node.value))
+    return sorted(issues, key=lambda issue: (issue.line, issue.column))
 
 
 def _plain(node: Any, path: PathKey, doc: LocatedDocument, issues: list[Issue]) -> Any:

@@ -1,0 +1,166 @@
+"""``openral robot``: list, show and validate the robots under robots/.
+
+Examples::
+
+    openral robot list
+    openral robot show franka_panda
+    openral robot validate --all
+    openral robot validate path/to/robot.yaml
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from openral_core import (
+    ManifestError,
+    RobotDescription,
+    load_robot,
+    load_robot_by_id,
+    manifest_path,
+    robot_ids,
+    robot_tables,
+)
+from openral_core.registry import MANIFEST_NAME
+
+app = typer.Typer(help="Inspect and validate robot manifests.", no_args_is_help=True)
+out = Console(soft_wrap=True)
+err = Console(stderr=True, soft_wrap=True)
+
+
+@app.command("list")
+def list_robots() -> None:
+    """Table of every robot: id, joints, grippers, cameras, floating base."""
+    table = Table(title="robots/")
+    for column in ("id", "name", "joints", "grippers", "cameras", "floating base", "model"):
+        table.add_column(column)
+    invalid = 0
+    for robot_id in robot_ids():
+        try:
+            robot = load_robot_by_id(robot_id)
+        except ManifestError as error:
+            invalid += 1
+            problems = f"INVALID ({len(error.issues)} problem(s)); run `openral robot validate`"
+            table.add_row(robot_id, f"[red]{problems}[/]", "", "", "", "", "")
+            continue
+        sim = robot.sim
+        cameras = [s.name for s in robot.sensors if s.kind.value == "rgb"]
+        table.add_row(
+            robot.name,
+            robot.display_name,
+            str(len(robot.joints)),
+            str(len(sim.grippers)) if sim else "-",
+            ", ".join(cameras) or "-",
+            ("yes" if sim.floating_base else "no") if sim else "-",
+            sim.mjcf_uri if sim else "-",
+        )
+    out.print(table)
+    if invalid:
+        raise typer.Exit(1)
+
+
+@app.command("show")
+def show(robot_id: Annotated[str, typer.Argument(help="Robot id (folder under robots/).")]) -> None:
+    """The resolved HAL wiring, VLA slot table and joint-name map of one robot."""
+    robot = load_robot_by_id(robot_id)
+    tables = robot_tables(robot)
+    out.print(f"[bold]{robot.display_name}[/] ({robot.name}) — {manifest_path(robot_id)}")
+    wiring = tables.hal_wiring
+    joints = Table(title="joints and HAL wiring")
+    for column in ("joint", "type", "limits", "MJCF name", "qpos", "qvel", "actuator"):
+        joints.add_column(column)
+    for joint in robot.joints:
+        limits = joint.position_limits
+        joints.add_row(
+            joint.name,
+            joint.type.value,
+            f"[{limits[0]:g}, {limits[1]:g}]" if limits else "-",
+            tables.joint_name_map[joint.name],
+            str(wiring.joint_qpos_addr[joint.name]) if wiring else "-",
+            str(wiring.joint_qvel_addr[joint.name]) if wiring else "-",
+            str(wiring.actuator_index[joint.name]) if wiring else "-",
+        )
+    out.print(joints)
+    if wiring:
+        _print_sim_summary(wiring.mjcf_uri, robot)
+    slots = Table(title="VLA camera slots")
+    slots.add_column("sensor")
+    slots.add_column("slot")
+    for slot in tables.vla_slots:
+        slots.add_row(slot.sensor, slot.slot)
+    out.print(slots if tables.vla_slots else "no RGB cameras: no VLA slots")
+
+
+def _print_sim_summary(mjcf_uri: str, robot: RobotDescription) -> None:
+    wiring = robot_tables(robot).hal_wiring
+    assert wiring is not None
+    out.print(
+        f"model: {mjcf_uri}  floating base: {wiring.floating_base}  "
+        f"keyframe: {wiring.keyframe_index}  seed ctrl from qpos: {wiring.seed_ctrl_from_qpos}  "
+        f"control: {wiring.control_mode}  settle steps: {wiring.settle_steps_default}"
+    )
+    if not wiring.grippers:
+        return
+    grippers = Table(title="grippers")
+    for column in ("joint", "actuator", "mirror", "ctrl range", "qpos addrs", "scale", "read", "write"):
+        grippers.add_column(column)
+    for g in wiring.grippers:
+        grippers.add_row(
+            g.joint,
+            str(g.actuator_index),
+            "-" if g.mirror_actuator_index is None else str(g.mirror_actuator_index),
+            f"[{g.ctrl_range[0]:g}, {g.ctrl_range[1]:g}]",
+            ", ".join(map(str, g.qpos_addrs)),
+            f"{g.qpos_scale:g}",
+            g.read_mode,
+            g.write_mode,
+        )
+    out.print(grippers)
+
+
+@app.command("validate")
+def validate(
+    targets: Annotated[
+        list[str] | None,
+        typer.Argument(help="Robot ids, manifest files or robot folders.", show_default=False),
+    ] = None,
+    all_robots: Annotated[bool, typer.Option("--all", help="Validate every robot.")] = False,
+) -> None:
+    """Validate manifests; print every problem as file:line:col: field: message.
+
+    Exits 1 when any file is invalid, 2 when nothing was named.
+    """
+    files = [_manifest_file(t) for t in targets or []]
+    if all_robots:
+        files += [manifest_path(robot_id) for robot_id in robot_ids()]
+    if not files:
+        err.print("name robot ids or files to validate, or pass --all")
+        raise typer.Exit(2)
+    failures = 0
+    for file in files:
+        try:
+            load_robot(file, check_folder_name=file.name == MANIFEST_NAME)
+        except ManifestError as error:
+            failures += 1
+            err.print(f"{file}: [red]INVALID[/]", highlight=False)
+            for issue in error.issues:
+                err.print(f"  {issue.format()}", highlight=False, markup=False)
+            continue
+        out.print(f"{file}: [green]OK[/]", highlight=False)
+    if failures:
+        err.print(f"{failures} of {len(files)} file(s) invalid")
+        raise typer.Exit(1)
+
+
+def _manifest_file(target: str) -> Path:
+    path = Path(target)
+    if path.is_dir():
+        return path / MANIFEST_NAME
+    if path.suffix in (".yaml", ".yml") or path.exists():
+        return path
+    return manifest_path(target)

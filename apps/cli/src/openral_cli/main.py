@@ -1,0 +1,37 @@
+"""The ``openral`` command: builds the typer app and maps errors to exit codes.
+
+Every command lives in ``openral_cli.commands.<noun>``; this module only assembles them.
+An :class:`~openral_core.OpenralError` becomes one message on stderr and exit code 1;
+usage errors exit 2 (typer's convention).
+"""
+
+from __future__ import annotations
+
+import sys
+
+import typer
+from rich.console import Console
+
+from openral_cli.commands import robot
+from openral_core.errors import OpenralError
+
+app = typer.Typer(
+    name="openral",
+    help="Describe a robot once in robots/<id>/robot.yaml; simulate and deploy it.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+)
+app.add_typer(robot.app, name="robot")
+
+
+def run() -> None:
+    """Console-script entry point."""
+    try:
+        app()
+    except OpenralError as error:
+        Console(stderr=True).print(f"[bold red]error:[/] {error}", highlight=False, soft_wrap=True)
+        sys.exit(1)
+
+
+if __name__ == "__main__":
+    run()

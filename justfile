@@ -1,0 +1,48 @@
+# Recipes of the openral monorepo. Run them through ./bootstrap on a fresh machine
+# (it installs uv, just and the locked .venv first), or with `just` once set up.
+
+set shell := ["bash", "-euo", "pipefail", "-c"]
+
+export PATH := justfile_directory() + "/.venv/bin:" + env_var("PATH")
+export MUJOCO_GL := env_var_or_default("MUJOCO_GL", "egl")
+
+# List the recipes.
+default:
+    @just --list
+
+# The main job: list the robots and validate every manifest.
+demo:
+    openral robot list
+    openral robot validate --all
+
+# The whole test suite (extra arguments go to pytest).
+test *ARGS:
+    pytest {{ARGS}}
+
+# ruff lint and format check.
+lint:
+    ruff check libs apps tests benchmarks
+    ruff format --check libs apps tests benchmarks
+
+# mypy --strict on the handwritten libraries and apps.
+typecheck:
+    mypy
+
+# Regenerate generated/ and docs/reference/ from schema/ and robots/.
+schema-export:
+    python -m openral_codegen export
+
+# Fail when `just schema-export` would change, add or remove a file.
+schema-check:
+    python -m openral_codegen check
+
+# Build the docs site strictly into site/.
+docs:
+    mkdocs build --strict --site-dir site
+
+# Serve the docs site with live reload.
+docs-serve:
+    mkdocs serve
+
+# The static checks CI runs after the tests: lint, types, generated-tree drift.
+check: lint typecheck schema-check

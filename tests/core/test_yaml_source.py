@@ -1,0 +1,66 @@
+"""Tests for yaml_source.py: safe loading with positions."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from openral_core.errors import ManifestError
+from openral_core.yaml_source import format_field, load_located
+
+
+def _load_error(tmp_path: Path, text: str) -> ManifestError:
+    file = tmp_path / "doc.yaml"
+    file.write_text(text)
+    with pytest.raises(ManifestError) as info:
+        load_located(file)
+    return info.value
+
+
+def test_positions_are_one_based_line_and_column(tmp_path: Path) -> None:
+    file = tmp_path / "doc.yaml"
+    file.write_text("a: 1\nb:\n  - x: 2\n    y: [3, 4]\n")
+    doc = load_located(file)
+    assert doc.data == {"a": 1, "b": [{"x": 2, "y": [3, 4]}]}
+    assert doc.position(("a",)) == (1, 1)
+    assert doc.position(("b", 0, "y")) == (4, 5)
+    assert doc.position(("b", 0, "y", 1, "missing")) == doc.position(("b", 0, "y", 1))
+
+
+def test_duplicate_keys_name_both_lines_and_are_all_reported(tmp_path: Path) -> None:
+    error = _load_error(tmp_path, "a: 1\nb: {c: 1}\na: 2\nd:\n  - {e: 1, e: 2}\n")
+    messages = [issue.format() for issue in error.issues]
+    assert len(messages) == 2
+    assert messages[0].endswith("doc.yaml:3:1: a: duplicate key 'a': also defined on line 1; each key may appear once")
+    assert "d[0].e: duplicate key 'e': also defined on line 5" in messages[1]
+
+
+@pytest.mark.parametrize("value", [".inf", "-.inf", ".nan"])
+def test_non_finite_numbers_are_rejected(tmp_path: Path, value: str) -> None:
+    error = _load_error(tmp_path, f"x:\n  y: {value}\n")
+    (issue,) = error.issues
+    assert (issue.line, issue.field) == (2, "x.y")
+    assert "expected a finite number" in issue.message
+
+
+def test_custom_tags_and_dates_are_rejected(tmp_path: Path) -> None:
+    error = _load_error(tmp_path, "a: !python/object:os.system ls\nb: 2024-01-01\n")
+    fields = {issue.field: issue.message for issue in error.issues}
+    assert "custom YAML tag" in fields["a"]
+    assert "unsupported YAML value" in fields["b"]
+
+
+def test_syntax_error_is_located(tmp_path: Path) -> None:
+    (issue,) = _load_error(tmp_path, "a: [1, 2\nb: 3\n").issues
+    assert issue.line >= 1 and "invalid YAML" in issue.message
+
+
+def test_missing_file_is_reported_not_raised_raw(tmp_path: Path) -> None:
+    with pytest.raises(ManifestError, match="cannot read file"):
+        load_located(tmp_path / "absent.yaml")
+
+
+def test_format_field_renders_dots_and_indices() -> None:
+    assert format_field(("sim", "grippers", 0, "joint")) == "sim.grippers[0].joint"
+    assert format_field(()) == ""
