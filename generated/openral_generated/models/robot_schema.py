@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from enum import StrEnum
 from typing import Annotated, Literal
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import ConfigDict, Field
+from openral_base import OpenralModel
 from typing_extensions import TypeAliasType
 from . import sim_schema
 
@@ -33,7 +34,7 @@ PositionLimit = TypeAliasType(
 )
 
 
-class Joint(BaseModel):
+class Joint(OpenralModel):
     """
     One controllable joint.
     """
@@ -96,7 +97,7 @@ AngleRangeDegItem = TypeAliasType(
 )
 
 
-class Sensor(BaseModel):
+class Sensor(OpenralModel):
     """
     One camera, depth camera or lidar, read from the simulated scene.
     """
@@ -132,7 +133,7 @@ class Sensor(BaseModel):
     """
     MJCF body (native name) the camera is rigidly attached to, such as the hand for a wrist camera. Absent means a fixed camera placed by the scene.
     """
-    fovy_deg: Annotated[float, Field(gt=0.0, lt=180.0)] = 45
+    fovy_deg: Annotated[float, Field(gt=0.0, lt=180.0)] = 45.0
     """
     Vertical field of view [deg] of a camera the scene creates.
     """
@@ -184,7 +185,7 @@ class Sensor(BaseModel):
     """
 
 
-class RobotDescription(BaseModel):
+class RobotDescription(OpenralModel):
     """
     Everything openral knows about one robot arm, written once in robots/<id>/robot.yaml. The HAL, the simulated scene and the ROS 2 graph are all derived from this document.
     """

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from typing import Annotated, Literal
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import ConfigDict, Field
+from openral_base import OpenralModel
 from typing_extensions import TypeAliasType
 from enum import StrEnum
 
@@ -13,7 +14,7 @@ PositionMItem = TypeAliasType(
 )
 
 
-class BasePose(BaseModel):
+class BasePose(OpenralModel):
     """
     Pose of the robot base in the world frame.
     """
@@ -35,7 +36,7 @@ class BasePose(BaseModel):
     """
 
 
-class Observation(BaseModel):
+class Observation(OpenralModel):
     """
     Rendered image size shared by every camera of the scene.
     """
@@ -69,7 +70,7 @@ SizeMItem = TypeAliasType("SizeMItem", Annotated[float, Field(gt=0.0, le=10.0)])
 RgbaItem = TypeAliasType("RgbaItem", Annotated[float, Field(ge=0.0, le=1.0)])
 
 
-class SceneObject(BaseModel):
+class SceneObject(OpenralModel):
     """
     A simple primitive object placed in a native scene.
     """
@@ -112,7 +113,7 @@ class SceneObject(BaseModel):
     """
 
 
-class SceneOptions(BaseModel):
+class SceneOptions(OpenralModel):
     """
     Backend options. Each backend reads the fields that apply to it and ignores none silently: a field another backend owns is an error when the scene is built.
     """
@@ -120,7 +121,7 @@ class SceneOptions(BaseModel):
     model_config = ConfigDict(
         extra="forbid",
     )
-    control_freq_hz: Annotated[float, Field(gt=0.0, le=1000.0)] = 20
+    control_freq_hz: Annotated[float, Field(gt=0.0, le=1000.0)] = 20.0
     """
     How often an action is applied [Hz]; each env.step advances 1/control_freq_hz seconds of physics.
     """
@@ -158,7 +159,7 @@ Camera = TypeAliasType(
 )
 
 
-class SceneSpec(BaseModel):
+class SceneSpec(OpenralModel):
     """
     Scene identity, backend, assets, image size and cameras.
     """
@@ -192,7 +193,7 @@ class SceneSpec(BaseModel):
     """
 
 
-class DeployScene(BaseModel):
+class DeployScene(OpenralModel):
     """
     A deploy scene: the file passed as `--config` to `openral sim run` and `openral deploy sim`. It names the robot, the simulator backend that owns physics and pixels, the cameras to render and where the robot stands.
     """

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from typing import Annotated
-from pydantic import BaseModel, ConfigDict, Field, StringConstraints
+from pydantic import ConfigDict, Field, StringConstraints
+from openral_base import OpenralModel
 from typing_extensions import TypeAliasType
 from enum import StrEnum
 
@@ -50,7 +51,7 @@ CtrlRangeItem = TypeAliasType(
 QposAddr = TypeAliasType("QposAddr", Annotated[int, Field(ge=0, le=10000)])
 
 
-class SimGripperDescription(BaseModel):
+class SimGripperDescription(OpenralModel):
     """
     Wiring of one gripper.
     """
@@ -76,11 +77,11 @@ class SimGripperDescription(BaseModel):
     """
     Divisor for `sum_over_scale`: the summed qpos when fully open [m or rad].
     """
-    read_mode: GripperReadMode = "sum_over_scale"
+    read_mode: GripperReadMode = GripperReadMode.sum_over_scale
     """
     How the reported gripper position is computed (see GripperReadMode).
     """
-    write_mode: GripperWriteMode = "normalised"
+    write_mode: GripperWriteMode = GripperWriteMode.normalised
     """
     How a gripper command is written to ctrl (see GripperWriteMode).
     """
@@ -125,7 +126,7 @@ KdAdditionalProperty = TypeAliasType(
 )
 
 
-class SimControl(BaseModel):
+class SimControl(OpenralModel):
     """
     Control law between joint targets and actuator controls.
     """
@@ -161,7 +162,7 @@ class SimControl(BaseModel):
     """
 
 
-class SimDescription(BaseModel):
+class SimDescription(OpenralModel):
     """
     MuJoCo wiring of one robot: where its MJCF model comes from and how the canonical joints map onto the model's qpos, qvel and actuators. Every map is optional: without one, joints map 1:1 in canonical order (offset by 7 in qpos and 6 in qvel when the robot has a floating base).
     """
