@@ -58,7 +58,12 @@ def model_files(root: Path) -> ExportFiles:
 
 def derived_files(root: Path) -> ExportFiles:
     """Per-robot tables and the schema reference pages, keyed by repo-relative path."""
-    from openral_codegen.schema_docs import page_name, reference_index, render_schema_page
+    from openral_codegen.schema_docs import (
+        page_name,
+        read_schemas,
+        reference_index,
+        render_schema_page,
+    )
     from openral_core.errors import ManifestError
     from openral_core.loader import load_robot
     from openral_core.registry import manifest_path, robot_ids
@@ -78,9 +83,10 @@ def derived_files(root: Path) -> ExportFiles:
         files[f"generated/openral_generated/tables/{robot_id}.json"] = table.encode()
     if problems:
         raise CodegenError("cannot export tables of invalid manifests:\n" + "\n".join(problems))
+    schemas = read_schemas(root / "schema")
     for name in SchemaName:
-        files[f"docs/reference/{page_name(name)}"] = render_schema_page(name).encode()
-    files["docs/reference/index.md"] = reference_index().encode()
+        files[f"docs/reference/{page_name(name)}"] = render_schema_page(name, schemas).encode()
+    files["docs/reference/index.md"] = reference_index(schemas).encode()
     return files
 
 

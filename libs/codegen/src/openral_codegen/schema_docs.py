@@ -8,9 +8,13 @@ description, and the cross-field rules from ``$comment``.
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
+from pathlib import Path
 from typing import Any
 
-from openral_core.schemas import SchemaName, load_schema
+from openral_core.schemas import SchemaName
+
+Schemas = Mapping[SchemaName, dict[str, Any]]
 
 HEADER = "<!-- GENERATED from schema/ by `just schema-export` -- do not edit. -->\n"
 
@@ -32,20 +36,25 @@ def page_name(name: SchemaName) -> str:
     return f"{name.value}.md"
 
 
-def render_schema_page(name: SchemaName) -> str:
+def read_schemas(schema_dir: Path) -> dict[SchemaName, dict[str, Any]]:
+    """Parse every schema file in ``schema_dir``."""
+    return {n: json.loads((schema_dir / n.file_name).read_text("utf-8")) for n in SchemaName}
+
+
+def render_schema_page(name: SchemaName, schemas: Schemas) -> str:
     """The Markdown reference page of schema ``name``."""
-    schema = load_schema(name)
+    schema = schemas[name]
     parts = [
         HEADER,
         f"# {schema['title']}\n",
         f"{schema['description']}\n",
         f"Source: `schema/{name.file_name}` (JSON Schema draft 2020-12, `$id` "
         f"`{schema['$id']}`).\n",
-        _object_section(schema["title"], schema, level=2, with_description=False),
+        _object_section(schema["title"], schema, schemas, with_description=False),
     ]
     for def_name, definition in schema.get("$defs", {}).items():
         if definition.get("type") == "object":
-            parts.append(_object_section(def_name, definition, level=2))
+            parts.append(_object_section(def_name, definition, schemas))
         else:
             parts.append(_value_section(def_name, definition))
     if "$comment" in schema:
@@ -53,8 +62,8 @@ def render_schema_page(name: SchemaName) -> str:
     return "\n".join(parts)
 
 
-def property_names(name: SchemaName) -> set[str]:
-    """Every property name declared anywhere in schema ``name`` (for coverage tests)."""
+def property_names(schema: dict[str, Any]) -> set[str]:
+    """Every property name declared anywhere in ``schema`` (for coverage tests)."""
     names: set[str] = set()
 
     def walk(node: Any) -> None:
@@ -66,12 +75,14 @@ def property_names(name: SchemaName) -> set[str]:
             for item in node:
                 walk(item)
 
-    walk(load_schema(name))
+    walk(schema)
     return names
 
 
-def _object_section(title: str, schema: dict[str, Any], *, level: int, with_description: bool = True) -> str:
-    lines = [f"{'#' * level} {title}\n"]
+def _object_section(
+    title: str, schema: dict[str, Any], schemas: Schemas, *, with_description: bool = True
+) -> str:
+    lines = [f"## {title}\n"]
     if with_description and schema.get("description"):
         lines.append(f"{schema['description']}\n")
     required = set(schema.get("required", []))
@@ -84,7 +95,7 @@ def _object_section(title: str, schema: dict[str, Any], *, level: int, with_desc
             + " | ".join(
                 [
                     f"`{prop}`",
-                    _type_text(spec),
+                    _type_text(spec, schemas),
                     "yes" if prop in required else "no",
                     default,
                     _constraint_text(spec),
@@ -106,25 +117,25 @@ def _value_section(title: str, schema: dict[str, Any]) -> str:
     return text
 
 
-def _type_text(spec: dict[str, Any]) -> str:
+def _type_text(spec: dict[str, Any], schemas: Schemas) -> str:
     if "$ref" in spec:
         ref = str(spec["$ref"])
         if ref.startswith("#/$defs/"):
             target = ref.removeprefix("#/$defs/")
             return f"[{target}](#{target.lower()})"
         other = SchemaName(ref.removesuffix(".schema.json"))
-        return f"[{load_schema(other)['title']}]({page_name(other)})"
+        return f"[{schemas[other]['title']}]({page_name(other)})"
     if "const" in spec:
         return f"`{json.dumps(spec['const'])}`"
     if "enum" in spec:
         return " \\| ".join(f"`{v}`" for v in spec["enum"])
     if "oneOf" in spec:
-        return " or ".join(_type_text(option) for option in spec["oneOf"])
+        return " or ".join(_type_text(option, schemas) for option in spec["oneOf"])
     kind = spec.get("type", "any")
     if kind == "array":
-        return f"list of {_type_text(spec.get('items', {}))}"
+        return f"list of {_type_text(spec.get('items', {}), schemas)}"
     if kind == "object" and isinstance(spec.get("additionalProperties"), dict):
-        return f"map of name → {_type_text(spec['additionalProperties'])}"
+        return f"map of name → {_type_text(spec['additionalProperties'], schemas)}"
     return str(kind)
 
 
@@ -183,10 +194,10 @@ def _cell(text: str) -> str:
     return text.replace("|", "\\|").replace("\n", " ")
 
 
-def reference_index() -> str:
+def reference_index(schemas: Schemas) -> str:
     """The landing page of the reference section."""
     lines = [HEADER, "# Schema reference\n", "Generated from the JSON Schemas in `schema/`.\n"]
     for name in SchemaName:
-        schema = load_schema(name)
+        schema = schemas[name]
         lines.append(f"- [{schema['title']}]({page_name(name)}) — {schema['description']}")
     return "\n".join(lines) + "\n"

@@ -1,0 +1,64 @@
+"""Tests for `openral robot`: list, show, validate and their exit codes."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from openral_cli.main import app
+from openral_core import robot_ids
+from tests.conftest import FRANKA, ROBOTS, ManifestWriter
+
+runner = CliRunner()
+
+
+def test_list_shows_every_robot_with_its_counts() -> None:
+    result = runner.invoke(app, ["robot", "list"], env={"COLUMNS": "200"})
+    assert result.exit_code == 0, result.output
+    for robot_id in robot_ids(ROBOTS):
+        assert robot_id in result.output
+    franka_row = next(line for line in result.output.splitlines() if "franka_panda" in line)
+    assert "│ 8 " in franka_row and "agentview, wrist" in franka_row
+
+
+def test_show_prints_wiring_and_slot_tables() -> None:
+    result = runner.invoke(app, ["robot", "show", "franka_panda"], env={"COLUMNS": "200"})
+    assert result.exit_code == 0, result.output
+    assert "panda_joint4" in result.output and "joint4" in result.output
+    assert "camera1" in result.output and "sum_over_scale" in result.output
+
+
+def test_validate_all_passes_on_the_repository() -> None:
+    result = runner.invoke(app, ["robot", "validate", "--all"])
+    assert result.exit_code == 0, result.output
+    assert result.output.count(": OK") == len(robot_ids(ROBOTS))
+
+
+def test_validate_bad_file_exits_1_with_located_message(write_manifest: ManifestWriter) -> None:
+    path = write_manifest(("base: fixed", "base: fixed\nbase: mobile"))
+    result = runner.invoke(app, ["robot", "validate", str(path)])
+    assert result.exit_code == 1
+    assert f"{path}:7:1: base: duplicate key 'base': also defined on line 6" in result.output
+
+
+def test_validate_accepts_ids_folders_and_files() -> None:
+    result = runner.invoke(app, ["robot", "validate", "franka_panda", str(FRANKA.parent), str(FRANKA)])
+    assert result.exit_code == 0, result.output
+    assert result.output.count(": OK") == 3
+
+
+def test_validate_without_targets_is_a_usage_error() -> None:
+    assert runner.invoke(app, ["robot", "validate"]).exit_code == 2
+
+
+@pytest.mark.parametrize("command", [["robot", "show", "no_such_robot"], ["robot", "validate", "no_such_robot"]])
+def test_unknown_robot_is_one_clear_error_without_traceback(command: list[str]) -> None:
+    cli = Path(sys.executable).with_name("openral")
+    result = subprocess.run([str(cli), *command], capture_output=True, text=True, check=False)
+    assert result.returncode == 1
+    assert "unknown robot 'no_such_robot'; known robots:" in result.stderr
+    assert "Traceback" not in result.stderr + result.stdout

@@ -1,0 +1,106 @@
+"""Drift guards for tables.py: exported tables equal the runtime resolution, and the slot rule."""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+from hypothesis import HealthCheck, Phase, assume, given, settings
+from hypothesis import strategies as st
+from hypothesis_jsonschema import from_schema
+
+from openral_core.models import RobotDescription, Sensor
+from openral_core.rules import robot_findings
+from openral_core.schemas import SchemaName, bundled_schema
+from openral_core.tables import FREE_JOINT_NDOF, FREE_JOINT_NQPOS, RobotTables, robot_tables, vla_slots
+
+SETTINGS = settings(
+    max_examples=40,
+    deadline=None,
+    phases=[Phase.explicit, Phase.reuse, Phase.generate],
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
+
+
+def _repair(document: dict[str, Any]) -> dict[str, Any]:
+    """Point a drawn sim block's joint references at the drawn joints, so rules can pass."""
+    sim = document.get("sim")
+    if sim is None:
+        return document
+    joints = [j["name"] for j in document["joints"]]
+    for field in ("joint_qpos_addr", "joint_qvel_addr", "actuator_index"):
+        if field in sim:
+            values = list(sim[field].values())
+            sim[field] = dict(zip(joints, values, strict=False))
+    grippers = sim.get("grippers", [])[: len(joints)]
+    for gripper, joint in zip(grippers, reversed(joints), strict=False):
+        gripper["joint"] = joint
+        gripper["ctrl_range"] = sorted(gripper["ctrl_range"])
+    sim["grippers"] = grippers
+    control = sim.get("control", {})
+    for gain in ("kp", "kd"):
+        if isinstance(control.get(gain), dict):
+            control[gain] = {j: 1.0 + i for i, j in enumerate(joints)}
+    return document
+
+
+@SETTINGS
+@given(from_schema(bundled_schema(SchemaName.ROBOT)).map(_repair))
+def test_exported_tables_equal_runtime_resolution(document: Any) -> None:
+    robot = RobotDescription.model_validate_json(json.dumps(document), strict=True)
+    assume(not robot_findings(robot, None))
+    tables = robot_tables(robot)
+    # What `just schema-export` writes, read back, is what the runtime computes.
+    assert RobotTables.from_json(tables.to_json()) == tables
+    wiring, sim = tables.hal_wiring, robot.sim
+    if sim is None:
+        assert wiring is None
+        return
+    assert wiring is not None
+    for index, joint in enumerate(robot.joints):
+        qpos_default = index + (FREE_JOINT_NQPOS if sim.floating_base else 0)
+        qvel_default = index + (FREE_JOINT_NDOF if sim.floating_base else 0)
+        assert wiring.joint_qpos_addr[joint.name] == (sim.joint_qpos_addr or {}).get(joint.name, qpos_default)
+        assert wiring.joint_qvel_addr[joint.name] == (sim.joint_qvel_addr or {}).get(joint.name, qvel_default)
+        assert wiring.actuator_index[joint.name] == (sim.actuator_index or {}).get(joint.name, index)
+
+
+SLOT_NAMES = st.sampled_from(["camera1", "camera2", "agentview", "wrist", "image"])
+
+
+@st.composite
+def sensor_lists(draw: st.DrawFn) -> list[Sensor]:
+    count = draw(st.integers(min_value=0, max_value=5))
+    names = draw(st.lists(SLOT_NAMES, min_size=count, max_size=count, unique=True))
+    sensors = []
+    for name in names:
+        kind = draw(st.sampled_from(["rgb", "rgb", "depth"]))
+        entry: dict[str, Any] = {
+            "name": name, "kind": kind, "width": 8, "height": 8, "rate_hz": 10.0, "frame_id": "f",
+        }
+        if kind == "rgb" and draw(st.booleans()):
+            entry["vla_feature_key"] = f"observation.images.{draw(SLOT_NAMES)}"
+        sensors.append(Sensor.model_validate(entry))
+    return sensors
+
+
+@SETTINGS
+@given(sensor_lists())
+def test_slot_rule_gives_unique_slots_in_manifest_order(sensors: list[Sensor]) -> None:
+    robot = RobotDescription.model_validate(
+        {
+            "schema_version": "0.1", "name": "arm", "display_name": "Arm", "base": "fixed",
+            "joints": [{"name": "j", "type": "continuous", "velocity_limit": 1.0, "effort_limit": 1.0}],
+            "sensors": [s.model_dump(exclude_none=True) for s in sensors],
+        }
+    )
+    slots = vla_slots(robot)
+    rgb = [s for s in sensors if s.kind.value == "rgb"]
+    assert [slot.sensor for slot in slots] == [s.name for s in rgb]
+    for slot, sensor in zip(slots, rgb, strict=True):
+        key = sensor.vla_feature_key
+        assert slot.slot == (key.removeprefix("observation.images.") if key else sensor.name)
+    names = [slot.slot for slot in slots]
+    duplicate_findings = [f for f in robot_findings(robot, None) if "duplicate VLA slot" in f[1]]
+    # The rules reject exactly the lists whose slots collide; accepted lists have unique slots.
+    assert (len(set(names)) == len(names)) == (not duplicate_findings)
