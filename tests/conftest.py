@@ -6,7 +6,6 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
-
 from openral_core.paths import repo_root
 
 REPO = repo_root()

@@ -7,10 +7,10 @@ import sys
 from pathlib import Path
 
 import pytest
-from typer.testing import CliRunner
-
 from openral_cli.main import app
 from openral_core import robot_ids
+from typer.testing import CliRunner
+
 from tests.conftest import FRANKA, ROBOTS, ManifestWriter
 
 runner = CliRunner()
@@ -46,7 +46,9 @@ def test_validate_bad_file_exits_1_with_located_message(write_manifest: Manifest
 
 
 def test_validate_accepts_ids_folders_and_files() -> None:
-    result = runner.invoke(app, ["robot", "validate", "franka_panda", str(FRANKA.parent), str(FRANKA)])
+    result = runner.invoke(
+        app, ["robot", "validate", "franka_panda", str(FRANKA.parent), str(FRANKA)]
+    )
     assert result.exit_code == 0, result.output
     assert result.output.count(": OK") == 3
 
@@ -55,7 +57,9 @@ def test_validate_without_targets_is_a_usage_error() -> None:
     assert runner.invoke(app, ["robot", "validate"]).exit_code == 2
 
 
-@pytest.mark.parametrize("command", [["robot", "show", "no_such_robot"], ["robot", "validate", "no_such_robot"]])
+@pytest.mark.parametrize(
+    "command", [["robot", "show", "no_such_robot"], ["robot", "validate", "no_such_robot"]]
+)
 def test_unknown_robot_is_one_clear_error_without_traceback(command: list[str]) -> None:
     cli = Path(sys.executable).with_name("openral")
     result = subprocess.run([str(cli), *command], capture_output=True, text=True, check=False)

@@ -6,6 +6,7 @@ import shutil
 from pathlib import Path
 
 from openral_codegen import check, export
+
 from tests.conftest import REPO
 
 COPIED = ("schema", "robots", "generated", "docs", "pyproject.toml")

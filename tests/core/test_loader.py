@@ -5,11 +5,13 @@ from __future__ import annotations
 import re
 
 import pytest
-
 from openral_core import ManifestError, load_robot, load_scene
+
 from tests.conftest import FRANKA, ManifestWriter
 
-LOCATED = re.compile(r"^(?P<file>.+\.yaml):(?P<line>\d+):(?P<col>\d+): (?P<field>\S+): (?P<msg>.+)$")
+LOCATED = re.compile(
+    r"^(?P<file>.+\.yaml):(?P<line>\d+):(?P<col>\d+): (?P<field>\S+): (?P<msg>.+)$"
+)
 
 
 def _issues(path: object) -> list[re.Match[str]]:
@@ -33,8 +35,18 @@ def test_franka_manifest_loads() -> None:
         (("base: fixed", "base: fixed\ncolour: red"), "colour", 7, "unknown field 'colour'"),
         (("base: fixed", "base: fixed\nbase: mobile"), "base", 7, "also defined on line 6"),
         (("{joint: jaw,", "{joint: claw,"), "sim.grippers[0].joint", 20, "'claw' is not a joint"),
-        (("qpos_scale: 0.1", "qpos_scale: wide"), "sim.grippers[0].qpos_scale", 20, "expected a number, got a string 'wide'"),
-        (("observation.images.camera1", "observation.imgs.camera1"), "sensors[0].vla_feature_key", 12, "does not match the required form"),
+        (
+            ("qpos_scale: 0.1", "qpos_scale: wide"),
+            "sim.grippers[0].qpos_scale",
+            20,
+            "expected a number, got a string 'wide'",
+        ),
+        (
+            ("observation.images.camera1", "observation.imgs.camera1"),
+            "sensors[0].vla_feature_key",
+            12,
+            "does not match the required form",
+        ),
     ],
     ids=["unknown-key", "duplicate-key", "gripper-not-a-joint", "string-for-number", "bad-vla-key"],
 )
@@ -59,7 +71,9 @@ def test_every_problem_of_a_file_is_reported_at_once(write_manifest: ManifestWri
     assert fields == {"display_name", "joints[1].velocity_limit", "sensors[2].width"}
 
 
-def test_missing_required_field_names_the_parent_and_the_field(write_manifest: ManifestWriter) -> None:
+def test_missing_required_field_names_the_parent_and_the_field(
+    write_manifest: ManifestWriter,
+) -> None:
     path = write_manifest((", effort_limit: 10.0", ""))
     (match,) = _issues(path)
     assert match["field"] == "joints[1]"
@@ -67,7 +81,9 @@ def test_missing_required_field_names_the_parent_and_the_field(write_manifest: M
 
 
 def test_conditional_rules_explain_the_condition(write_manifest: ManifestWriter) -> None:
-    path = write_manifest(("site: lidar_site, ", ""), ("kind: rgb, width: 64", "kind: rgb, site: s, width: 64"))
+    path = write_manifest(
+        ("site: lidar_site, ", ""), ("kind: rgb, width: 64", "kind: rgb, site: s, width: 64")
+    )
     messages = {m["field"]: m["msg"] for m in _issues(path)}
     assert messages["sensors[3]"] == "missing required field 'site' (because kind is 'lidar')"
     assert messages["sensors[0].site"] == "field 'site' is not allowed here (because kind is 'rgb')"

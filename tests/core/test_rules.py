@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import pytest
-
 from openral_core import ManifestError, load_robot
+
 from tests.conftest import ManifestWriter
 
 
@@ -21,21 +21,74 @@ def test_mock_arm_passes_every_rule(write_manifest: ManifestWriter) -> None:
 @pytest.mark.parametrize(
     ("edit", "field", "fragment"),
     [
-        (("name: wrist_roll", "name: shoulder"), "joints[1].name", "duplicate joint name 'shoulder'"),
-        (("name: jaw, type", "name: jaw, sim_joint_name: roll, type"), "joints[2].sim_joint_name", "duplicate sim_joint_name 'roll'"),
-        (("name: hand, kind", "name: overhead, kind"), "sensors[1].name", "duplicate sensor name 'overhead'"),
-        (("position_limits: [-1.5, 1.5]", "position_limits: [1.5, -1.5]"), "joints[0].position_limits", "lower limit 1.5 must be below upper limit -1.5"),
-        (("ctrl_range: [0.0, 1.0]", "ctrl_range: [1.0, 1.0]"), "sim.grippers[0].ctrl_range", "lower bound 1.0 must be below upper bound 1.0"),
-        (("joint_qpos_addr: {jaw: 3}", "joint_qpos_addr: {elbow: 3}"), "sim.joint_qpos_addr.elbow", "'elbow' is not a joint"),
-        (("joint_qpos_addr: {jaw: 3}", "joint_qvel_addr: {elbow: 3}"), "sim.joint_qvel_addr.elbow", "'elbow' is not a joint"),
-        (("joint_qpos_addr: {jaw: 3}", "actuator_index: {elbow: 3}"), "sim.actuator_index.elbow", "'elbow' is not a joint"),
-        (("frame_id: hand_optical}", "frame_id: hand_optical, vla_feature_key: observation.images.camera1}"), "sensors[1]", "duplicate VLA slot 'camera1'"),
-        (("vla_feature_key: observation.images.camera1}", "vla_feature_key: observation.images.hand}"), "sensors[1]", "duplicate VLA slot 'hand'"),
+        (
+            ("name: wrist_roll", "name: shoulder"),
+            "joints[1].name",
+            "duplicate joint name 'shoulder'",
+        ),
+        (
+            ("name: jaw, type", "name: jaw, sim_joint_name: roll, type"),
+            "joints[2].sim_joint_name",
+            "duplicate sim_joint_name 'roll'",
+        ),
+        (
+            ("name: hand, kind", "name: overhead, kind"),
+            "sensors[1].name",
+            "duplicate sensor name 'overhead'",
+        ),
+        (
+            ("position_limits: [-1.5, 1.5]", "position_limits: [1.5, -1.5]"),
+            "joints[0].position_limits",
+            "lower limit 1.5 must be below upper limit -1.5",
+        ),
+        (
+            ("ctrl_range: [0.0, 1.0]", "ctrl_range: [1.0, 1.0]"),
+            "sim.grippers[0].ctrl_range",
+            "lower bound 1.0 must be below upper bound 1.0",
+        ),
+        (
+            ("joint_qpos_addr: {jaw: 3}", "joint_qpos_addr: {elbow: 3}"),
+            "sim.joint_qpos_addr.elbow",
+            "'elbow' is not a joint",
+        ),
+        (
+            ("joint_qpos_addr: {jaw: 3}", "joint_qvel_addr: {elbow: 3}"),
+            "sim.joint_qvel_addr.elbow",
+            "'elbow' is not a joint",
+        ),
+        (
+            ("joint_qpos_addr: {jaw: 3}", "actuator_index: {elbow: 3}"),
+            "sim.actuator_index.elbow",
+            "'elbow' is not a joint",
+        ),
+        (
+            (
+                "frame_id: hand_optical}",
+                "frame_id: hand_optical, vla_feature_key: observation.images.camera1}",
+            ),
+            "sensors[1]",
+            "duplicate VLA slot 'camera1'",
+        ),
+        (
+            (
+                "vla_feature_key: observation.images.camera1}",
+                "vla_feature_key: observation.images.hand}",
+            ),
+            "sensors[1]",
+            "duplicate VLA slot 'hand'",
+        ),
     ],
     ids=[
-        "duplicate-joint", "duplicate-sim-joint-name", "duplicate-sensor", "limits-order",
-        "ctrl-range-order", "qpos-map-key", "qvel-map-key", "actuator-map-key",
-        "duplicate-vla-slot", "vla-slot-collides-with-sensor-name",
+        "duplicate-joint",
+        "duplicate-sim-joint-name",
+        "duplicate-sensor",
+        "limits-order",
+        "ctrl-range-order",
+        "qpos-map-key",
+        "qvel-map-key",
+        "actuator-map-key",
+        "duplicate-vla-slot",
+        "vla-slot-collides-with-sensor-name",
     ],
 )
 def test_rule_violation_is_reported(
@@ -47,8 +100,13 @@ def test_rule_violation_is_reported(
 
 
 def test_second_gripper_on_the_same_joint_is_rejected(write_manifest: ManifestWriter) -> None:
-    entry = "{joint: jaw, ctrl_range: [0.0, 1.0], qpos_addrs: [3, 4], qpos_scale: 0.1, mirror_actuator_index: 3}"
-    path = write_manifest((entry, entry + "\n    - " + entry.replace(", mirror_actuator_index: 3", "")))
+    entry = (
+        "{joint: jaw, ctrl_range: [0.0, 1.0], qpos_addrs: [3, 4], qpos_scale: 0.1, "
+        "mirror_actuator_index: 3}"
+    )
+    path = write_manifest(
+        (entry, entry + "\n    - " + entry.replace(", mirror_actuator_index: 3", ""))
+    )
     assert _findings(path) == {"sim.grippers[1].joint": "joint 'jaw' already has a gripper entry"}
 
 
@@ -61,7 +119,15 @@ def test_torque_pd_gain_maps_must_name_every_driven_joint(write_manifest: Manife
 
 
 def test_torque_pd_needs_gains_and_position_forbids_them(write_manifest: ManifestWriter) -> None:
-    torque = write_manifest(("  grippers:\n", "  control: {mode: torque_pd, kp: 1.0}\n  grippers:\n"))
-    assert _findings(torque) == {"sim.control": "missing required field 'kd' (because mode is 'torque_pd')"}
-    position = write_manifest(("  grippers:\n", "  control: {mode: position, kp: 1.0}\n  grippers:\n"))
-    assert _findings(position) == {"sim.control.kp": "field 'kp' is not allowed here (because mode is 'position')"}
+    torque = write_manifest(
+        ("  grippers:\n", "  control: {mode: torque_pd, kp: 1.0}\n  grippers:\n")
+    )
+    assert _findings(torque) == {
+        "sim.control": "missing required field 'kd' (because mode is 'torque_pd')"
+    }
+    position = write_manifest(
+        ("  grippers:\n", "  control: {mode: position, kp: 1.0}\n  grippers:\n")
+    )
+    assert _findings(position) == {
+        "sim.control.kp": "field 'kp' is not allowed here (because mode is 'position')"
+    }

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from openral_core import load_robot, robot_tables
 from openral_core.tables import FREE_JOINT_NDOF, FREE_JOINT_NQPOS, RobotTables
+
 from tests.conftest import MOCK_ARM, ManifestWriter
 
 
@@ -14,7 +15,9 @@ def test_defaults_follow_joint_order_and_overrides_win() -> None:
     assert wiring.joint_qpos_addr == {"shoulder": 0, "wrist_roll": 1, "jaw": 3}
     assert wiring.joint_qvel_addr == {"shoulder": 0, "wrist_roll": 1, "jaw": 2}
     assert wiring.actuator_index == {"shoulder": 0, "wrist_roll": 1, "jaw": 2}
-    assert wiring.control_mode == "position" and wiring.kp == {} and wiring.settle_steps_default == 1
+    assert (
+        wiring.control_mode == "position" and wiring.kp == {} and wiring.settle_steps_default == 1
+    )
 
 
 def test_floating_base_shifts_default_addresses(write_manifest: ManifestWriter) -> None:
@@ -26,7 +29,9 @@ def test_floating_base_shifts_default_addresses(write_manifest: ManifestWriter) 
     assert list(wiring.actuator_index.values()) == [0, 1, 2]
 
 
-def test_gripper_actuator_resolves_from_its_joint_unless_given(write_manifest: ManifestWriter) -> None:
+def test_gripper_actuator_resolves_from_its_joint_unless_given(
+    write_manifest: ManifestWriter,
+) -> None:
     (gripper,) = robot_tables(load_robot(MOCK_ARM)).hal_wiring.grippers  # type: ignore[union-attr]
     assert (gripper.actuator_index, gripper.mirror_actuator_index) == (2, 3)
     assert (gripper.read_mode, gripper.write_mode) == ("sum_over_scale", "normalised")
@@ -37,7 +42,9 @@ def test_gripper_actuator_resolves_from_its_joint_unless_given(write_manifest: M
 
 def test_torque_pd_gains_expand_per_driven_joint(write_manifest: ManifestWriter) -> None:
     control = "  control: {mode: torque_pd, kp: {shoulder: 100.0, wrist_roll: 5.0}, kd: 2.0}\n"
-    wiring = robot_tables(load_robot(write_manifest(("  grippers:\n", control + "  grippers:\n")))).hal_wiring
+    wiring = robot_tables(
+        load_robot(write_manifest(("  grippers:\n", control + "  grippers:\n")))
+    ).hal_wiring
     assert wiring is not None and wiring.control_mode == "torque_pd"
     assert wiring.kp == {"shoulder": 100.0, "wrist_roll": 5.0}
     assert wiring.kd == {"shoulder": 2.0, "wrist_roll": 2.0}
@@ -45,7 +52,10 @@ def test_torque_pd_gains_expand_per_driven_joint(write_manifest: ManifestWriter)
 
 def test_vla_slots_use_key_suffix_else_name_in_manifest_order() -> None:
     tables = robot_tables(load_robot(MOCK_ARM))
-    assert [(s.sensor, s.slot) for s in tables.vla_slots] == [("overhead", "camera1"), ("hand", "hand")]
+    assert [(s.sensor, s.slot) for s in tables.vla_slots] == [
+        ("overhead", "camera1"),
+        ("hand", "hand"),
+    ]
 
 
 def test_joint_name_map_uses_sim_joint_name_else_canonical() -> None:

@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-
 from openral_core.errors import ManifestError
 from openral_core.yaml_source import format_field, load_located
 
@@ -32,7 +31,9 @@ def test_duplicate_keys_name_both_lines_and_are_all_reported(tmp_path: Path) -> 
     error = _load_error(tmp_path, "a: 1\nb: {c: 1}\na: 2\nd:\n  - {e: 1, e: 2}\n")
     messages = [issue.format() for issue in error.issues]
     assert len(messages) == 2
-    assert messages[0].endswith("doc.yaml:3:1: a: duplicate key 'a': also defined on line 1; each key may appear once")
+    assert messages[0].endswith(
+        "doc.yaml:3:1: a: duplicate key 'a': also defined on line 1; each key may appear once"
+    )
     assert "d[0].e: duplicate key 'e': also defined on line 5" in messages[1]
 
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from openral_codegen.schema_docs import property_names, read_schemas
 from openral_core.schemas import SchemaName
+
 from tests.conftest import REPO
 
 

@@ -15,10 +15,9 @@ import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 from hypothesis_jsonschema import from_schema
-from pydantic import BaseModel, ValidationError
-
 from openral_core.models import DeployScene, RobotDescription, SimDescription
 from openral_core.schemas import SchemaName, bundled_schema, validator
+from pydantic import BaseModel, ValidationError
 
 MODELS: dict[SchemaName, type[BaseModel]] = {
     SchemaName.ROBOT: RobotDescription,
@@ -31,7 +30,11 @@ SETTINGS = settings(
     max_examples=40,
     deadline=None,
     phases=[Phase.explicit, Phase.reuse, Phase.generate],
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much, HealthCheck.data_too_large],
+    suppress_health_check=[
+        HealthCheck.too_slow,
+        HealthCheck.filter_too_much,
+        HealthCheck.data_too_large,
+    ],
 )
 
 

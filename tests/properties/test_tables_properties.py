@@ -8,11 +8,16 @@ from typing import Any
 from hypothesis import HealthCheck, Phase, assume, given, settings
 from hypothesis import strategies as st
 from hypothesis_jsonschema import from_schema
-
 from openral_core.models import RobotDescription, Sensor
 from openral_core.rules import robot_findings
 from openral_core.schemas import SchemaName, bundled_schema
-from openral_core.tables import FREE_JOINT_NDOF, FREE_JOINT_NQPOS, RobotTables, robot_tables, vla_slots
+from openral_core.tables import (
+    FREE_JOINT_NDOF,
+    FREE_JOINT_NQPOS,
+    RobotTables,
+    robot_tables,
+    vla_slots,
+)
 
 SETTINGS = settings(
     max_examples=40,
@@ -60,9 +65,15 @@ def test_exported_tables_equal_runtime_resolution(document: Any) -> None:
     for index, joint in enumerate(robot.joints):
         qpos_default = index + (FREE_JOINT_NQPOS if sim.floating_base else 0)
         qvel_default = index + (FREE_JOINT_NDOF if sim.floating_base else 0)
-        assert wiring.joint_qpos_addr[joint.name] == (sim.joint_qpos_addr or {}).get(joint.name, qpos_default)
-        assert wiring.joint_qvel_addr[joint.name] == (sim.joint_qvel_addr or {}).get(joint.name, qvel_default)
-        assert wiring.actuator_index[joint.name] == (sim.actuator_index or {}).get(joint.name, index)
+        assert wiring.joint_qpos_addr[joint.name] == (sim.joint_qpos_addr or {}).get(
+            joint.name, qpos_default
+        )
+        assert wiring.joint_qvel_addr[joint.name] == (sim.joint_qvel_addr or {}).get(
+            joint.name, qvel_default
+        )
+        assert wiring.actuator_index[joint.name] == (sim.actuator_index or {}).get(
+            joint.name, index
+        )
 
 
 SLOT_NAMES = st.sampled_from(["camera1", "camera2", "agentview", "wrist", "image"])
@@ -76,7 +87,12 @@ def sensor_lists(draw: st.DrawFn) -> list[Sensor]:
     for name in names:
         kind = draw(st.sampled_from(["rgb", "rgb", "depth"]))
         entry: dict[str, Any] = {
-            "name": name, "kind": kind, "width": 8, "height": 8, "rate_hz": 10.0, "frame_id": "f",
+            "name": name,
+            "kind": kind,
+            "width": 8,
+            "height": 8,
+            "rate_hz": 10.0,
+            "frame_id": "f",
         }
         if kind == "rgb" and draw(st.booleans()):
             entry["vla_feature_key"] = f"observation.images.{draw(SLOT_NAMES)}"
@@ -89,8 +105,13 @@ def sensor_lists(draw: st.DrawFn) -> list[Sensor]:
 def test_slot_rule_gives_unique_slots_in_manifest_order(sensors: list[Sensor]) -> None:
     robot = RobotDescription.model_validate(
         {
-            "schema_version": "0.1", "name": "arm", "display_name": "Arm", "base": "fixed",
-            "joints": [{"name": "j", "type": "continuous", "velocity_limit": 1.0, "effort_limit": 1.0}],
+            "schema_version": "0.1",
+            "name": "arm",
+            "display_name": "Arm",
+            "base": "fixed",
+            "joints": [
+                {"name": "j", "type": "continuous", "velocity_limit": 1.0, "effort_limit": 1.0}
+            ],
             "sensors": [s.model_dump(exclude_none=True) for s in sensors],
         }
     )

@@ -10,10 +10,10 @@ from __future__ import annotations
 import sys
 
 import typer
+from openral_core.errors import OpenralError
 from rich.console import Console
 
 from openral_cli.commands import robot
-from openral_core.errors import OpenralError
 
 app = typer.Typer(
     name="openral",

@@ -58,17 +58,18 @@ def model_files(root: Path) -> ExportFiles:
 
 def derived_files(root: Path) -> ExportFiles:
     """Per-robot tables and the schema reference pages, keyed by repo-relative path."""
+    from openral_core.errors import ManifestError
+    from openral_core.loader import load_robot
+    from openral_core.registry import manifest_path, robot_ids
+    from openral_core.schemas import SchemaName
+    from openral_core.tables import robot_tables
+
     from openral_codegen.schema_docs import (
         page_name,
         read_schemas,
         reference_index,
         render_schema_page,
     )
-    from openral_core.errors import ManifestError
-    from openral_core.loader import load_robot
-    from openral_core.registry import manifest_path, robot_ids
-    from openral_core.schemas import SchemaName
-    from openral_core.tables import robot_tables
 
     files: ExportFiles = {}
     problems = []

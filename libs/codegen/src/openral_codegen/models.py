@@ -16,7 +16,6 @@ from pathlib import Path
 # committed ones are stale or broken (openral_core imports them).
 
 
-
 class CodegenError(RuntimeError):
     """The generator could not run (a tool is missing or failed)."""
 
@@ -38,7 +37,7 @@ def generate_models(repo_root: Path, out_dir: Path) -> None:
     if result.returncode != 0:
         raise CodegenError(f"datamodel-codegen failed:\n{result.stderr.strip()}")
     (out_dir / "__init__.py").write_text(
-        '# GENERATED from schema/ by `just schema-export` -- do not edit.\n'
+        "# GENERATED from schema/ by `just schema-export` -- do not edit.\n"
         '"""Pydantic models of the contract, one module per schema file."""\n',
         encoding="utf-8",
     )

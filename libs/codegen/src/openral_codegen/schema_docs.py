@@ -150,13 +150,13 @@ def _constraint_text(spec: dict[str, Any]) -> str:
 
 
 def _conditions(schema: dict[str, Any]) -> str:
-    blocks = [schema] + list(schema.get("allOf", []))
+    blocks = [schema, *schema.get("allOf", [])]
     notes = []
     for block in blocks:
         condition = block.get("if", {}).get("properties", {})
         if not condition:
             continue
-        (key, test), = condition.items()
+        ((key, test),) = condition.items()
         when = f"When `{key}` is `{test['const']}`"
         for branch, prefix in (("then", when), ("else", "Otherwise")):
             rule = block.get(branch)

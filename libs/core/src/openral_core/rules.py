@@ -104,7 +104,9 @@ def _sim_findings(robot: RobotDescription) -> Iterator[Finding]:
                     yield path, f"no gain for joint(s) {', '.join(missing)}; give every joint one"
 
 
-def _keys_known(mapping: Mapping[str, object] | None, known: set[str], path: PathKey) -> Iterator[Finding]:
+def _keys_known(
+    mapping: Mapping[str, object] | None, known: set[str], path: PathKey
+) -> Iterator[Finding]:
     for key in mapping or {}:
         if key not in known:
             yield (*path, key), _not_a_joint(key, sorted(known))

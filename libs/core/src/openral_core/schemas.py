@@ -37,10 +37,8 @@ def _is_strict_integer(_checker: Any, instance: object) -> bool:
     return isinstance(instance, int) and not isinstance(instance, bool)
 
 
-_TYPE_CHECKER = jsonschema.Draft202012Validator.TYPE_CHECKER.redefine(
-    "integer", _is_strict_integer
-)
-_StrictValidator = jsonschema.validators.extend(
+_TYPE_CHECKER = jsonschema.Draft202012Validator.TYPE_CHECKER.redefine("integer", _is_strict_integer)
+_StrictValidator = jsonschema.validators.extend(  # type: ignore[no-untyped-call]
     jsonschema.Draft202012Validator, type_checker=_TYPE_CHECKER
 )
 
@@ -74,7 +72,7 @@ def bundled_schema(name: SchemaName) -> dict[str, Any]:
 
     Tools that cannot follow references between files (hypothesis-jsonschema) use this.
     """
-    root = json.loads(json.dumps(load_schema(name)))
+    root: dict[str, Any] = json.loads(json.dumps(load_schema(name)))
     defs: dict[str, Any] = root.setdefault("$defs", {})
 
     def inline(node: Any) -> Any:

@@ -50,10 +50,13 @@ def describe_value(value: Any) -> str:
 
 def _explain(error: ValidationError) -> Iterable[tuple[PathKey, str]]:
     path: PathKey = tuple(error.absolute_path)
-    instance, value, kind = error.instance, error.validator_value, error.validator
+    instance: Any = error.instance
+    value: Any = error.validator_value
+    schema: Any = error.schema
+    kind = error.validator
     because = _because(error)
     if kind == "additionalProperties" and isinstance(instance, dict):
-        known = sorted(error.schema.get("properties", {}))
+        known = sorted(schema.get("properties", {}))
         for key in instance:
             if key not in known:
                 expected = f"; expected one of: {', '.join(known)}" if known else ""
@@ -73,7 +76,9 @@ def _explain(error: ValidationError) -> Iterable[tuple[PathKey, str]]:
 
 
 def _message(error: ValidationError) -> str:
-    instance, value, kind = error.instance, error.validator_value, error.validator
+    instance: Any = error.instance
+    value: Any = error.validator_value
+    kind = error.validator
     got = describe_value(instance)
     if kind == "type":
         names = [value] if isinstance(value, str) else list(value)
@@ -105,7 +110,7 @@ def _message(error: ValidationError) -> str:
         return f"expected {' or '.join(options)} matching the schema, got {got}"
     if kind == "propertyNames":
         return f"key {instance!r} is not a valid name"
-    return error.message
+    return str(error.message)
 
 
 def _because(error: ValidationError) -> str:

@@ -64,7 +64,8 @@ def load_located(file: Path) -> LocatedDocument:
     try:
         text = file.read_text(encoding="utf-8")
     except OSError as exc:
-        raise ManifestError(file, [Issue(file, 0, 0, "", f"cannot read file: {exc.strerror}")])
+        issue = Issue(file, 0, 0, "", f"cannot read file: {exc.strerror}")
+        raise ManifestError(file, [issue]) from None
     yaml = YAML(typ="rt")
     try:
         raw = yaml.load(text)
@@ -74,7 +75,8 @@ def load_located(file: Path) -> LocatedDocument:
         mark = exc.problem_mark or exc.context_mark
         line, col = (mark.line + 1, mark.column + 1) if mark else (0, 0)
         problem = exc.problem or exc.context or "invalid YAML"
-        raise ManifestError(file, [Issue(file, line, col, "", f"invalid YAML: {problem}")])
+        issue = Issue(file, line, col, "", f"invalid YAML: {problem}")
+        raise ManifestError(file, [issue]) from None
     document = LocatedDocument(file, None)
     issues: list[Issue] = []
     document.data = _plain(raw, (), document, issues)

@@ -14,9 +14,6 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
-from rich.table import Table
-
 from openral_core import (
     ManifestError,
     RobotDescription,
@@ -27,6 +24,8 @@ from openral_core import (
     robot_tables,
 )
 from openral_core.registry import MANIFEST_NAME
+from rich.console import Console
+from rich.table import Table
 
 app = typer.Typer(help="Inspect and validate robot manifests.", no_args_is_help=True)
 out = Console(soft_wrap=True)
@@ -107,7 +106,16 @@ def _print_sim_summary(mjcf_uri: str, robot: RobotDescription) -> None:
     if not wiring.grippers:
         return
     grippers = Table(title="grippers")
-    for column in ("joint", "actuator", "mirror", "ctrl range", "qpos addrs", "scale", "read", "write"):
+    for column in (
+        "joint",
+        "actuator",
+        "mirror",
+        "ctrl range",
+        "qpos addrs",
+        "scale",
+        "read",
+        "write",
+    ):
         grippers.add_column(column)
     for g in wiring.grippers:
         grippers.add_row(
