@@ -80,13 +80,16 @@ def test_missing_required_field_names_the_parent_and_the_field(
     assert "missing required field 'effort_limit'" in match["msg"]
 
 
-def test_conditional_rules_explain_the_condition(write_manifest: ManifestWriter) -> None:
+def test_variant_errors_explain_the_discriminator(write_manifest: ManifestWriter) -> None:
     path = write_manifest(
         ("site: lidar_site, ", ""), ("kind: rgb, width: 64", "kind: rgb, site: s, width: 64")
     )
     messages = {m["field"]: m["msg"] for m in _issues(path)}
     assert messages["sensors[3]"] == "missing required field 'site' (because kind is 'lidar')"
-    assert messages["sensors[0].site"] == "field 'site' is not allowed here (because kind is 'rgb')"
+    assert messages["sensors[0].site"] == (
+        "unknown field 'site'; expected one of: camera, fovy_deg, frame_id, height, kind, "
+        "mount_body, name, rate_hz, vla_feature_key, width (because kind is 'rgb')"
+    )
 
 
 def test_name_must_equal_folder(write_manifest: ManifestWriter) -> None:
@@ -121,3 +124,18 @@ def test_valid_scene_loads_with_defaults(tmp_path: object) -> None:
     )
     scene = load_scene(file)
     assert scene.seed == 0 and scene.scene.assets == "tabletop" and scene.base_pose is None
+
+
+def test_unknown_discriminator_lists_the_allowed_values(write_manifest: ManifestWriter) -> None:
+    path = write_manifest(("name: tof, kind: depth", "name: tof, kind: sonar"))
+    (match,) = _issues(path)
+    assert match["field"] == "sensors[2].kind"
+    assert match["msg"] == "expected one of depth, lidar, rgb, got a string 'sonar'"
+
+
+def test_continuous_joint_with_limits_is_rejected(write_manifest: ManifestWriter) -> None:
+    path = write_manifest(("type: continuous,", "type: continuous, position_limits: [-1.0, 1.0],"))
+    (match,) = _issues(path)
+    assert match["field"] == "joints[1].position_limits"
+    assert "unknown field 'position_limits'" in match["msg"]
+    assert match["msg"].endswith("(because type is 'continuous')")

@@ -129,5 +129,5 @@ def test_torque_pd_needs_gains_and_position_forbids_them(write_manifest: Manifes
         ("  grippers:\n", "  control: {mode: position, kp: 1.0}\n  grippers:\n")
     )
     assert _findings(position) == {
-        "sim.control.kp": "field 'kp' is not allowed here (because mode is 'position')"
+        "sim.control.kp": "unknown field 'kp'; expected one of: mode (because mode is 'position')"
     }

@@ -8,7 +8,7 @@ from typing import Any
 from hypothesis import HealthCheck, Phase, assume, given, settings
 from hypothesis import strategies as st
 from hypothesis_jsonschema import from_schema
-from openral_core.models import RobotDescription, Sensor
+from openral_core.models import RgbSensor, RobotDescription, Sensor
 from openral_core.rules import robot_findings
 from openral_core.schemas import SchemaName, bundled_schema
 from openral_core.tables import (
@@ -18,6 +18,7 @@ from openral_core.tables import (
     robot_tables,
     vla_slots,
 )
+from pydantic import TypeAdapter
 
 SETTINGS = settings(
     max_examples=40,
@@ -96,7 +97,7 @@ def sensor_lists(draw: st.DrawFn) -> list[Sensor]:
         }
         if kind == "rgb" and draw(st.booleans()):
             entry["vla_feature_key"] = f"observation.images.{draw(SLOT_NAMES)}"
-        sensors.append(Sensor.model_validate(entry))
+        sensors.append(TypeAdapter(Sensor).validate_python(entry))
     return sensors
 
 
@@ -116,7 +117,7 @@ def test_slot_rule_gives_unique_slots_in_manifest_order(sensors: list[Sensor]) -
         }
     )
     slots = vla_slots(robot)
-    rgb = [s for s in sensors if s.kind.value == "rgb"]
+    rgb = [s for s in sensors if isinstance(s, RgbSensor)]
     assert [slot.sensor for slot in slots] == [s.name for s in rgb]
     for slot, sensor in zip(slots, rgb, strict=True):
         key = sensor.vla_feature_key

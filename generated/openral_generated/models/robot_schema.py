@@ -21,12 +21,11 @@ class Base(StrEnum):
 
 class Type(StrEnum):
     """
-    Kinematic type: `revolute` (bounded rotation, radians), `prismatic` (linear, metres) or `continuous` (unbounded rotation, radians).
+    `revolute` (bounded rotation, radians) or `prismatic` (linear, metres).
     """
 
     revolute = "revolute"
     prismatic = "prismatic"
-    continuous = "continuous"
 
 
 PositionLimit = TypeAliasType(
@@ -34,9 +33,9 @@ PositionLimit = TypeAliasType(
 )
 
 
-class Joint(OpenralModel):
+class LimitedJoint(OpenralModel):
     """
-    One controllable joint.
+    A revolute or prismatic joint with position limits.
     """
 
     model_config = ConfigDict(
@@ -54,14 +53,14 @@ class Joint(OpenralModel):
     """
     type: Type
     """
-    Kinematic type: `revolute` (bounded rotation, radians), `prismatic` (linear, metres) or `continuous` (unbounded rotation, radians).
+    `revolute` (bounded rotation, radians) or `prismatic` (linear, metres).
     """
     position_limits: Annotated[
-        list[PositionLimit] | None,
+        list[PositionLimit],
         Field(examples=[[-2.8973, 2.8973]], max_length=2, min_length=2),
-    ] = None
+    ]
     """
-    Lower and upper position limit [rad for revolute, m for prismatic]. Required for revolute and prismatic joints, not allowed for continuous ones. The lower bound must be below the upper bound.
+    Lower and upper position limit [rad for revolute, m for prismatic]. The lower bound must be below the upper bound.
     """
     velocity_limit: Annotated[float, Field(gt=0.0, le=1000.0)]
     """
@@ -79,27 +78,47 @@ class Joint(OpenralModel):
     """
 
 
-class Kind(StrEnum):
+class ContinuousJoint(OpenralModel):
     """
-    `rgb` (colour image), `depth` (depth image and point cloud) or `lidar` (planar laser scan).
+    An unbounded revolute joint (no position limits).
     """
 
-    rgb = "rgb"
-    depth = "depth"
-    lidar = "lidar"
-
-
-RangeMItem = TypeAliasType("RangeMItem", Annotated[float, Field(ge=0.0, le=1000.0)])
-
-
-AngleRangeDegItem = TypeAliasType(
-    "AngleRangeDegItem", Annotated[float, Field(ge=-360.0, le=360.0)]
-)
-
-
-class Sensor(OpenralModel):
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    name: Annotated[
+        str,
+        Field(
+            examples=["panda_joint1", "shoulder_pan_joint"],
+            pattern="^[A-Za-z][A-Za-z0-9_]{0,62}$",
+        ),
+    ]
     """
-    One camera, depth camera or lidar, read from the simulated scene.
+    Canonical joint name: the name used on /joint_states, by the safety envelope and by real drivers. Never renamed for a simulator.
+    """
+    type: Literal["continuous"]
+    """
+    `continuous`: unbounded rotation, radians.
+    """
+    velocity_limit: Annotated[float, Field(gt=0.0, le=1000.0)]
+    """
+    Largest allowed speed [rad/s for revolute and continuous, m/s for prismatic].
+    """
+    effort_limit: Annotated[float, Field(gt=0.0, le=100000.0)]
+    """
+    Largest allowed effort [N·m for revolute and continuous, N for prismatic].
+    """
+    sim_joint_name: Annotated[
+        str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+    ] = None
+    """
+    The joint's name in the robot's native MJCF model where it differs from the canonical name (for example `joint1` for `panda_joint1`). Absent means the MJCF uses the canonical name. Robosuite's `robot0_` prefixes are stripped automatically and never written here.
+    """
+
+
+class RgbSensor(OpenralModel):
+    """
+    A colour camera; optionally the input of a vision-language-action policy.
     """
 
     model_config = ConfigDict(
@@ -111,21 +130,15 @@ class Sensor(OpenralModel):
     """
     Sensor name, unique within the robot. Topics are derived from it (`/openral/cameras/<name>/image`).
     """
-    kind: Kind
+    kind: Literal["rgb"]
     """
-    `rgb` (colour image), `depth` (depth image and point cloud) or `lidar` (planar laser scan).
+    `rgb`: a colour camera.
     """
     camera: Annotated[str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")] = (
         None
     )
     """
     MJCF camera the sensor renders from (rgb and depth). Defaults to the sensor name.
-    """
-    site: Annotated[str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")] = (
-        None
-    )
-    """
-    MJCF site the lidar's rays start from (lidar only).
     """
     mount_body: Annotated[
         str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
@@ -169,6 +182,67 @@ class Sensor(OpenralModel):
     """
     LeRobot-style observation key a vision-language-action policy expects this camera under, `observation.images.<slot>`. Only for rgb sensors. The slot (the part after the last dot) is what policies look frames up by.
     """
+
+
+RangeMItem = TypeAliasType("RangeMItem", Annotated[float, Field(ge=0.0, le=1000.0)])
+
+
+class DepthSensor(OpenralModel):
+    """
+    A depth camera; published as a depth image and a point cloud.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    name: Annotated[
+        str, Field(examples=["agentview", "wrist"], pattern="^[a-z][a-z0-9_]{0,62}$")
+    ]
+    """
+    Sensor name, unique within the robot. Topics are derived from it (`/openral/cameras/<name>/image`).
+    """
+    kind: Literal["depth"]
+    """
+    `depth`: a depth camera (depth image and point cloud).
+    """
+    camera: Annotated[str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")] = (
+        None
+    )
+    """
+    MJCF camera the sensor renders from (rgb and depth). Defaults to the sensor name.
+    """
+    mount_body: Annotated[
+        str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+    ] = None
+    """
+    MJCF body (native name) the camera is rigidly attached to, such as the hand for a wrist camera. Absent means a fixed camera placed by the scene.
+    """
+    fovy_deg: Annotated[float, Field(gt=0.0, lt=180.0)] = 45.0
+    """
+    Vertical field of view [deg] of a camera the scene creates.
+    """
+    width: Annotated[int, Field(ge=1, le=4096)]
+    """
+    Image width [px] (for a lidar: number of rays).
+    """
+    height: Annotated[int, Field(ge=1, le=4096)]
+    """
+    Image height [px] (1 for a lidar).
+    """
+    rate_hz: Annotated[float, Field(gt=0.0, le=1000.0)]
+    """
+    Nominal publish rate [Hz] on a real robot; the sim bridge's camera rate is a runtime setting.
+    """
+    frame_id: Annotated[
+        str,
+        Field(
+            examples=["agentview_optical_frame"],
+            pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$",
+        ),
+    ]
+    """
+    TF frame of the sensor's optical centre, copied into message headers.
+    """
     range_m: Annotated[
         list[RangeMItem] | None,
         Field(examples=[[0.05, 10.0]], max_length=2, min_length=2),
@@ -176,10 +250,67 @@ class Sensor(OpenralModel):
     """
     Shortest and longest measured distance [m] (depth and lidar).
     """
+
+
+AngleRangeDegItem = TypeAliasType(
+    "AngleRangeDegItem", Annotated[float, Field(ge=-360.0, le=360.0)]
+)
+
+
+class LidarSensor(OpenralModel):
+    """
+    A planar lidar: rays cast from an MJCF site.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    name: Annotated[
+        str, Field(examples=["agentview", "wrist"], pattern="^[a-z][a-z0-9_]{0,62}$")
+    ]
+    """
+    Sensor name, unique within the robot. Topics are derived from it (`/openral/cameras/<name>/image`).
+    """
+    kind: Literal["lidar"]
+    """
+    `lidar`: a planar laser scanner.
+    """
+    site: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
+    """
+    MJCF site the lidar's rays start from (lidar only).
+    """
+    width: Annotated[int, Field(ge=1, le=4096)]
+    """
+    Image width [px] (for a lidar: number of rays).
+    """
+    height: Annotated[int, Field(ge=1, le=4096)]
+    """
+    Image height [px] (1 for a lidar).
+    """
+    rate_hz: Annotated[float, Field(gt=0.0, le=1000.0)]
+    """
+    Nominal publish rate [Hz] on a real robot; the sim bridge's camera rate is a runtime setting.
+    """
+    frame_id: Annotated[
+        str,
+        Field(
+            examples=["agentview_optical_frame"],
+            pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$",
+        ),
+    ]
+    """
+    TF frame of the sensor's optical centre, copied into message headers.
+    """
+    range_m: Annotated[
+        list[RangeMItem], Field(examples=[[0.05, 10.0]], max_length=2, min_length=2)
+    ]
+    """
+    Shortest and longest measured distance [m] (depth and lidar).
+    """
     angle_range_deg: Annotated[
-        list[AngleRangeDegItem] | None,
+        list[AngleRangeDegItem],
         Field(examples=[[-135.0, 135.0]], max_length=2, min_length=2),
-    ] = None
+    ]
     """
     First and last ray angle [deg] of a lidar scan, counter-clockwise about the site's z axis.
     """
@@ -209,11 +340,16 @@ class RobotDescription(OpenralModel):
     """
     Human-readable name shown in tables and docs.
     """
-    joints: Annotated[list[Joint], Field(max_length=64, min_length=1)]
+    joints: Annotated[
+        list[LimitedJoint | ContinuousJoint], Field(max_length=64, min_length=1)
+    ]
     """
     The robot's controllable joints in canonical order. This order is the order of JointState messages, of HAL state vectors and of joint-space actions. A gripper is listed as one joint (its driving finger or jaw).
     """
-    sensors: Annotated[list[Sensor], Field(max_length=32, validate_default=True)] = []
+    sensors: Annotated[
+        list[RgbSensor | DepthSensor | LidarSensor],
+        Field(max_length=32, validate_default=True),
+    ] = []
     """
     Sensors the robot carries or that its scenes provide for it (cameras, depth cameras, lidars). Each becomes a ROS topic under deploy sim.
     """

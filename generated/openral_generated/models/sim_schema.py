@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Literal
 from pydantic import ConfigDict, Field, StringConstraints
 from openral_base import OpenralModel
 from typing_extensions import TypeAliasType
@@ -95,70 +95,62 @@ class SimGripperDescription(OpenralModel):
     """
 
 
-class Mode(StrEnum):
-    """
-    `position`: ctrl = target (position actuators). `torque_pd`: every physics step, ctrl = kp·(target − q) − kd·q̇, clipped to the actuator's ctrlrange (motor/torque actuators).
-    """
-
-    position = "position"
-    torque_pd = "torque_pd"
-
-
-Kp = TypeAliasType("Kp", Annotated[float, Field(ge=0.0, le=100000.0)])
+Gain1 = TypeAliasType("Gain1", Annotated[float, Field(ge=0.0, le=100000.0)])
 """
-Proportional gain [N·m/rad or N/m]: one number for every joint, or a map from joint name to gain. Required for torque_pd.
+A controller gain: one number for every joint, or a map from joint name to gain.
 """
 
 
-KpAdditionalProperty = TypeAliasType(
-    "KpAdditionalProperty", Annotated[float, Field(ge=0.0, le=100000.0)]
+GainAdditionalProperty = TypeAliasType(
+    "GainAdditionalProperty", Annotated[float, Field(ge=0.0, le=100000.0)]
 )
 
 
-Kd = TypeAliasType("Kd", Annotated[float, Field(ge=0.0, le=100000.0)])
-"""
-Derivative gain [N·m·s/rad or N·s/m]: one number for every joint, or a map from joint name to gain. Required for torque_pd.
-"""
-
-
-KdAdditionalProperty = TypeAliasType(
-    "KdAdditionalProperty", Annotated[float, Field(ge=0.0, le=100000.0)]
-)
-
-
-class SimControl(OpenralModel):
+class PositionControl(OpenralModel):
     """
-    Control law between joint targets and actuator controls.
+    Position actuators: the joint target is written to ctrl unchanged.
     """
 
     model_config = ConfigDict(
         extra="forbid",
     )
-    mode: Mode
+    mode: Literal["position"]
     """
-    `position`: ctrl = target (position actuators). `torque_pd`: every physics step, ctrl = kp·(target − q) − kd·q̇, clipped to the actuator's ctrlrange (motor/torque actuators).
+    `position`.
+    """
+
+
+class TorquePdControl(OpenralModel):
+    """
+    Motor (torque) actuators: every physics step, ctrl = kp·(target − q) − kd·q̇, clipped to the actuator's ctrlrange.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    mode: Literal["torque_pd"]
+    """
+    `torque_pd`.
     """
     kp: (
-        Kp
+        Gain1
         | dict[
             Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$")],
-            KpAdditionalProperty,
+            GainAdditionalProperty,
         ]
-        | None
-    ) = None
+    )
     """
-    Proportional gain [N·m/rad or N/m]: one number for every joint, or a map from joint name to gain. Required for torque_pd.
+    Proportional gain [N·m/rad or N/m]: one number for every joint, or a map from joint name to gain.
     """
     kd: (
-        Kd
+        Gain1
         | dict[
             Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$")],
-            KdAdditionalProperty,
+            GainAdditionalProperty,
         ]
-        | None
-    ) = None
+    )
     """
-    Derivative gain [N·m·s/rad or N·s/m]: one number for every joint, or a map from joint name to gain. Required for torque_pd.
+    Derivative gain [N·m·s/rad or N·s/m]: one number for every joint, or a map from joint name to gain.
     """
 
 
@@ -235,7 +227,9 @@ class SimDescription(OpenralModel):
     """
     Number of mj_step calls after each commanded action by default (the HAL's settle_steps argument overrides it).
     """
-    control: SimControl | None = None
+    control: Annotated[
+        PositionControl | TorquePdControl | None, Field(title="SimControl")
+    ] = None
     """
     How joint targets become actuator controls. Absent means `position`: the target is written to ctrl unchanged.
     """

@@ -6,9 +6,15 @@ here so user code never depends on generated module names.
 
 from __future__ import annotations
 
-from openral_generated.models.robot_schema import Base, Joint, RobotDescription, Sensor
-from openral_generated.models.robot_schema import Kind as SensorKind
-from openral_generated.models.robot_schema import Type as JointType
+from openral_generated.models.robot_schema import (
+    Base,
+    ContinuousJoint,
+    DepthSensor,
+    LidarSensor,
+    LimitedJoint,
+    RgbSensor,
+    RobotDescription,
+)
 from openral_generated.models.scene_schema import (
     BasePose,
     DeployScene,
@@ -20,29 +26,40 @@ from openral_generated.models.scene_schema import (
 from openral_generated.models.sim_schema import (
     GripperReadMode,
     GripperWriteMode,
-    SimControl,
+    PositionControl,
     SimDescription,
     SimGripperDescription,
+    TorquePdControl,
 )
-from openral_generated.models.sim_schema import Mode as ControlMode
+
+Joint = LimitedJoint | ContinuousJoint
+"""Any joint: ``LimitedJoint`` (revolute/prismatic, with limits) or ``ContinuousJoint``."""
+Sensor = RgbSensor | DepthSensor | LidarSensor
+"""Any sensor, discriminated by ``kind``."""
+SimControl = PositionControl | TorquePdControl
+"""Any control law, discriminated by ``mode``."""
 
 __all__ = [
     "Base",
     "BasePose",
-    "ControlMode",
+    "ContinuousJoint",
     "DeployScene",
+    "DepthSensor",
     "GripperReadMode",
     "GripperWriteMode",
     "Joint",
-    "JointType",
+    "LidarSensor",
+    "LimitedJoint",
     "Observation",
+    "PositionControl",
+    "RgbSensor",
     "RobotDescription",
     "SceneObject",
     "SceneOptions",
     "SceneSpec",
     "Sensor",
-    "SensorKind",
     "SimControl",
     "SimDescription",
     "SimGripperDescription",
+    "TorquePdControl",
 ]

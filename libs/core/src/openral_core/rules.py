@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
 
-from openral_core.models import RobotDescription
+from openral_core.models import LimitedJoint, RgbSensor, RobotDescription, TorquePdControl
 from openral_core.tables import vla_slot
 from openral_core.yaml_source import PathKey, format_field
 
@@ -23,7 +23,7 @@ def robot_findings(robot: RobotDescription, folder_name: str | None) -> list[Fin
         robot: A description that already passed schema validation.
         folder_name: Name of the folder holding the file, or None when not checked.
     """
-    rgb = [(i, s) for i, s in enumerate(robot.sensors) if s.kind.value == "rgb"]
+    rgb = [(i, s) for i, s in enumerate(robot.sensors) if isinstance(s, RgbSensor)]
     return [
         *_name_matches_folder(robot, folder_name),
         *_unique(
@@ -64,8 +64,10 @@ def _unique(located: Sequence[tuple[PathKey, str]], what: str) -> Iterator[Findi
 
 def _limits_ordered(robot: RobotDescription) -> Iterator[Finding]:
     for index, joint in enumerate(robot.joints):
+        if not isinstance(joint, LimitedJoint):
+            continue
         limits = joint.position_limits
-        if limits is not None and not limits[0] < limits[1]:
+        if not limits[0] < limits[1]:
             yield (
                 ("joints", index, "position_limits"),
                 f"lower limit {limits[0]} must be below upper limit {limits[1]}",
@@ -92,7 +94,7 @@ def _sim_findings(robot: RobotDescription) -> Iterator[Finding]:
         if not low < high:
             yield (*path, "ctrl_range"), f"lower bound {low} must be below upper bound {high}"
     control = sim.control
-    if control is not None and control.mode.value == "torque_pd":
+    if isinstance(control, TorquePdControl):
         driven = [j for j in joints if j not in gripper_joints]
         for gain_name in ("kp", "kd"):
             gains = getattr(control, gain_name)

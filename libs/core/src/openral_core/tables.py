@@ -18,7 +18,7 @@ import json
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
-from openral_core.models import RobotDescription, Sensor, SimDescription
+from openral_core.models import RgbSensor, RobotDescription, SimDescription, TorquePdControl
 
 FREE_JOINT_NQPOS = 7
 """qpos entries of a MuJoCo free joint: position (3) + unit quaternion (4)."""
@@ -93,7 +93,7 @@ class RobotTables:
         )
 
 
-def vla_slot(sensor: Sensor) -> str:
+def vla_slot(sensor: RgbSensor) -> str:
     """Policy slot of an RGB sensor: ``observation.images.<slot>`` → ``<slot>``, else its name."""
     key = sensor.vla_feature_key
     return key.rsplit(".", 1)[-1] if key else sensor.name
@@ -101,7 +101,7 @@ def vla_slot(sensor: Sensor) -> str:
 
 def vla_slots(robot: RobotDescription) -> tuple[VlaSlot, ...]:
     """RGB sensors and their slots, in manifest order."""
-    return tuple(VlaSlot(s.name, vla_slot(s)) for s in robot.sensors if s.kind.value == "rgb")
+    return tuple(VlaSlot(s.name, vla_slot(s)) for s in robot.sensors if isinstance(s, RgbSensor))
 
 
 def joint_name_map(robot: RobotDescription) -> dict[str, str]:
@@ -143,7 +143,7 @@ def hal_wiring(robot: RobotDescription) -> HalWiring | None:
         keyframe_index=sim.keyframe_index,
         seed_ctrl_from_qpos=sim.seed_ctrl_from_qpos,
         settle_steps_default=sim.settle_steps_default,
-        control_mode=sim.control.mode.value if sim.control else "position",
+        control_mode=sim.control.mode if sim.control else "position",
         kp=kp,
         kd=kd,
     )
@@ -165,7 +165,7 @@ def _gains(
     sim: SimDescription, names: tuple[str, ...], gripper_joints: set[str]
 ) -> tuple[dict[str, float], dict[str, float]]:
     control = sim.control
-    if control is None or control.mode.value != "torque_pd":
+    if not isinstance(control, TorquePdControl):
         return {}, {}
     driven = [n for n in names if n not in gripper_joints]
 

@@ -48,31 +48,74 @@ def describe_value(value: Any) -> str:
     return kind if len(text) > 40 or isinstance(value, dict | list) else f"{kind} {text}"
 
 
-def _explain(error: ValidationError) -> Iterable[tuple[PathKey, str]]:
+def _explain(error: ValidationError, because: str = "") -> Iterable[tuple[PathKey, str]]:
     path: PathKey = tuple(error.absolute_path)
     instance: Any = error.instance
     value: Any = error.validator_value
     schema: Any = error.schema
     kind = error.validator
-    because = _because(error)
     if kind == "additionalProperties" and isinstance(instance, dict):
         known = sorted(schema.get("properties", {}))
         for key in instance:
             if key not in known:
                 expected = f"; expected one of: {', '.join(known)}" if known else ""
-                yield (*path, key), f"unknown field {key!r}{expected}"
+                yield (*path, key), f"unknown field {key!r}{expected}{because}"
         return
     if kind == "required" and isinstance(instance, dict):
         for key in value:
             if key not in instance:
                 yield path, f"missing required field {key!r}{because}"
         return
-    if kind == "not" and isinstance(instance, dict):
-        for key in _required_keys(value):
-            if key in instance:
-                yield (*path, key), f"field {key!r} is not allowed here{because}"
+    if kind == "oneOf" and error.context:
+        yield from _explain_variant(error)
         return
     yield path, _message(error) + because
+
+
+def _explain_variant(error: ValidationError) -> Iterable[tuple[PathKey, str]]:
+    """Explain a failed ``oneOf`` by the variant its discriminator (kind/type/mode) selects."""
+    path: PathKey = tuple(error.absolute_path)
+    instance: Any = error.instance
+    branches: dict[int, list[ValidationError]] = {}
+    for sub in error.context or []:
+        branches.setdefault(int(sub.relative_schema_path[0]), []).append(sub)
+    key = next((k for k in _DISCRIMINATORS if isinstance(instance, dict) and k in instance), None)
+    selected = [
+        errors
+        for errors in branches.values()
+        if not any(_rejects_discriminator(sub, error, key) for sub in errors)
+    ]
+    if len(selected) == 1:
+        because = f" (because {key} is {instance[key]!r})" if key else ""
+        for sub in selected[0]:
+            yield from _explain(sub, because)
+        return
+    if key is not None and not selected:
+        allowed = sorted(
+            {str(v) for errors in branches.values() for sub in errors for v in _allowed(sub, key)}
+        )
+        yield (
+            (*path, key),
+            f"expected one of {', '.join(allowed)}, got {describe_value(instance[key])}",
+        )
+        return
+    yield path, _message(error)
+
+
+def _rejects_discriminator(sub: ValidationError, parent: ValidationError, key: str | None) -> bool:
+    """True when ``sub`` says its variant does not apply (wrong type or wrong discriminator)."""
+    relative = list(sub.absolute_path)[len(parent.absolute_path) :]
+    if sub.validator == "type" and not relative:
+        return True
+    return key is not None and relative == [key] and sub.validator in ("const", "enum")
+
+
+def _allowed(sub: ValidationError, key: str) -> list[Any]:
+    relative = list(sub.absolute_path)[-1:]
+    if relative != [key]:
+        return []
+    value: Any = sub.validator_value
+    return [value] if sub.validator == "const" else list(value) if sub.validator == "enum" else []
 
 
 def _message(error: ValidationError) -> str:
@@ -106,33 +149,7 @@ def _message(error: ValidationError) -> str:
     if kind == "uniqueItems":
         return "items must be unique"
     if kind in ("oneOf", "anyOf"):
-        options = [_JSON_TYPE_NAMES.get(str(s.get("type")), "a value") for s in value]
-        return f"expected {' or '.join(options)} matching the schema, got {got}"
+        return f"{got} does not match any allowed form of this field"
     if kind == "propertyNames":
         return f"key {instance!r} is not a valid name"
     return str(error.message)
-
-
-def _because(error: ValidationError) -> str:
-    """Explain conditional requirements, e.g. ' (because kind is 'lidar')'."""
-    schema_path = list(error.relative_schema_path)
-    if not any(step in ("then", "else") for step in schema_path):
-        return ""
-    parent = error.parent.instance if error.parent is not None else None
-    instance = parent if isinstance(parent, dict) else error.instance
-    if not isinstance(instance, dict):
-        return ""
-    for key in _DISCRIMINATORS:
-        if key in instance:
-            return f" (because {key} is {instance[key]!r})"
-    return ""
-
-
-def _required_keys(schema: Any) -> list[str]:
-    """Keys named by ``required`` anywhere inside a (``not``) subschema."""
-    if isinstance(schema, dict):
-        keys = list(schema.get("required", []))
-        for sub in schema.get("anyOf", []) + schema.get("allOf", []):
-            keys += _required_keys(sub)
-        return keys
-    return []

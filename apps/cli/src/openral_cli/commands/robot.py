@@ -23,6 +23,7 @@ from openral_core import (
     robot_ids,
     robot_tables,
 )
+from openral_core.models import LimitedJoint
 from openral_core.registry import MANIFEST_NAME
 from rich.console import Console
 from rich.table import Table
@@ -48,7 +49,7 @@ def list_robots() -> None:
             table.add_row(robot_id, f"[red]{problems}[/]", "", "", "", "", "")
             continue
         sim = robot.sim
-        cameras = [s.name for s in robot.sensors if s.kind.value == "rgb"]
+        cameras = [s.name for s in robot.sensors if s.kind == "rgb"]
         table.add_row(
             robot.name,
             robot.display_name,
@@ -74,10 +75,10 @@ def show(robot_id: Annotated[str, typer.Argument(help="Robot id (folder under ro
     for column in ("joint", "type", "limits", "MJCF name", "qpos", "qvel", "actuator"):
         joints.add_column(column)
     for joint in robot.joints:
-        limits = joint.position_limits
+        limits = joint.position_limits if isinstance(joint, LimitedJoint) else None
         joints.add_row(
             joint.name,
-            joint.type.value,
+            str(joint.type),
             f"[{limits[0]:g}, {limits[1]:g}]" if limits else "-",
             tables.joint_name_map[joint.name],
             str(wiring.joint_qpos_addr[joint.name]) if wiring else "-",
