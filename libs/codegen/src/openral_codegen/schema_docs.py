@@ -56,7 +56,7 @@ def render_schema_page(name: SchemaName, schemas: Schemas) -> str:
         if definition.get("type") == "object":
             parts.append(_object_section(def_name, definition, schemas))
         else:
-            parts.append(_value_section(def_name, definition))
+            parts.append(_value_section(def_name, definition, schemas))
     if "$comment" in schema:
         parts.append("## Rules checked after the schema\n\n" + _rules(schema["$comment"]))
     return "\n".join(parts)
@@ -110,10 +110,13 @@ def _object_section(
     return "\n".join(lines) + "\n"
 
 
-def _value_section(title: str, schema: dict[str, Any]) -> str:
+def _value_section(title: str, schema: dict[str, Any], schemas: Schemas) -> str:
     text = f"## {title}\n\n{schema.get('description', '')}\n\n"
     if "enum" in schema:
         text += "Allowed values: " + ", ".join(f"`{v}`" for v in schema["enum"]) + ".\n"
+    if "oneOf" in schema:
+        options = [_type_text(option, schemas) for option in schema["oneOf"]]
+        text += "Exactly one of: " + ", ".join(options) + ".\n"
     return text
 
 

@@ -37,8 +37,10 @@ err = Console(stderr=True, soft_wrap=True)
 def list_robots() -> None:
     """Table of every robot: id, joints, grippers, cameras, floating base."""
     table = Table(title="robots/")
-    for column in ("id", "name", "joints", "grippers", "cameras", "floating base", "model"):
+    table.add_column("id", no_wrap=True)
+    for column in ("joints", "grippers", "cameras", "floating base"):
         table.add_column(column)
+    table.add_column("model", overflow="fold")
     invalid = 0
     for robot_id in robot_ids():
         try:
@@ -46,13 +48,12 @@ def list_robots() -> None:
         except ManifestError as error:
             invalid += 1
             problems = f"INVALID ({len(error.issues)} problem(s)); run `openral robot validate`"
-            table.add_row(robot_id, f"[red]{problems}[/]", "", "", "", "", "")
+            table.add_row(robot_id, f"[red]{problems}[/]", "", "", "", "")
             continue
         sim = robot.sim
         cameras = [s.name for s in robot.sensors if s.kind == "rgb"]
         table.add_row(
             robot.name,
-            robot.display_name,
             str(len(robot.joints)),
             str(len(sim.grippers)) if sim else "-",
             ", ".join(cameras) or "-",
