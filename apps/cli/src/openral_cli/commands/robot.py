@@ -38,9 +38,11 @@ def list_robots() -> None:
     """Table of every robot: id, joints, grippers, cameras, floating base."""
     table = Table(title="robots/")
     table.add_column("id", no_wrap=True)
-    for column in ("joints", "grippers", "cameras", "floating base"):
-        table.add_column(column)
-    table.add_column("model", overflow="fold")
+    for column in ("joints", "grippers"):
+        table.add_column(column, no_wrap=True, justify="right")
+    table.add_column("cameras")
+    table.add_column("floating base", no_wrap=True)
+    table.add_column("model", overflow="fold", min_width=20)
     invalid = 0
     for robot_id in robot_ids():
         try:
@@ -58,11 +60,20 @@ def list_robots() -> None:
             str(len(sim.grippers)) if sim else "-",
             ", ".join(cameras) or "-",
             ("yes" if sim.floating_base else "no") if sim else "-",
-            sim.mjcf_uri if sim else "-",
+            _short_uri(sim.mjcf_uri) if sim else "-",
         )
     out.print(table)
     if invalid:
         raise typer.Exit(1)
+
+
+def _short_uri(uri: str) -> str:
+    """``scheme:first/…/last`` so a long package path fits a table cell."""
+    scheme, _, rest = uri.partition(":")
+    parts = rest.split("/")
+    if len(parts) <= 2:
+        return uri
+    return f"{scheme}:{parts[0]}/…/{parts[-1]}"
 
 
 @app.command("show")
