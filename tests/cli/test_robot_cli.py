@@ -22,7 +22,8 @@ def test_list_shows_every_robot_with_its_counts() -> None:
     for robot_id in robot_ids(ROBOTS):
         assert robot_id in result.output
     franka_row = next(line for line in result.output.splitlines() if "franka_panda" in line)
-    assert "│ 8 " in franka_row and "agentview, wrist" in franka_row
+    cells = [cell.strip() for cell in franka_row.split("│")]
+    assert cells[2:5] == ["8", "1", "agentview, wrist"]
 
 
 def test_show_prints_wiring_and_slot_tables() -> None:
