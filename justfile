@@ -10,10 +10,11 @@ export MUJOCO_GL := env_var_or_default("MUJOCO_GL", "egl")
 default:
     @just --list
 
-# The main job: list the robots and validate every manifest.
+# The main job: list the robots, validate every manifest and check it against its model.
 demo:
     openral robot list
     openral robot validate --all
+    openral robot check --all
 
 # The whole test suite (extra arguments go to pytest).
 test *ARGS:
@@ -46,3 +47,7 @@ docs-serve:
 
 # The static checks CI runs after the tests: lint, types, generated-tree drift.
 check: lint typecheck schema-check
+
+# HAL overhead per robot against a raw mj_step loop; writes benchmarks/results/hal_step.json.
+bench-hal *ARGS:
+    python benchmarks/hal_step.py {{ARGS}}

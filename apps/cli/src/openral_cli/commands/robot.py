@@ -1,4 +1,4 @@
-"""``openral robot``: list, show and validate the robots under robots/.
+"""``openral robot``: list, show, validate, check and scaffold the robots under robots/.
 
 Examples::
 
@@ -6,6 +6,8 @@ Examples::
     openral robot show franka_panda
     openral robot validate --all
     openral robot validate path/to/robot.yaml
+    openral robot check --all
+    openral robot scaffold --mjcf pkg:<distribution>/<path>.xml --name my_arm
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from openral_core import (
     robot_ids,
     robot_tables,
 )
+from openral_core.errors import OpenralError
 from openral_core.models import LimitedJoint
 from openral_core.registry import MANIFEST_NAME
 from rich.console import Console
@@ -185,3 +188,94 @@ def _manifest_file(target: str) -> Path:
     if path.suffix in (".yaml", ".yml") or path.exists():
         return path
     return manifest_path(target)
+
+
+@app.command("check")
+def check(
+    targets: Annotated[
+        list[str] | None,
+        typer.Argument(help="Robot ids, manifest files or robot folders.", show_default=False),
+    ] = None,
+    all_robots: Annotated[bool, typer.Option("--all", help="Check every robot.")] = False,
+    verbose: Annotated[
+        bool, typer.Option("--verbose", "-v", help="Show passing checks too.")
+    ] = False,
+) -> None:
+    """Load each robot's MJCF and verify the manifest's wiring against it.
+
+    Checks joint names, qpos/qvel addresses, which joint each actuator drives, gripper
+    control ranges, the keyframe, the floating base and sensor cameras/bodies/sites.
+    Exits 1 on any mismatch, 2 when nothing was named.
+    """
+    import mujoco
+    from openral_hal.mjcf_uri import resolve_mjcf_uri
+    from openral_hal.model_check import check_robot
+
+    files = [_manifest_file(t) for t in targets or []]
+    if all_robots:
+        files += [manifest_path(robot_id) for robot_id in robot_ids()]
+    if not files:
+        err.print("name robot ids or files to check, or pass --all")
+        raise typer.Exit(2)
+    summary = Table(title="robot check")
+    for column in ("robot", "model", "checks", "failed"):
+        summary.add_column(column)
+    failed_robots = 0
+    for file in files:
+        try:
+            robot = load_robot(file, check_folder_name=file.name == MANIFEST_NAME)
+            if robot.sim is None:
+                raise OpenralError(f"{file}: no sim block; nothing to check")
+            path = resolve_mjcf_uri(robot.sim.mjcf_uri, file.parent)
+            model = mujoco.MjModel.from_xml_path(str(path))
+        except (OpenralError, ValueError) as error:
+            failed_robots += 1
+            err.print(f"[red]✗[/] {file}: {error}", highlight=False)
+            summary.add_row(file.parent.name, "-", "-", "[red]cannot load[/]")
+            continue
+        rows = check_robot(robot, model)
+        failures = [row for row in rows if not row.ok]
+        shown = rows if verbose else failures
+        if shown:
+            table = Table(title=f"{robot.name}: {path.name}")
+            for column in ("field", "manifest", "model", ""):
+                table.add_column(column)
+            for row in shown:
+                mark = "[green]ok[/]" if row.ok else "[red]MISMATCH[/]"
+                table.add_row(row.field, row.expected, row.actual, mark)
+            out.print(table)
+        failed_robots += bool(failures)
+        status = f"[red]{len(failures)}[/]" if failures else "[green]0[/]"
+        summary.add_row(robot.name, path.name, str(len(rows)), status)
+    out.print(summary)
+    if failed_robots:
+        err.print(f"{failed_robots} of {len(files)} robot(s) do not match their model")
+        raise typer.Exit(1)
+
+
+@app.command("scaffold")
+def scaffold(
+    mjcf: Annotated[str, typer.Option("--mjcf", help="MJCF URI, e.g. pkg:<dist>/<path>.xml")],
+    name: Annotated[str, typer.Option("--name", help="Robot id (folder under robots/).")],
+    out_dir: Annotated[
+        Path | None,
+        typer.Option("--out", help="Folder to write robot.yaml into [default: robots/<name>]"),
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
+) -> None:
+    """Draft a robot.yaml from an MJCF model; lines marked `# REVIEW:` need a human."""
+    from openral_core.paths import repo_root
+    from openral_hal.scaffold import scaffold_manifest
+
+    folder = out_dir or repo_root() / "robots" / name
+    target = folder / MANIFEST_NAME
+    if target.exists() and not force:
+        err.print(f"{target} exists; pass --force to overwrite it")
+        raise typer.Exit(1)
+    text = scaffold_manifest(mjcf, name, folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    target.write_text(text, encoding="utf-8")
+    out.print(
+        f"wrote {target}; review the lines marked REVIEW, then run "
+        f"`openral robot validate {target}` and `openral robot check {target}`"
+    )

@@ -1,0 +1,171 @@
+"""Verify a manifest's wiring against the MJCF model it names (`openral robot check`)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import mujoco
+from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
+from openral_core.tables import HalWiring, hal_wiring
+
+
+@dataclass(frozen=True)
+class CheckRow:
+    """One comparison between the manifest and the model."""
+
+    field: str
+    expected: str
+    actual: str
+    ok: bool
+
+
+def check_robot(description: RobotDescription, model: mujoco.MjModel) -> list[CheckRow]:
+    """Every check of ``description`` against ``model``; a robot passes when all rows are ok."""
+    wiring = hal_wiring(description)
+    if wiring is None:
+        return [CheckRow("sim", "a sim block", "none", ok=False)]
+    return [
+        *_joint_rows(description, wiring, model),
+        *_gripper_rows(wiring, model),
+        *_keyframe_and_base_rows(wiring, model),
+        *_sensor_rows(description, model),
+    ]
+
+
+def _joint_rows(
+    description: RobotDescription, wiring: HalWiring, model: mujoco.MjModel
+) -> Iterator[CheckRow]:
+    for index, joint in enumerate(description.joints):
+        native = joint.sim_joint_name or joint.name
+        name_field = "sim_joint_name" if joint.sim_joint_name else "name"
+        jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, native)
+        yield CheckRow(
+            f"joints[{index}].{name_field}",
+            native,
+            "found" if jid >= 0 else "no such joint in the model",
+            ok=jid >= 0,
+        )
+        if jid < 0:
+            continue
+        qpos, qvel = int(model.jnt_qposadr[jid]), int(model.jnt_dofadr[jid])
+        yield _equal(f"sim.joint_qpos_addr.{joint.name}", wiring.joint_qpos_addr[joint.name], qpos)
+        yield _equal(f"sim.joint_qvel_addr.{joint.name}", wiring.joint_qvel_addr[joint.name], qvel)
+        yield _actuator_row(
+            f"sim.actuator_index.{joint.name}",
+            wiring.actuator_index[joint.name],
+            jid,
+            native,
+            model,
+        )
+
+
+def _actuator_row(
+    field: str, actuator: int, jid: int, native: str, model: mujoco.MjModel
+) -> CheckRow:
+    expected = f"{actuator} drives {native}"
+    if not 0 <= actuator < model.nu:
+        return CheckRow(field, expected, f"the model has {model.nu} actuators", ok=False)
+    driven = _driven_joints(model, actuator)
+    names = ", ".join(mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or "?" for j in driven)
+    return CheckRow(field, expected, f"{actuator} drives {names or 'no joint'}", ok=jid in driven)
+
+
+def _driven_joints(model: mujoco.MjModel, actuator: int) -> list[int]:
+    """Joints an actuator moves: its joint, or every joint of its fixed tendon."""
+    kind = model.actuator_trntype[actuator]
+    target = int(model.actuator_trnid[actuator, 0])
+    if kind in (mujoco.mjtTrn.mjTRN_JOINT, mujoco.mjtTrn.mjTRN_JOINTINPARENT):
+        return [target]
+    if kind == mujoco.mjtTrn.mjTRN_TENDON:
+        start, count = int(model.tendon_adr[target]), int(model.tendon_num[target])
+        return [
+            int(model.wrap_objid[w])
+            for w in range(start, start + count)
+            if model.wrap_type[w] == mujoco.mjtWrap.mjWRAP_JOINT
+        ]
+    return []
+
+
+def _gripper_rows(wiring: HalWiring, model: mujoco.MjModel) -> Iterator[CheckRow]:
+    for index, gripper in enumerate(wiring.grippers):
+        prefix = f"sim.grippers[{index}]"
+        for k, addr in enumerate(gripper.qpos_addrs):
+            yield CheckRow(
+                f"{prefix}.qpos_addrs[{k}]",
+                f"{addr} < nq",
+                f"nq = {model.nq}",
+                ok=0 <= addr < model.nq,
+            )
+        yield _equal(
+            f"{prefix}.qpos_addrs[0]", gripper.qpos_addrs[0], wiring.joint_qpos_addr[gripper.joint]
+        )
+        yield _ctrl_range_row(
+            f"{prefix}.ctrl_range", gripper.ctrl_range, gripper.actuator_index, model
+        )
+        if gripper.mirror_actuator_index is not None:
+            low, high = gripper.ctrl_range
+            yield _ctrl_range_row(
+                f"{prefix}.mirror_actuator_index",
+                (-high, -low),
+                gripper.mirror_actuator_index,
+                model,
+            )
+
+
+def _ctrl_range_row(
+    field: str, ctrl_range: tuple[float, float], actuator: int, model: mujoco.MjModel
+) -> CheckRow:
+    expected = f"[{ctrl_range[0]:g}, {ctrl_range[1]:g}] inside actuator {actuator}"
+    if not 0 <= actuator < model.nu:
+        return CheckRow(field, expected, f"the model has {model.nu} actuators", ok=False)
+    if not model.actuator_ctrllimited[actuator]:
+        return CheckRow(field, expected, "ctrl unlimited", ok=True)
+    low, high = (float(v) for v in model.actuator_ctrlrange[actuator])
+    inside = low - 1e-9 <= ctrl_range[0] and ctrl_range[1] <= high + 1e-9
+    return CheckRow(field, expected, f"ctrlrange [{low:g}, {high:g}]", ok=inside)
+
+
+def _keyframe_and_base_rows(wiring: HalWiring, model: mujoco.MjModel) -> Iterator[CheckRow]:
+    if wiring.keyframe_index is not None:
+        yield CheckRow(
+            "sim.keyframe_index",
+            str(wiring.keyframe_index),
+            f"the model has {model.nkey} keyframe(s)",
+            ok=0 <= wiring.keyframe_index < model.nkey,
+        )
+    root_free = model.njnt > 0 and model.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE
+    root_free = root_free and int(model.jnt_qposadr[0]) == 0
+    yield CheckRow(
+        "sim.floating_base",
+        str(wiring.floating_base).lower(),
+        "free joint at qpos 0" if root_free else "no free joint at qpos 0",
+        ok=wiring.floating_base == root_free,
+    )
+
+
+def _sensor_rows(description: RobotDescription, model: mujoco.MjModel) -> Iterator[CheckRow]:
+    for index, sensor in enumerate(description.sensors):
+        if isinstance(sensor, RgbSensor | DepthSensor):
+            if sensor.camera is not None:
+                yield _exists(
+                    f"sensors[{index}].camera", sensor.camera, mujoco.mjtObj.mjOBJ_CAMERA, model
+                )
+            if sensor.mount_body is not None:
+                yield _exists(
+                    f"sensors[{index}].mount_body",
+                    sensor.mount_body,
+                    mujoco.mjtObj.mjOBJ_BODY,
+                    model,
+                )
+        elif isinstance(sensor, LidarSensor):
+            yield _exists(f"sensors[{index}].site", sensor.site, mujoco.mjtObj.mjOBJ_SITE, model)
+
+
+def _exists(field: str, name: str, kind: mujoco.mjtObj, model: mujoco.MjModel) -> CheckRow:
+    found = mujoco.mj_name2id(model, kind, name) >= 0
+    return CheckRow(field, name, "found" if found else "not in the model", ok=found)
+
+
+def _equal(field: str, expected: int, actual: int) -> CheckRow:
+    return CheckRow(field, str(expected), str(actual), ok=expected == actual)

@@ -1,0 +1,367 @@
+"""MujocoArmHAL: one data-driven MuJoCo HAL for every robot manifest (ADR-0023).
+
+All robot-specific knowledge arrives as wiring: which qpos/qvel slot and actuator belong to
+each canonical joint, how grippers are read and written, whether to reset to a keyframe or
+seed the actuators, and which control law drives the joints. ``from_description`` derives
+the wiring from a manifest with the same function that generates ``generated/…/tables``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import mujoco
+import numpy as np
+from openral_core.models import RobotDescription
+from openral_core.registry import manifest_path
+from openral_core.tables import GripperWiring, hal_wiring
+
+from openral_hal.action import validated_action
+from openral_hal.errors import EStopLatched, HalError, NotConnected, SimulationDiverged
+from openral_hal.gripper import gripper_ctrl, read_gripper
+from openral_hal.mjcf_uri import resolve_mjcf_uri
+from openral_hal.state import FloatArray, JointStateSample
+
+CONTROL_MODES = ("position", "torque_pd")
+_INSTABILITY_WARNINGS = [
+    int(w)
+    for w in (
+        mujoco.mjtWarning.mjWARN_BADQPOS,
+        mujoco.mjtWarning.mjWARN_BADQVEL,
+        mujoco.mjtWarning.mjWARN_BADQACC,
+    )
+]
+
+
+class MujocoArmHAL:
+    """A robot simulated in its own MuJoCo model, driven by joint-space targets.
+
+    The HAL owns the model: ``step()`` advances physics, ``send_action()`` only sets targets.
+    """
+
+    is_real = False
+    """A simulation, never real hardware."""
+
+    def __init__(
+        self,
+        *,
+        mjcf_path: str | Path,
+        joint_names: Sequence[str],
+        joint_qpos_addr: Mapping[str, int],
+        joint_qvel_addr: Mapping[str, int],
+        actuator_index: Mapping[str, int],
+        grippers: Sequence[GripperWiring] = (),
+        floating_base: bool = False,
+        keyframe_index: int | None = None,
+        seed_ctrl_from_qpos: bool = False,
+        settle_steps: int = 1,
+        control_mode: str = "position",
+        kp: Mapping[str, float] | None = None,
+        kd: Mapping[str, float] | None = None,
+        gravity_enabled: bool = True,
+        staleness_limit_s: float = 0.5,
+    ) -> None:
+        """Wire the HAL; nothing is loaded until :meth:`connect`.
+
+        Args:
+            mjcf_path: The MJCF file.
+            joint_names: Canonical joint names in manifest order (the action/state order).
+            joint_qpos_addr: Joint → index into ``data.qpos``.
+            joint_qvel_addr: Joint → index into ``data.qvel``.
+            actuator_index: Joint → actuator driving it.
+            grippers: Gripper wiring; a gripper's joint is commanded and read per its modes.
+            floating_base: The model's root is a free joint (informational; addresses above
+                already include its offset).
+            keyframe_index: Reset to this keyframe on connect.
+            seed_ctrl_from_qpos: On connect, set every joint actuator's ctrl to its joint's
+                current qpos so position servos hold the start pose.
+            settle_steps: Physics steps run at the end of connect.
+            control_mode: ``position`` (ctrl is a position target) or ``torque_pd`` (ctrl is
+                torque; the HAL applies ``kp * (target - q) - kd * qdot`` every step).
+            kp: Per-joint proportional gains for ``torque_pd``.
+            kd: Per-joint derivative gains for ``torque_pd``.
+            gravity_enabled: False zeroes the model's gravity.
+            staleness_limit_s: A state sample is flagged stale when physics has not advanced
+                for longer than this (wall time).
+        """
+        if control_mode not in CONTROL_MODES:
+            raise HalError(f"control_mode {control_mode!r}; expected one of {CONTROL_MODES}")
+        self.mjcf_path = Path(mjcf_path)
+        self.joint_names = tuple(joint_names)
+        self._qpos = np.array([joint_qpos_addr[n] for n in self.joint_names], dtype=np.intp)
+        self._qvel = np.array([joint_qvel_addr[n] for n in self.joint_names], dtype=np.intp)
+        self._act = np.array([actuator_index[n] for n in self.joint_names], dtype=np.intp)
+        self.grippers = {g.joint: g for g in grippers}
+        self._gripper_slots = {self.joint_names.index(j): g for j, g in self.grippers.items()}
+        self._arm_slots = np.array(
+            [i for i in range(len(self.joint_names)) if i not in self._gripper_slots],
+            dtype=np.intp,
+        )
+        self._arm_qpos = self._qpos[self._arm_slots]
+        self._arm_qvel = self._qvel[self._arm_slots]
+        self._arm_act = self._act[self._arm_slots]
+        self._ctrl_low = self._ctrl_high = self._arm_low = self._arm_high = np.zeros(0)
+        self.floating_base = floating_base
+        self.keyframe_index = keyframe_index
+        self.seed_ctrl_from_qpos = seed_ctrl_from_qpos
+        self.settle_steps = settle_steps
+        self.control_mode = control_mode
+        gains_kp, gains_kd = kp or {}, kd or {}
+        arm = [self.joint_names[i] for i in self._arm_slots]
+        self._kp = np.array([gains_kp.get(n, 0.0) for n in arm])
+        self._kd = np.array([gains_kd.get(n, 0.0) for n in arm])
+        self.gravity_enabled = gravity_enabled
+        self.staleness_limit_s = staleness_limit_s
+        self._model: mujoco.MjModel | None = None
+        self._data: mujoco.MjData | None = None
+        self._targets = np.zeros(len(self._arm_slots))
+        self._estopped = False
+        self._last_step_ns = 0
+
+    @classmethod
+    def from_description(
+        cls,
+        description: RobotDescription,
+        *,
+        settle_steps: int | None = None,
+        gravity_enabled: bool = True,
+        staleness_limit_s: float = 0.5,
+        mjcf_path_override: str | Path | None = None,
+        manifest_dir: Path | None = None,
+    ) -> MujocoArmHAL:
+        """A HAL wired from ``description.sim``.
+
+        Args:
+            description: A validated manifest with a ``sim`` block.
+            settle_steps: Overrides ``sim.settle_steps_default``.
+            gravity_enabled: See :meth:`__init__`.
+            staleness_limit_s: See :meth:`__init__`.
+            mjcf_path_override: Use this MJCF file instead of resolving ``sim.mjcf_uri``.
+            manifest_dir: Folder of the manifest (for ``file:`` URIs); defaults to
+                ``robots/<name>/``.
+        """
+        wiring = hal_wiring(description)
+        if wiring is None:
+            raise HalError(f"robot {description.name!r} has no sim block; cannot simulate it")
+        if mjcf_path_override is not None:
+            path = Path(mjcf_path_override)
+        else:
+            folder = manifest_dir or manifest_path(description.name).parent
+            path = resolve_mjcf_uri(wiring.mjcf_uri, folder)
+        kwargs = hal_kwargs(asdict(wiring))
+        kwargs["grippers"] = wiring.grippers
+        if settle_steps is not None:
+            kwargs["settle_steps"] = settle_steps
+        return cls(
+            mjcf_path=path,
+            gravity_enabled=gravity_enabled,
+            staleness_limit_s=staleness_limit_s,
+            **kwargs,
+        )
+
+    # -- lifecycle -------------------------------------------------------------------------
+
+    @property
+    def connected(self) -> bool:
+        """True between :meth:`connect` and :meth:`disconnect`."""
+        return self._model is not None
+
+    def connect(self) -> None:
+        """Load the model, reset (keyframe), seed the actuators, forward and settle."""
+        model = mujoco.MjModel.from_xml_path(str(self.mjcf_path))
+        self._check_wiring(model)
+        if not self.gravity_enabled:
+            model.opt.gravity[:] = 0.0
+        data = mujoco.MjData(model)
+        if self.keyframe_index is not None:
+            mujoco.mj_resetDataKeyframe(model, data, self.keyframe_index)
+        if self.seed_ctrl_from_qpos:
+            _seed_ctrl(model, data)
+        mujoco.mj_forward(model, data)
+        self._ctrl_low, self._ctrl_high = _ctrl_limits(model)
+        self._arm_low = self._ctrl_low[self._arm_act]
+        self._arm_high = self._ctrl_high[self._arm_act]
+        self._model, self._data = model, data
+        self._targets = data.qpos[self._arm_qpos]
+        self._estopped = False
+        self.step(self.settle_steps)
+
+    def disconnect(self) -> None:
+        """Drop the model and data."""
+        self._model = self._data = None
+
+    def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData]:
+        """The live (model, data) pair."""
+        return self._handles()
+
+    # -- state and commands ----------------------------------------------------------------
+
+    def read_state(self) -> JointStateSample:
+        """Positions, velocities and efforts of every manifest joint."""
+        _, data = self._handles()
+        positions = data.qpos[self._qpos]
+        for slot, gripper in self._gripper_slots.items():
+            fingers = [data.qpos[a] for a in gripper.qpos_addrs]
+            positions[slot] = read_gripper(
+                gripper.read_mode, fingers, gripper.ctrl_range, gripper.qpos_scale
+            )
+        now = time.monotonic_ns()
+        return JointStateSample(
+            names=self.joint_names,
+            positions=positions,
+            velocities=data.qvel[self._qvel],
+            efforts=data.actuator_force[self._act],
+            stamp_ns=now,
+            sim_time_s=float(data.time),
+            stale=(now - self._last_step_ns) > self.staleness_limit_s * 1e9,
+        )
+
+    def send_action(self, action: object) -> None:
+        """Set joint targets and gripper commands (one value per manifest joint).
+
+        Raises:
+            ActionRejected: Wrong type, width, or a non-finite value; nothing is changed.
+            EStopLatched: The E-stop is latched.
+        """
+        _, data = self._handles()
+        values = validated_action(action, self.joint_names)
+        if self._estopped:
+            raise EStopLatched("E-stop is latched; call release_estop() before sending actions")
+        self._targets = values[self._arm_slots]
+        if self.control_mode == "position":
+            data.ctrl[self._arm_act] = np.minimum(
+                np.maximum(self._targets, self._arm_low), self._arm_high
+            )
+        for slot, gripper in self._gripper_slots.items():
+            ctrl = gripper_ctrl(gripper.write_mode, float(values[slot]), gripper.ctrl_range)
+            self._set_ctrl(data, gripper.actuator_index, ctrl)
+            if gripper.mirror_actuator_index is not None:
+                self._set_ctrl(data, gripper.mirror_actuator_index, -ctrl)
+
+    def step(self, n: int = 1) -> bool:
+        """Advance physics ``n`` steps; returns False (and does nothing) while E-stopped.
+
+        Raises:
+            SimulationDiverged: MuJoCo met a NaN/Inf state and reset it.
+        """
+        model, data = self._handles()
+        if self._estopped:
+            return False
+        diverged_before = _instability_count(data)
+        if self.control_mode == "torque_pd":
+            for _ in range(n):
+                self._apply_pd(data)
+                mujoco.mj_step(model, data)
+        else:
+            mujoco.mj_step(model, data, nstep=n)
+        self._last_step_ns = time.monotonic_ns()
+        if _instability_count(data) != diverged_before:
+            raise SimulationDiverged(
+                f"{self.mjcf_path.name}: the simulation diverged (NaN/Inf state) and MuJoCo "
+                "reset it; lower the gains or the targets"
+            )
+        return True
+
+    # -- E-stop ----------------------------------------------------------------------------
+
+    @property
+    def estopped(self) -> bool:
+        """True while the E-stop is latched."""
+        return self._estopped
+
+    def estop(self) -> None:
+        """Latch the E-stop: physics stops advancing and actions are refused."""
+        self._estopped = True
+
+    def release_estop(self) -> None:
+        """Unlatch the E-stop; targets are reset to the current pose so nothing jumps."""
+        _, data = self._handles()
+        self._targets = data.qpos[self._arm_qpos]
+        self._estopped = False
+
+    # -- internals -------------------------------------------------------------------------
+
+    def _handles(self) -> tuple[mujoco.MjModel, mujoco.MjData]:
+        if self._model is None or self._data is None:
+            raise NotConnected("the HAL is not connected; call connect() first")
+        return self._model, self._data
+
+    def _apply_pd(self, data: mujoco.MjData) -> None:
+        error = self._targets - data.qpos[self._arm_qpos]
+        torque = self._kp * error - self._kd * data.qvel[self._arm_qvel]
+        data.ctrl[self._arm_act] = np.minimum(np.maximum(torque, self._arm_low), self._arm_high)
+
+    def _set_ctrl(self, data: mujoco.MjData, actuator: int, value: float) -> None:
+        """ctrl[actuator] = value clipped to the actuator's ctrlrange."""
+        data.ctrl[actuator] = min(max(value, self._ctrl_low[actuator]), self._ctrl_high[actuator])
+
+    def _check_wiring(self, model: mujoco.MjModel) -> None:
+        problems = []
+        for what, table, limit in (
+            ("qpos address", self._qpos, model.nq),
+            ("qvel address", self._qvel, model.nv),
+            ("actuator index", self._act, model.nu),
+        ):
+            for name, value in zip(self.joint_names, table.tolist(), strict=True):
+                if not 0 <= value < limit:
+                    problems.append(f"{name}: {what} {value} outside 0..{limit - 1}")
+        if self.keyframe_index is not None and not 0 <= self.keyframe_index < model.nkey:
+            problems.append(f"keyframe_index {self.keyframe_index} but the model has {model.nkey}")
+        if problems:
+            raise HalError(
+                f"{self.mjcf_path}: wiring does not fit the model ({'; '.join(problems)}); "
+                "run `openral robot check` for a full report"
+            )
+
+
+def hal_kwargs(wiring: Mapping[str, Any]) -> dict[str, Any]:
+    """:class:`MujocoArmHAL` keyword arguments from a wiring table (``HalWiring`` as a dict).
+
+    The generated ``tables/<id>.json`` files hold exactly this dict under ``hal_wiring``.
+    """
+    kwargs = {k: v for k, v in wiring.items() if k not in ("mjcf_uri", "settle_steps_default")}
+    kwargs["settle_steps"] = wiring["settle_steps_default"]
+    kwargs["grippers"] = tuple(
+        g if isinstance(g, GripperWiring) else _gripper_from_dict(g) for g in wiring["grippers"]
+    )
+    return kwargs
+
+
+def _gripper_from_dict(data: Mapping[str, Any]) -> GripperWiring:
+    return GripperWiring(
+        **{**data, "ctrl_range": tuple(data["ctrl_range"]), "qpos_addrs": tuple(data["qpos_addrs"])}
+    )
+
+
+def _instability_count(data: mujoco.MjData) -> int:
+    """How often MuJoCo has met a NaN/Inf position, velocity or acceleration and reset."""
+    return sum(int(data.warning[w].number) for w in _INSTABILITY_WARNINGS)
+
+
+def _ctrl_limits(model: mujoco.MjModel) -> tuple[FloatArray, FloatArray]:
+    """Per-actuator (low, high) control bounds; ±inf where ctrl is unlimited."""
+    limited = model.actuator_ctrllimited.astype(bool)
+    low: FloatArray = np.where(limited, model.actuator_ctrlrange[:, 0], -np.inf)
+    high: FloatArray = np.where(limited, model.actuator_ctrlrange[:, 1], np.inf)
+    return low, high
+
+
+def _seed_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> None:
+    """ctrl ← qpos of the joint for every position-servo actuator on a hinge or slide joint."""
+    for actuator in range(model.nu):
+        if model.actuator_trntype[actuator] != mujoco.mjtTrn.mjTRN_JOINT:
+            continue
+        if model.actuator_biastype[actuator] != mujoco.mjtBias.mjBIAS_AFFINE:
+            continue
+        joint = model.actuator_trnid[actuator, 0]
+        if model.jnt_type[joint] not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
+            continue
+        low, high = model.actuator_ctrlrange[actuator]
+        value = float(data.qpos[model.jnt_qposadr[joint]])
+        data.ctrl[actuator] = (
+            min(max(value, low), high) if model.actuator_ctrllimited[actuator] else value
+        )

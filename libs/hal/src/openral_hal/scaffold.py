@@ -1,0 +1,499 @@
+"""Draft a ``robot.yaml`` from an MJCF model (`openral robot scaffold`).
+
+The draft is written by hand, line by line, so it can carry ``# REVIEW:`` comments on
+every value that is a guess or a placeholder (velocity limits, guessed grippers, PD
+gains). It is built so that it loads (:func:`openral_core.loader.load_robot`) and passes
+:func:`openral_hal.model_check.check_robot` against the model it came from; a human still
+has to read it before it describes a real robot.
+
+How the model becomes a manifest:
+
+- One joint per actuator, in actuator order. A joint transmission drives its joint; a
+  fixed-tendon transmission drives the tendon's first joint (the others are coupled
+  fingers). Actuators of other transmissions, and repeats, are skipped.
+- Canonical names are the MJCF names with every character outside ``[A-Za-z0-9_]``
+  replaced by ``_``; ``sim_joint_name`` keeps the MJCF name where they differ.
+- qpos/qvel/actuator overrides are written only where the model differs from the
+  default wiring (1:1 in manifest order, +7/+6 with a floating base).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import textwrap
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import mujoco
+
+from openral_hal.errors import HalError
+from openral_hal.mjcf_uri import resolve_mjcf_uri
+
+SCHEMA_LINE = "# yaml-language-server: $schema=../../schema/robot.schema.json"
+"""First line of every manifest under ``robots/<name>/``."""
+
+ROBOT_NAME = re.compile(r"[a-z][a-z0-9_]{1,62}")
+MJCF_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_/.-]{0,126}")
+GRIPPER_WORDS = ("finger", "gripper", "jaw", "hand")
+
+FREE_JOINT_NQPOS = 7
+FREE_JOINT_NDOF = 6
+MAX_NAME = 63
+MAX_QPOS_ADDRS = 8
+LIMIT_BOUND = 1000.0
+EFFORT_BOUND = 100000.0
+CTRL_BOUND = 10000.0
+QPOS_SCALE_BOUND = 1000.0
+DIGITS = 6
+
+PLACEHOLDER_VELOCITY = 1.0
+PLACEHOLDER_EFFORT = 1.0
+PLACEHOLDER_KP = 100.0
+PLACEHOLDER_KD = 2.0
+CAMERA_SIZE = 128
+CAMERA_RATE_HZ = 10.0
+
+_REVIEW = "  # REVIEW:"
+_RESERVED = {"true", "false", "null", "yes", "no", "on", "off", "y", "n", "~"}
+_PLAIN = re.compile(r"[A-Za-z][A-Za-z0-9_./:-]*(?: [A-Za-z0-9_./-]+)*")
+_TRANSMISSION_NAMES = {
+    int(mujoco.mjtTrn.mjTRN_JOINT): "joint",
+    int(mujoco.mjtTrn.mjTRN_JOINTINPARENT): "joint in parent",
+    int(mujoco.mjtTrn.mjTRN_SLIDERCRANK): "slider-crank",
+    int(mujoco.mjtTrn.mjTRN_TENDON): "tendon",
+    int(mujoco.mjtTrn.mjTRN_SITE): "site",
+    int(mujoco.mjtTrn.mjTRN_BODY): "body",
+}
+
+
+@dataclass(frozen=True)
+class _Driven:
+    """A joint the manifest lists, and what drives it."""
+
+    jid: int
+    mjcf_name: str
+    name: str
+    actuator: int
+    coupled: tuple[int, ...]
+    """Joints of the fixed tendon the actuator drives (this joint first), or () for a joint."""
+
+
+def scaffold_manifest(mjcf_uri: str, name: str, manifest_dir: Path) -> str:
+    """Draft robot.yaml text for the MJCF model `mjcf_uri` names.
+
+    Args:
+        mjcf_uri: A ``sim.mjcf_uri`` (see :mod:`openral_hal.mjcf_uri`), written into the draft
+            as given.
+        name: Robot id; the draft belongs in ``robots/<name>/robot.yaml``.
+        manifest_dir: Folder the draft will be written to (relative ``file:`` URIs start
+            there).
+
+    Raises:
+        MjcfUriError: The URI cannot be resolved to an MJCF file.
+        HalError: Invalid robot id, a model MuJoCo cannot load, or no actuator that drives
+            a joint.
+    """
+    if not ROBOT_NAME.fullmatch(name):
+        raise HalError(
+            f"robot name {name!r} must be lower-case snake case, 2 to 63 characters "
+            "(^[a-z][a-z0-9_]{1,62}$)"
+        )
+    path = resolve_mjcf_uri(mjcf_uri, manifest_dir)
+    try:
+        model = mujoco.MjModel.from_xml_path(str(path))
+    except ValueError as error:
+        raise HalError(f"{mjcf_uri}: MuJoCo cannot load {path}: {error}") from None
+    driven, skipped, actuated = _driven_joints(model)
+    if not driven:
+        why = f" ({'; '.join(skipped)})" if skipped else ""
+        raise HalError(
+            f"{mjcf_uri}: none of the {model.nu} actuator(s) of {path} drives a hinge or "
+            f"slide joint a manifest can list (through a joint or a fixed tendon){why}; "
+            "there is nothing to put under joints"
+        )
+    return "\n".join(_manifest_lines(model, mjcf_uri, name, driven, skipped, actuated)) + "\n"
+
+
+# --------------------------------------------------------------------------- model reading
+
+
+def _driven_joints(model: mujoco.MjModel) -> tuple[list[_Driven], list[str], set[int]]:
+    """Listed joints in actuator order, notes on skipped actuators, and every joint id an
+    actuator drives (listed or not)."""
+    driven: list[_Driven] = []
+    skipped: list[str] = []
+    seen: set[int] = set()
+    names: set[str] = set()
+    for actuator in range(model.nu):
+        label = _actuator_label(model, actuator)
+        kind = int(model.actuator_trntype[actuator])
+        target = int(model.actuator_trnid[actuator, 0])
+        coupled: tuple[int, ...] = ()
+        if kind in (int(mujoco.mjtTrn.mjTRN_JOINT), int(mujoco.mjtTrn.mjTRN_JOINTINPARENT)):
+            jid = target
+        elif kind == int(mujoco.mjtTrn.mjTRN_TENDON):
+            coupled = _fixed_tendon_joints(model, target)
+            if not coupled:
+                skipped.append(f"{label} (spatial tendon)")
+                continue
+            jid = coupled[0]
+        else:
+            skipped.append(f"{label} ({_TRANSMISSION_NAMES.get(kind, 'other')} transmission)")
+            continue
+        if jid in seen:
+            continue
+        seen.add(jid)
+        mjcf_name = _joint_name(model, jid)
+        if int(model.jnt_type[jid]) not in (
+            int(mujoco.mjtJoint.mjJNT_HINGE),
+            int(mujoco.mjtJoint.mjJNT_SLIDE),
+        ):
+            skipped.append(f"{label} (drives the ball or free joint {mjcf_name or jid})")
+            continue
+        if not MJCF_NAME.fullmatch(mjcf_name):
+            skipped.append(
+                f"{label} (drives joint {mjcf_name or jid!r}, whose name a manifest cannot "
+                "reference as sim_joint_name)"
+            )
+            continue
+        canonical = _unique(_canonical_joint_name(mjcf_name), names)
+        names.add(canonical)
+        driven.append(_Driven(jid, mjcf_name, canonical, actuator, coupled))
+    return driven, skipped, seen
+
+
+def _fixed_tendon_joints(model: mujoco.MjModel, tendon: int) -> tuple[int, ...]:
+    """Joints of a fixed tendon in wrap order, or () for a spatial tendon."""
+    start, count = int(model.tendon_adr[tendon]), int(model.tendon_num[tendon])
+    wraps = range(start, start + count)
+    if not wraps or any(model.wrap_type[w] != mujoco.mjtWrap.mjWRAP_JOINT for w in wraps):
+        return ()
+    joints: list[int] = []
+    for w in wraps:
+        jid = int(model.wrap_objid[w])
+        if jid not in joints:
+            joints.append(jid)
+    return tuple(joints)
+
+
+def _canonical_joint_name(mjcf_name: str) -> str:
+    name = re.sub(r"[^A-Za-z0-9_]", "_", mjcf_name)
+    if not name[:1].isalpha() or not name[:1].isascii():
+        name = f"j_{name}"
+    return name[:MAX_NAME]
+
+
+def _sensor_name(camera: str) -> str:
+    name = re.sub(r"[^a-z0-9_]", "_", camera.lower())
+    if not name[:1].isalpha() or not name[:1].isascii():
+        name = f"cam_{name}"
+    return name[:MAX_NAME]
+
+
+def _unique(name: str, taken: set[str]) -> str:
+    if name not in taken:
+        return name
+    for n in range(2, 10_000):
+        suffix = f"_{n}"
+        candidate = name[: MAX_NAME - len(suffix)] + suffix
+        if candidate not in taken:
+            return candidate
+    raise HalError(f"cannot make joint name {name!r} unique")  # pragma: no cover
+
+
+def _joint_name(model: mujoco.MjModel, jid: int) -> str:
+    return mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, jid) or ""
+
+
+def _actuator_label(model: mujoco.MjModel, actuator: int) -> str:
+    name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator)
+    return f"actuator {actuator} ({name})" if name else f"actuator {actuator}"
+
+
+def _root_is_free(model: mujoco.MjModel) -> bool:
+    return (
+        model.njnt > 0
+        and int(model.jnt_type[0]) == int(mujoco.mjtJoint.mjJNT_FREE)
+        and int(model.jnt_qposadr[0]) == 0
+    )
+
+
+def _is_motor(model: mujoco.MjModel, actuator: int) -> bool:
+    return int(model.actuator_biastype[actuator]) == int(mujoco.mjtBias.mjBIAS_NONE)
+
+
+def _is_position_servo(model: mujoco.MjModel, actuator: int) -> bool:
+    return int(model.actuator_biastype[actuator]) == int(mujoco.mjtBias.mjBIAS_AFFINE)
+
+
+# --------------------------------------------------------------------------- writing
+
+
+def _manifest_lines(
+    model: mujoco.MjModel,
+    mjcf_uri: str,
+    name: str,
+    driven: Sequence[_Driven],
+    skipped: Sequence[str],
+    actuated: set[int],
+) -> list[str]:
+    floating = _root_is_free(model)
+    one_line_uri = mjcf_uri.replace("\n", " ")
+    lines = [
+        SCHEMA_LINE,
+        f"# Drafted by `openral robot scaffold` from {one_line_uri}.",
+        "# Lines marked `# REVIEW:` are guesses or placeholders and need a human.",
+    ]
+    if floating:
+        root = _joint_name(model, 0) or "(unnamed)"
+        lines.append(f"# The root free joint {root} is the floating base (sim.floating_base).")
+    unlisted = [
+        _joint_name(model, j) or f"(unnamed joint {j})"
+        for j in range(model.njnt)
+        if j not in actuated and not (floating and j == 0)
+    ]
+    lines += _comment_block(
+        "Joints no actuator drives (free joints of objects, passive or coupled fingers) "
+        "are not listed:",
+        unlisted,
+    )
+    lines += _comment_block("REVIEW: actuators left out of joints:", skipped)
+    lines += [
+        'schema_version: "0.1"',
+        f"name: {_scalar(name)}",
+        f"display_name: {_scalar(name.replace('_', ' ').title())}",
+        f"base: {'mobile' if floating else 'fixed'}",
+        "joints:",
+    ]
+    for joint in driven:
+        lines += _joint_lines(model, joint)
+    lines += _sensor_lines(model)
+    lines += _sim_lines(model, mjcf_uri, driven, floating)
+    return lines
+
+
+def _comment_block(title: str, items: Sequence[str]) -> list[str]:
+    if not items:
+        return []
+    text = f"{title} {', '.join(items)}."
+    return [f"# {line}" for line in textwrap.wrap(text, width=96, break_on_hyphens=False)]
+
+
+def _joint_lines(model: mujoco.MjModel, joint: _Driven) -> list[str]:
+    lines = [f"  - name: {_scalar(joint.name)}"]
+    if joint.name != joint.mjcf_name:
+        lines.append(f"    sim_joint_name: {_scalar(joint.mjcf_name)}")
+    jid = joint.jid
+    limited = bool(model.jnt_limited[jid])
+    low, high = (float(v) for v in model.jnt_range[jid])
+    if int(model.jnt_type[jid]) == int(mujoco.mjtJoint.mjJNT_HINGE):
+        limits = _limits(low, high) if limited else None
+        if limits is None:
+            lines.append("    type: continuous")
+            if limited:
+                lines[-1] += f"{_REVIEW} its MJCF range [{low:g}, {high:g}] is empty"
+        else:
+            lines.append("    type: revolute")
+            lines.append(_limits_line(limits, low, high))
+    else:
+        lines.append("    type: prismatic")
+        limits = _limits(low, high) if limited else None
+        if limits is None:
+            lines.append(
+                f"    position_limits: [-1.0, 1.0]{_REVIEW} the MJCF slide joint has no range"
+            )
+        else:
+            lines.append(_limits_line(limits, low, high))
+    lines.append(f"    velocity_limit: {_num(PLACEHOLDER_VELOCITY)}{_REVIEW} not in the MJCF")
+    effort, source = _effort(model, joint)
+    if effort is None:
+        lines.append(f"    effort_limit: {_num(PLACEHOLDER_EFFORT)}{_REVIEW} {source}")
+    elif effort > EFFORT_BOUND:
+        lines.append(
+            f"    effort_limit: {_num(EFFORT_BOUND)}{_REVIEW} clipped; the MJCF {source} "
+            f"gives {effort:g}"
+        )
+    else:
+        lines.append(f"    effort_limit: {_num(effort)}")
+    return lines
+
+
+def _limits(low: float, high: float) -> tuple[float, float] | None:
+    """Rounded limits, unrounded where rounding would collapse them, None when empty."""
+    rounded = (round(low, DIGITS), round(high, DIGITS))
+    if rounded[0] < rounded[1]:
+        return rounded
+    return (low, high) if low < high else None
+
+
+def _limits_line(limits: tuple[float, float], low: float, high: float) -> str:
+    lower, upper = max(limits[0], -LIMIT_BOUND), min(limits[1], LIMIT_BOUND)
+    mjcf_range = f"the MJCF range is [{low:g}, {high:g}]"
+    if not lower < upper:
+        return f"    position_limits: [-1.0, 1.0]{_REVIEW} {mjcf_range}, outside +-1000"
+    line = f"    position_limits: [{_num(lower, rounded=False)}, {_num(upper, rounded=False)}]"
+    if (lower, upper) != limits:
+        line += f"{_REVIEW} clipped to +-1000; {mjcf_range}"
+    return line
+
+
+def _effort(model: mujoco.MjModel, joint: _Driven) -> tuple[float | None, str]:
+    """Effort limit and where it came from; (None, why) when the MJCF gives none."""
+    jid, actuator = joint.jid, joint.actuator
+    candidates: list[tuple[float, str]] = []
+    if model.jnt_actfrclimited[jid]:
+        candidates.append((float(model.jnt_actfrcrange[jid, 1]), "actuatorfrcrange"))
+    if model.actuator_forcelimited[actuator]:
+        candidates.append((float(model.actuator_forcerange[actuator, 1]), "forcerange"))
+    if _is_motor(model, actuator) and model.actuator_ctrllimited[actuator]:
+        gear = abs(float(model.actuator_gear[actuator, 0]))
+        ctrl_high = float(model.actuator_ctrlrange[actuator, 1])
+        candidates.append((ctrl_high * gear, "motor ctrlrange x gear"))
+    for value, source in candidates:
+        if math.isfinite(value) and round(value, DIGITS) > 0:
+            return value, source
+    if candidates:
+        return None, "the MJCF effort bound is not positive"
+    return None, "not in the MJCF"
+
+
+def _sensor_lines(model: mujoco.MjModel) -> list[str]:
+    lines: list[str] = []
+    taken: set[str] = set()
+    for cam in range(model.ncam):
+        camera = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, cam) or ""
+        if not MJCF_NAME.fullmatch(camera):
+            continue
+        sensor = _sensor_name(camera)
+        if sensor in taken:
+            continue
+        taken.add(sensor)
+        lines += [
+            f"  - name: {_scalar(sensor)}",
+            "    kind: rgb",
+            f"    camera: {_scalar(camera)}",
+            f"    width: {CAMERA_SIZE}",
+            f"    height: {CAMERA_SIZE}",
+            f"    rate_hz: {_num(CAMERA_RATE_HZ)}",
+            f"    frame_id: {sensor}_optical_frame",
+        ]
+    return ["sensors:", *lines] if lines else ["sensors: []"]
+
+
+def _sim_lines(
+    model: mujoco.MjModel, mjcf_uri: str, driven: Sequence[_Driven], floating: bool
+) -> list[str]:
+    lines = ["sim:", f"  mjcf_uri: {_scalar(mjcf_uri)}"]
+    if floating:
+        lines.append("  floating_base: true")
+    qpos_offset = FREE_JOINT_NQPOS if floating else 0
+    qvel_offset = FREE_JOINT_NDOF if floating else 0
+    overrides = {
+        "joint_qpos_addr": [
+            (d.name, int(model.jnt_qposadr[d.jid]), qpos_offset + i) for i, d in enumerate(driven)
+        ],
+        "joint_qvel_addr": [
+            (d.name, int(model.jnt_dofadr[d.jid]), qvel_offset + i) for i, d in enumerate(driven)
+        ],
+        "actuator_index": [(d.name, d.actuator, i) for i, d in enumerate(driven)],
+    }
+    for field, rows in overrides.items():
+        differing = [(joint, real) for joint, real, default in rows if real != default]
+        if differing:
+            lines.append(f"  {field}:")
+            lines += [f"    {_scalar(joint)}: {real}" for joint, real in differing]
+    if model.nkey > 0:
+        lines.append("  keyframe_index: 0")
+    actuators = [d.actuator for d in driven]
+    if any(_is_position_servo(model, a) for a in actuators):
+        lines.append("  seed_ctrl_from_qpos: true")
+    gripper_lines = [line for d in driven for line in _gripper_lines(model, d)]
+    notes = [line for line in gripper_lines if line.startswith("  #")]
+    entries = [line for line in gripper_lines if not line.startswith("  #")]
+    lines += notes
+    if entries:
+        lines += ["  grippers:", *entries]
+    if all(_is_motor(model, a) for a in actuators):
+        lines.append(
+            f"  control: {{mode: torque_pd, kp: {_num(PLACEHOLDER_KP)}, "
+            f"kd: {_num(PLACEHOLDER_KD)}}}{_REVIEW} gains are placeholders"
+        )
+    return lines
+
+
+def _gripper_lines(model: mujoco.MjModel, joint: _Driven) -> list[str]:
+    if not (joint.coupled or any(w in joint.mjcf_name.lower() for w in GRIPPER_WORDS)):
+        return []
+    actuator = joint.actuator
+    ctrl_limited = bool(model.actuator_ctrllimited[actuator])
+    ctrl = tuple(float(v) for v in model.actuator_ctrlrange[actuator])
+    if joint.coupled:
+        fingers = joint.coupled[:MAX_QPOS_ADDRS]
+        addrs = [int(model.jnt_qposadr[j]) for j in fingers]
+        opened = sum(float(model.jnt_range[j, 1]) for j in fingers if model.jnt_limited[j])
+        scale = round(opened, DIGITS)
+        if not 0 < scale <= QPOS_SCALE_BOUND:
+            scale = 1.0
+        ctrl_range = _inward(ctrl[0], ctrl[1]) if ctrl_limited else (0.0, 1.0)
+        modes = ("sum_over_scale", "normalised")
+    else:
+        addrs = [int(model.jnt_qposadr[joint.jid])]
+        scale = 1.0
+        if ctrl_limited:
+            ctrl_range = _inward(ctrl[0], ctrl[1])
+        else:
+            low, high = (float(v) for v in model.jnt_range[joint.jid])
+            ctrl_range = _inward(low, high) if model.jnt_limited[joint.jid] else (0.0, 0.0)
+        modes = ("passthrough", "passthrough")
+    ctrl_range = (max(ctrl_range[0], -CTRL_BOUND), min(ctrl_range[1], CTRL_BOUND))
+    if not ctrl_range[0] < ctrl_range[1]:
+        return [
+            f"  # REVIEW: {joint.name} looks like a gripper, but its control range is empty; "
+            "no gripper entry was drafted"
+        ]
+    shown_low, shown_high = (_num(v, rounded=False) for v in ctrl_range)
+    return [
+        f"    - joint: {_scalar(joint.name)}{_REVIEW} guessed gripper",
+        f"      ctrl_range: [{shown_low}, {shown_high}]",
+        f"      qpos_addrs: [{', '.join(str(a) for a in addrs)}]",
+        f"      qpos_scale: {_num(scale)}",
+        f"      read_mode: {modes[0]}",
+        f"      write_mode: {modes[1]}",
+    ]
+
+
+def _inward(low: float, high: float) -> tuple[float, float]:
+    """``(low, high)`` rounded to DIGITS decimals without leaving the interval."""
+    step = 10.0**DIGITS
+    rounded_low, rounded_high = round(low, DIGITS), round(high, DIGITS)
+    if rounded_low < low:
+        rounded_low = math.ceil(low * step) / step
+    if rounded_high > high:
+        rounded_high = math.floor(high * step) / step
+    return rounded_low, rounded_high
+
+
+def _num(value: float, *, rounded: bool = True) -> str:
+    """A float YAML reads back as a float: ``round(x, 6)`` in ``repr`` form, with a dot."""
+    number = round(float(value), DIGITS) if rounded else float(value)
+    if number == 0:
+        number = 0.0  # no "-0.0"
+    text = repr(number)
+    mantissa, e, exponent = text.partition("e")
+    if "." not in mantissa:
+        mantissa += ".0"
+    return f"{mantissa}{e}{exponent}"
+
+
+def _scalar(text: str) -> str:
+    """``text`` as a YAML plain scalar where that reads back as the same string, else quoted."""
+    plain = (
+        _PLAIN.fullmatch(text) is not None
+        and ": " not in text
+        and not text.endswith(":")
+        and text.lower() not in _RESERVED
+    )
+    return text if plain else json.dumps(text)
