@@ -1,0 +1,1 @@
+"""Bridges between a simulated scene and the outside world (idle stepping, sensors)."""

@@ -1,0 +1,56 @@
+"""The SimRollout protocol every scene backend implements."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Protocol, runtime_checkable
+
+import mujoco
+import numpy as np
+import numpy.typing as npt
+
+Observation = dict[str, Any]
+"""Backend observation. Camera images are ``obs["images"][<camera name>]`` (H×W×3 uint8);
+non-MuJoCo backends may report ``obs["joint_positions"]`` (a 1-D float array)."""
+
+
+@dataclass
+class StepResult:
+    """What one ``SimRollout.step`` returns (gymnasium's five-tuple, named)."""
+
+    obs: Observation
+    reward: float = 0.0
+    terminated: bool = False
+    truncated: bool = False
+    info: dict[str, Any] = field(default_factory=dict)
+
+
+@runtime_checkable
+class SimRollout(Protocol):
+    """A simulated scene that owns physics and rendering; a HAL attaches to it."""
+
+    @property
+    def action_dim(self) -> int | None:
+        """Width of the action ``step`` expects, or None when the backend cannot tell."""
+        ...
+
+    @property
+    def camera_names(self) -> tuple[str, ...]:
+        """Cameras rendered into ``obs["images"]``."""
+        ...
+
+    def reset(self, seed: int | None = None) -> Observation:
+        """Start a new episode; returns its first observation."""
+        ...
+
+    def step(self, action: npt.NDArray[np.floating[Any]]) -> StepResult:
+        """Apply ``action`` for one control period and advance."""
+        ...
+
+    def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
+        """The live MuJoCo (model, data), or None for a non-MuJoCo backend."""
+        ...
+
+    def close(self) -> None:
+        """Release renderers and other resources."""
+        ...
