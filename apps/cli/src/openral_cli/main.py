@@ -13,7 +13,7 @@ import typer
 from openral_core.errors import OpenralError
 from rich.console import Console
 
-from openral_cli.commands import robot
+from openral_cli.commands import robot, sim
 
 app = typer.Typer(
     name="openral",
@@ -22,6 +22,7 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 app.add_typer(robot.app, name="robot")
+app.add_typer(sim.app, name="sim")
 
 
 def run() -> None:

@@ -10,7 +10,7 @@ import numpy as np
 import numpy.typing as npt
 
 Observation = dict[str, Any]
-"""Backend observation. Camera images are ``obs["images"][<camera name>]`` (H×W×3 uint8);
+"""Backend observation. Camera images are ``obs["images"][<camera name>]`` (HxWx3 uint8);
 non-MuJoCo backends may report ``obs["joint_positions"]`` (a 1-D float array)."""
 
 

@@ -1,0 +1,375 @@
+"""The native scene backend: any manifest's robot composed into a tabletop with MjSpec.
+
+The scene adds a floor, lights, optionally a table and a pedestal, the objects the scene file
+lists, and a camera for every manifest camera sensor the scene file names:
+
+- a sensor with ``camera`` renders that camera of the robot's own model;
+- a sensor with ``mount_body`` gets a camera fixed to that body, looking forward (+x) on a
+  torso, head, pelvis or base body and along the body's +z (the tool axis) on any other;
+- any other sensor is a fixed camera in front of the robot, framed by the robot's reach.
+
+The action is one control value per actuator of the robot model. For a ``torque_pd`` robot
+the values are position targets, turned into torques by the manifest's PD law every step.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import mujoco
+import numpy as np
+import numpy.typing as npt
+from openral_core.errors import OpenralError
+from openral_core.models import DeployScene, DepthSensor, RgbSensor, RobotDescription
+from openral_core.registry import manifest_path
+from openral_core.tables import hal_wiring
+from openral_hal.mjcf_uri import resolve_mjcf_uri
+
+from openral_sim.rollout import Observation, StepResult
+
+ASSETS = ("tabletop", "floor")
+"""``scene.assets`` values: a table in front of the robot, or only floor and lights (for
+models that bring their own table)."""
+DEFAULT_TABLE_HEIGHT_M = 0.75
+FORWARD_LOOKING = ("torso", "head", "pelvis", "base")
+
+
+class SceneError(OpenralError):
+    """A scene file that cannot be built for its robot."""
+
+
+class NativeScene:
+    """A MuJoCo scene composed from a manifest and a deploy-scene file (a SimRollout)."""
+
+    def __init__(self, scene: DeployScene, robot: RobotDescription, source: Path | None = None):
+        self.scene = scene
+        self.robot = robot
+        where = f"{source}: " if source else ""
+        if scene.scene.assets not in ASSETS:
+            raise SceneError(
+                f"{where}scene.assets {scene.scene.assets!r}; expected one of {ASSETS}"
+            )
+        sim = robot.sim
+        if sim is None:
+            raise SceneError(f"{where}robot {robot.name!r} has no sim block")
+        self._sensors = _camera_sensors(robot, scene.scene.cameras, where)
+        self.model = _compose(scene, robot, self._sensors)
+        self.data = mujoco.MjData(self.model)
+        wiring = hal_wiring(robot)
+        assert wiring is not None
+        self._keyframe = wiring.keyframe_index
+        self._floating = wiring.floating_base
+        self._width = scene.scene.observation.width
+        self._height = scene.scene.observation.height
+        options = scene.scene.options
+        control_hz = options.control_freq_hz if options and options.control_freq_hz else 20.0
+        self.substeps = max(1, round(1.0 / (control_hz * self.model.opt.timestep)))
+        self.horizon = options.horizon if options and options.horizon else None
+        self._pd = _pd_law(robot, self.model) if wiring.control_mode == "torque_pd" else None
+        self._renderer: mujoco.Renderer | None = None
+        self._steps = 0
+        self._rng = np.random.default_rng(scene.seed)
+
+    # -- SimRollout ------------------------------------------------------------------------
+
+    @property
+    def action_dim(self) -> int:
+        """One value per actuator of the robot model."""
+        return int(self.model.nu)
+
+    @property
+    def camera_names(self) -> tuple[str, ...]:
+        """Manifest sensor names rendered into ``obs["images"]``."""
+        return tuple(self._sensors)
+
+    def reset(self, seed: int | None = None) -> Observation:
+        """Keyframe (if any) at the scene's base pose, actuators holding the start pose."""
+        if seed is not None:
+            self._rng = np.random.default_rng(seed)
+        mujoco.mj_resetData(self.model, self.data)
+        if self._keyframe is not None:
+            mujoco.mj_resetDataKeyframe(self.model, self.data, self._keyframe)
+            if self._floating:
+                self._place_floating_base()
+        _hold_pose(self.model, self.data)
+        mujoco.mj_forward(self.model, self.data)
+        if self._pd is not None:  # targets are joint positions: hold the current ones
+            joints = self.model.actuator_trnid[:, 0]
+            self.data.ctrl[:] = self.data.qpos[self.model.jnt_qposadr[joints]]
+        self._steps = 0
+        return self._observe()
+
+    def step(self, action: npt.NDArray[Any]) -> StepResult:
+        """Apply ``action`` (one value per actuator) for one control period."""
+        values = np.asarray(action, dtype=np.float64)
+        if values.shape != (self.action_dim,):
+            raise SceneError(f"action has shape {values.shape}; expected ({self.action_dim},)")
+        low, high = self.model.actuator_ctrlrange.T
+        limited = self.model.actuator_ctrllimited.astype(bool)
+        if self._pd is None:
+            self.data.ctrl[:] = np.where(limited, np.clip(values, low, high), values)
+            mujoco.mj_step(self.model, self.data, nstep=self.substeps)
+        else:
+            for _ in range(self.substeps):
+                self.data.ctrl[:] = self._pd(self.data, values)
+                mujoco.mj_step(self.model, self.data)
+        self._steps += 1
+        truncated = self.horizon is not None and self._steps >= self.horizon
+        return StepResult(self._observe(), truncated=truncated, info={"steps": self._steps})
+
+    def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData]:
+        """The scene's live (model, data)."""
+        return self.model, self.data
+
+    def close(self) -> None:
+        """Free the offscreen renderer."""
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    # -- internals -------------------------------------------------------------------------
+
+    def _observe(self) -> Observation:
+        if self._sensors and self._renderer is None:
+            self._renderer = mujoco.Renderer(self.model, self._height, self._width)
+        images: dict[str, npt.NDArray[np.uint8]] = {}
+        for sensor, camera in self._sensors.items():
+            assert self._renderer is not None
+            self._renderer.update_scene(self.data, camera=camera)
+            images[sensor] = self._renderer.render().copy()
+        return {"images": images, "time": float(self.data.time)}
+
+    def _place_floating_base(self) -> None:
+        """Keyframe free-joint poses are world poses: move them to the scene's base pose."""
+        pose = self.scene.base_pose
+        if pose is None:
+            return
+        position = np.asarray(pose.position_m or [0.0, 0.0, 0.0])
+        yaw = math.radians(pose.yaw_deg or 0.0)
+        self.data.qpos[0:3] += position
+        turn = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
+        quat = np.empty(4)
+        mujoco.mju_mulQuat(quat, turn, self.data.qpos[3:7].copy())
+        self.data.qpos[3:7] = quat
+
+
+def _camera_sensors(robot: RobotDescription, wanted: Sequence[str], where: str) -> dict[str, str]:
+    """Scene camera list → {sensor name: MJCF camera name}, in the scene file's order."""
+    by_name = {s.name: s for s in robot.sensors if isinstance(s, RgbSensor | DepthSensor)}
+    cameras: dict[str, str] = {}
+    for name in wanted:
+        sensor = by_name.get(name)
+        if sensor is None:
+            known = ", ".join(by_name) or "(none)"
+            raise SceneError(
+                f"{where}scene.cameras: {name!r} is not a camera sensor of robot "
+                f"{robot.name!r}; its camera sensors are: {known}"
+            )
+        cameras[name] = sensor.camera or f"openral_{name}"
+    return cameras
+
+
+def _compose(
+    scene: DeployScene, robot: RobotDescription, cameras: dict[str, str]
+) -> mujoco.MjModel:
+    assert robot.sim is not None
+    folder = manifest_path(robot.name).parent
+    child = mujoco.MjSpec.from_file(str(resolve_mjcf_uri(robot.sim.mjcf_uri, folder)))
+    spec = mujoco.MjSpec()
+    spec.modelname = f"{scene.scene.id}_{robot.name}"
+    for key in ("timestep", "integrator", "cone", "impratio", "noslip_iterations"):
+        setattr(spec.option, key, getattr(child.option, key))
+    spec.compiler.degree = False
+    width, height = scene.scene.observation.width, scene.scene.observation.height
+    spec.visual.global_.offwidth = max(width, 640)
+    spec.visual.global_.offheight = max(height, 480)
+    spec.visual.quality.shadowsize = 0
+    spec.visual.quality.offsamples = 0
+    pose = scene.base_pose
+    base = np.asarray(pose.position_m if pose and pose.position_m else [0.0, 0.0, 0.0])
+    yaw = math.radians(pose.yaw_deg if pose and pose.yaw_deg else 0.0)
+    options = scene.scene.options
+    _add_world(spec)
+    if scene.scene.assets == "tabletop":
+        table_h = (
+            options.table_height_m
+            if options and options.table_height_m is not None
+            else DEFAULT_TABLE_HEIGHT_M
+        )
+        _add_table(spec, base, yaw, table_h)
+        fixed = robot.sim.floating_base is False
+        if fixed and base[2] > 0.05:
+            spec.worldbody.add_geom(
+                name="scene_pedestal",
+                type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+                size=[0.09, base[2] / 2, 0],
+                pos=[base[0], base[1], base[2] / 2],
+                rgba=[0.3, 0.3, 0.32, 1],
+            )
+    for obj in options.objects if options and options.objects else []:
+        _add_object(spec, obj)
+    frame = spec.worldbody.add_frame(pos=base.tolist(), quat=_yaw_quat(yaw).tolist())
+    reach = _reach(child)  # before attach: an attached spec must not be compiled again
+    _add_mounted_cameras(child, robot, cameras)
+    spec.attach(child, frame=frame, prefix="")
+    for sensor_name, camera in cameras.items():
+        if camera == f"openral_{sensor_name}" and not _has_mount(robot, sensor_name):
+            _add_fixed_camera(spec, camera, base, yaw, reach, _fovy(robot, sensor_name))
+    try:
+        return spec.compile()
+    except ValueError as error:
+        problem = f"scene {scene.scene.id!r} for {robot.name!r} does not compile: {error}"
+        raise SceneError(problem) from None
+
+
+def _add_world(spec: mujoco.MjSpec) -> None:
+    spec.worldbody.add_light(name="scene_key_light", pos=[0.5, -1.0, 3.0], dir=[0, 0.3, -1])
+    spec.worldbody.add_light(name="scene_fill_light", pos=[-1.0, 1.0, 2.5], dir=[0.4, -0.3, -1])
+    spec.worldbody.add_geom(
+        name="scene_floor",
+        type=mujoco.mjtGeom.mjGEOM_PLANE,
+        size=[5, 5, 0.05],
+        rgba=[0.55, 0.6, 0.65, 1],
+    )
+
+
+def _add_table(spec: mujoco.MjSpec, base: np.ndarray, yaw: float, height: float) -> None:
+    centre = base + _rotate(yaw, np.array([0.55, 0.0, 0.0]))
+    spec.worldbody.add_geom(
+        name="scene_table",
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[0.4, 0.6, height / 2],
+        pos=[centre[0], centre[1], height / 2],
+        quat=_yaw_quat(yaw).tolist(),
+        rgba=[0.72, 0.55, 0.38, 1],
+    )
+
+
+def _add_object(spec: mujoco.MjSpec, obj: Any) -> None:
+    shapes = {
+        "box": mujoco.mjtGeom.mjGEOM_BOX,
+        "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
+        "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
+    }
+    size = [*obj.size_m, 0.0, 0.0][:3]
+    body = spec.worldbody.add_body(name=f"scene_{obj.name}", pos=list(obj.position_m))
+    body.add_freejoint(name=f"scene_{obj.name}_joint")
+    body.add_geom(
+        name=f"scene_{obj.name}_geom",
+        type=shapes[obj.shape],
+        size=size,
+        rgba=list(obj.rgba or [0.8, 0.2, 0.2, 1.0]),
+        mass=obj.mass_kg or 0.1,
+    )
+
+
+def _add_mounted_cameras(
+    child: mujoco.MjSpec, robot: RobotDescription, cameras: dict[str, str]
+) -> None:
+    for sensor in robot.sensors:
+        if not isinstance(sensor, RgbSensor | DepthSensor) or sensor.name not in cameras:
+            continue
+        if sensor.camera is not None or sensor.mount_body is None:
+            continue
+        body = child.body(sensor.mount_body)
+        if body is None:
+            raise SceneError(f"sensor {sensor.name!r}: no body {sensor.mount_body!r} in the model")
+        forward = any(word in sensor.mount_body.lower() for word in FORWARD_LOOKING)
+        # A MuJoCo camera looks along its -z axis with +y up.
+        if forward:  # look along body +x, slightly down, from above the body origin
+            pos, xyaxes = [0.1, 0.0, 0.35], [0, -1, 0, 0.45, 0, 1]
+        else:  # look along body +z (the tool axis) from beside it
+            pos, xyaxes = [0.0, -0.07, 0.0], [1, 0, 0, 0, -1, 0]
+        body.add_camera(
+            name=cameras[sensor.name], pos=pos, xyaxes=xyaxes, fovy=sensor.fovy_deg or 60.0
+        )
+
+
+def _add_fixed_camera(
+    spec: mujoco.MjSpec, name: str, base: np.ndarray, yaw: float, reach: float, fovy: float
+) -> None:
+    target = base + _rotate(yaw, np.array([0.4 * reach, 0.0, 0.25 * reach]))
+    eye = base + _rotate(yaw, np.array([1.9 * reach, 0.35 * reach, 1.1 * reach]))
+    forward = target - eye
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    spec.worldbody.add_camera(name=name, pos=eye.tolist(), xyaxes=[*right, *up], fovy=fovy)
+
+
+def _reach(child: mujoco.MjSpec) -> float:
+    """Largest distance of any body from the model origin, at least 0.3 m."""
+    model = child.copy().compile()
+    data = mujoco.MjData(model)
+    if model.nkey:
+        mujoco.mj_resetDataKeyframe(model, data, 0)
+    mujoco.mj_kinematics(model, data)
+    points = data.xpos[1:]
+    if model.njnt and model.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE:
+        points = points - data.xpos[model.jnt_bodyid[0]] * np.array([1, 1, 0])
+    return max(0.3, float(np.linalg.norm(points, axis=1).max()) if len(points) else 0.3)
+
+
+def _has_mount(robot: RobotDescription, sensor_name: str) -> bool:
+    return any(
+        getattr(s, "mount_body", None) is not None for s in robot.sensors if s.name == sensor_name
+    )
+
+
+def _fovy(robot: RobotDescription, sensor_name: str) -> float:
+    for sensor in robot.sensors:
+        if sensor.name == sensor_name and getattr(sensor, "fovy_deg", None):
+            return float(sensor.fovy_deg)  # type: ignore[union-attr]
+    return 45.0
+
+
+def _hold_pose(model: mujoco.MjModel, data: mujoco.MjData) -> None:
+    """Position servos target the current joint positions (nothing jumps at start)."""
+    for actuator in range(model.nu):
+        if model.actuator_trntype[actuator] != mujoco.mjtTrn.mjTRN_JOINT:
+            continue
+        if model.actuator_biastype[actuator] != mujoco.mjtBias.mjBIAS_AFFINE:
+            continue
+        joint = model.actuator_trnid[actuator, 0]
+        value = float(data.qpos[model.jnt_qposadr[joint]])
+        if model.actuator_ctrllimited[actuator]:
+            value = float(np.clip(value, *model.actuator_ctrlrange[actuator]))
+        data.ctrl[actuator] = value
+
+
+def _pd_law(robot: RobotDescription, model: mujoco.MjModel) -> Any:
+    """ctrl = clip(kp * (target - q) - kd * qdot) for each actuator on a manifest joint."""
+    wiring = hal_wiring(robot)
+    assert wiring is not None
+    canonical = {j.sim_joint_name or j.name: j.name for j in robot.joints}
+    actuators = np.arange(model.nu)
+    joints = model.actuator_trnid[:, 0]
+    qpos_addr = model.jnt_qposadr[joints]
+    dof_addr = model.jnt_dofadr[joints]
+    names = [
+        canonical.get(mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or "", "")
+        for j in joints
+    ]
+    kp = np.array([wiring.kp.get(n, 0.0) for n in names])
+    kd = np.array([wiring.kd.get(n, 0.0) for n in names])
+    low, high = model.actuator_ctrlrange[actuators].T
+
+    def law(data: mujoco.MjData, targets: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        torque = kp * (targets - data.qpos[qpos_addr]) - kd * data.qvel[dof_addr]
+        clipped: npt.NDArray[np.float64] = np.clip(torque, low, high)
+        return clipped
+
+    return law
+
+
+def _yaw_quat(yaw: float) -> npt.NDArray[np.float64]:
+    return np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
+
+
+def _rotate(yaw: float, vector: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([c * vector[0] - s * vector[1], s * vector[0] + c * vector[1], vector[2]])
