@@ -180,7 +180,7 @@ class MujocoArmHAL:
         if self.keyframe_index is not None:
             mujoco.mj_resetDataKeyframe(model, data, self.keyframe_index)
         if self.seed_ctrl_from_qpos:
-            _seed_ctrl(model, data)
+            seed_position_servos(model, data)
         mujoco.mj_forward(model, data)
         self._ctrl_low, self._ctrl_high = _ctrl_limits(model)
         self._arm_low = self._ctrl_low[self._arm_act]
@@ -350,7 +350,7 @@ def _ctrl_limits(model: mujoco.MjModel) -> tuple[FloatArray, FloatArray]:
     return low, high
 
 
-def _seed_ctrl(model: mujoco.MjModel, data: mujoco.MjData) -> None:
+def seed_position_servos(model: mujoco.MjModel, data: mujoco.MjData) -> None:
     """ctrl ← qpos of the joint for every position-servo actuator on a hinge or slide joint."""
     for actuator in range(model.nu):
         if model.actuator_trntype[actuator] != mujoco.mjtTrn.mjTRN_JOINT:

@@ -27,6 +27,7 @@ from openral_core.models import DeployScene, DepthSensor, RgbSensor, RobotDescri
 from openral_core.registry import manifest_path
 from openral_core.tables import hal_wiring
 from openral_hal.mjcf_uri import resolve_mjcf_uri
+from openral_hal.mujoco_arm import seed_position_servos
 
 from openral_sim.rollout import Observation, StepResult
 
@@ -94,7 +95,7 @@ class NativeScene:
             mujoco.mj_resetDataKeyframe(self.model, self.data, self._keyframe)
             if self._floating:
                 self._place_floating_base()
-        _hold_pose(self.model, self.data)
+        seed_position_servos(self.model, self.data)  # nothing jumps at start
         mujoco.mj_forward(self.model, self.data)
         if self._pd is not None:  # targets are joint positions: hold the current ones
             joints = self.model.actuator_trnid[:, 0]
@@ -325,20 +326,6 @@ def _fovy(robot: RobotDescription, sensor_name: str) -> float:
         if sensor.name == sensor_name and getattr(sensor, "fovy_deg", None):
             return float(sensor.fovy_deg)  # type: ignore[union-attr]
     return 45.0
-
-
-def _hold_pose(model: mujoco.MjModel, data: mujoco.MjData) -> None:
-    """Position servos target the current joint positions (nothing jumps at start)."""
-    for actuator in range(model.nu):
-        if model.actuator_trntype[actuator] != mujoco.mjtTrn.mjTRN_JOINT:
-            continue
-        if model.actuator_biastype[actuator] != mujoco.mjtBias.mjBIAS_AFFINE:
-            continue
-        joint = model.actuator_trnid[actuator, 0]
-        value = float(data.qpos[model.jnt_qposadr[joint]])
-        if model.actuator_ctrllimited[actuator]:
-            value = float(np.clip(value, *model.actuator_ctrlrange[actuator]))
-        data.ctrl[actuator] = value
 
 
 def _pd_law(robot: RobotDescription, model: mujoco.MjModel) -> Any:
