@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+
+os.environ.setdefault("MUJOCO_GL", "egl")  # before any test module imports mujoco
 from openral_core.paths import repo_root
 
 REPO = repo_root()
