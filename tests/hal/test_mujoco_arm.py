@@ -8,11 +8,12 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import pytest
 from openral_core import load_robot_by_id, manifest_path, robot_ids
 from openral_core.paths import repo_root
-from openral_core.tables import hal_wiring
+from openral_core.tables import HalWiring, hal_wiring
 from openral_hal.errors import EStopLatched, NotConnected, SimulationDiverged
 from openral_hal.mjcf_uri import resolve_mjcf_uri
 from openral_hal.mujoco_arm import MujocoArmHAL, hal_kwargs
@@ -118,7 +119,7 @@ def test_generated_table_wires_the_same_hal_as_the_manifest() -> None:
     table = repo_root() / "generated" / "openral_generated" / "tables" / "franka_panda.json"
     wiring = json.loads(table.read_text())["hal_wiring"]
     path = resolve_mjcf_uri(wiring["mjcf_uri"], manifest_path("franka_panda").parent)
-    from_table = MujocoArmHAL(mjcf_path=path, **hal_kwargs(wiring))
+    from_table = MujocoArmHAL(mjcf_path=path, **hal_kwargs(HalWiring.from_dict(wiring)))
     from_manifest = MujocoArmHAL.from_description(load_robot_by_id("franka_panda"))
     for hal in (from_table, from_manifest):
         hal.connect()
@@ -200,3 +201,15 @@ def test_a_diverging_simulation_is_reported_not_silently_reset(
     data.qvel[:] = 1e30  # what an exploding controller leaves behind
     with pytest.raises(SimulationDiverged, match="diverged"):
         hal.step(5)
+
+
+def test_divergence_watch_covers_exactly_the_bad_state_warnings() -> None:
+    from openral_hal.mujoco_arm import _BAD_STATE_WARNINGS
+
+    watched = set(range(len(mujoco.mjtWarning.__members__))[_BAD_STATE_WARNINGS])
+    expected = {
+        int(mujoco.mjtWarning.mjWARN_BADQPOS),
+        int(mujoco.mjtWarning.mjWARN_BADQVEL),
+        int(mujoco.mjtWarning.mjWARN_BADQACC),
+    }
+    assert watched == expected

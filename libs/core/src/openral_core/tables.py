@@ -58,6 +58,21 @@ class HalWiring:
     kp: dict[str, float] = field(default_factory=dict)
     kd: dict[str, float] = field(default_factory=dict)
 
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> HalWiring:
+        """Inverse of ``dataclasses.asdict`` (the ``hal_wiring`` of a tables JSON file)."""
+        grippers = tuple(
+            GripperWiring(
+                **{
+                    **g,
+                    "ctrl_range": tuple(g["ctrl_range"]),
+                    "qpos_addrs": tuple(g["qpos_addrs"]),
+                }
+            )
+            for g in data["grippers"]
+        )
+        return cls(**{**data, "joint_names": tuple(data["joint_names"]), "grippers": grippers})
+
 
 @dataclass(frozen=True)
 class VlaSlot:
@@ -87,7 +102,7 @@ class RobotTables:
         wiring = data["hal_wiring"]
         return cls(
             robot=data["robot"],
-            hal_wiring=None if wiring is None else _wiring_from_dict(wiring),
+            hal_wiring=None if wiring is None else HalWiring.from_dict(wiring),
             vla_slots=tuple(VlaSlot(**slot) for slot in data["vla_slots"]),
             joint_name_map=dict(data["joint_name_map"]),
         )
@@ -175,17 +190,3 @@ def _gains(
         return {n: float(gains) for n in driven}
 
     return per_joint(control.kp), per_joint(control.kd)
-
-
-def _wiring_from_dict(data: dict[str, Any]) -> HalWiring:
-    grippers = tuple(
-        GripperWiring(
-            **{
-                **g,
-                "ctrl_range": tuple(g["ctrl_range"]),
-                "qpos_addrs": tuple(g["qpos_addrs"]),
-            }
-        )
-        for g in data["grippers"]
-    )
-    return HalWiring(**{**data, "joint_names": tuple(data["joint_names"]), "grippers": grippers})

@@ -9,6 +9,8 @@ import mujoco
 from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
 from openral_core.tables import HalWiring, hal_wiring
 
+from openral_hal.mjcf_model import actuator_joints, root_is_free
+
 
 @dataclass(frozen=True)
 class CheckRow:
@@ -66,25 +68,9 @@ def _actuator_row(
     expected = f"{actuator} drives {native}"
     if not 0 <= actuator < model.nu:
         return CheckRow(field, expected, f"the model has {model.nu} actuators", ok=False)
-    driven = _driven_joints(model, actuator)
+    driven = actuator_joints(model, actuator)
     names = ", ".join(mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or "?" for j in driven)
     return CheckRow(field, expected, f"{actuator} drives {names or 'no joint'}", ok=jid in driven)
-
-
-def _driven_joints(model: mujoco.MjModel, actuator: int) -> list[int]:
-    """Joints an actuator moves: its joint, or every joint of its fixed tendon."""
-    kind = model.actuator_trntype[actuator]
-    target = int(model.actuator_trnid[actuator, 0])
-    if kind in (mujoco.mjtTrn.mjTRN_JOINT, mujoco.mjtTrn.mjTRN_JOINTINPARENT):
-        return [target]
-    if kind == mujoco.mjtTrn.mjTRN_TENDON:
-        start, count = int(model.tendon_adr[target]), int(model.tendon_num[target])
-        return [
-            int(model.wrap_objid[w])
-            for w in range(start, start + count)
-            if model.wrap_type[w] == mujoco.mjtWrap.mjWRAP_JOINT
-        ]
-    return []
 
 
 def _gripper_rows(wiring: HalWiring, model: mujoco.MjModel) -> Iterator[CheckRow]:
@@ -134,8 +120,7 @@ def _keyframe_and_base_rows(wiring: HalWiring, model: mujoco.MjModel) -> Iterato
             f"the model has {model.nkey} keyframe(s)",
             ok=0 <= wiring.keyframe_index < model.nkey,
         )
-    root_free = model.njnt > 0 and model.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE
-    root_free = root_free and int(model.jnt_qposadr[0]) == 0
+    root_free = root_is_free(model)
     yield CheckRow(
         "sim.floating_base",
         str(wiring.floating_base).lower(),

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict
+from dataclasses import fields
 from pathlib import Path
 from typing import Any
 
@@ -18,23 +18,20 @@ import mujoco
 import numpy as np
 from openral_core.models import RobotDescription
 from openral_core.registry import manifest_path
-from openral_core.tables import GripperWiring, hal_wiring
+from openral_core.tables import GripperWiring, HalWiring, hal_wiring
 
 from openral_hal.action import validated_action
 from openral_hal.errors import EStopLatched, HalError, NotConnected, SimulationDiverged
 from openral_hal.gripper import gripper_ctrl, read_gripper
+from openral_hal.mjcf_model import ctrl_limits, is_position_servo
 from openral_hal.mjcf_uri import resolve_mjcf_uri
-from openral_hal.state import FloatArray, JointStateSample
+from openral_hal.state import JointStateSample
 
 CONTROL_MODES = ("position", "torque_pd")
-_INSTABILITY_WARNINGS = [
-    int(w)
-    for w in (
-        mujoco.mjtWarning.mjWARN_BADQPOS,
-        mujoco.mjtWarning.mjWARN_BADQVEL,
-        mujoco.mjtWarning.mjWARN_BADQACC,
-    )
-]
+_BAD_STATE_WARNINGS = slice(
+    int(mujoco.mjtWarning.mjWARN_BADQPOS), int(mujoco.mjtWarning.mjWARN_BADQACC) + 1
+)
+"""MuJoCo's NaN/Inf position, velocity and acceleration warnings (consecutive in mjtWarning)."""
 
 
 class MujocoArmHAL:
@@ -152,8 +149,7 @@ class MujocoArmHAL:
         else:
             folder = manifest_dir or manifest_path(description.name).parent
             path = resolve_mjcf_uri(wiring.mjcf_uri, folder)
-        kwargs = hal_kwargs(asdict(wiring))
-        kwargs["grippers"] = wiring.grippers
+        kwargs = hal_kwargs(wiring)
         if settle_steps is not None:
             kwargs["settle_steps"] = settle_steps
         return cls(
@@ -182,7 +178,7 @@ class MujocoArmHAL:
         if self.seed_ctrl_from_qpos:
             seed_position_servos(model, data)
         mujoco.mj_forward(model, data)
-        self._ctrl_low, self._ctrl_high = _ctrl_limits(model)
+        self._ctrl_low, self._ctrl_high = ctrl_limits(model)
         self._arm_low = self._ctrl_low[self._arm_act]
         self._arm_high = self._ctrl_high[self._arm_act]
         self._model, self._data = model, data
@@ -251,7 +247,8 @@ class MujocoArmHAL:
         model, data = self._handles()
         if self._estopped:
             return False
-        diverged_before = _instability_count(data)
+        bad_state = data.warning.number[_BAD_STATE_WARNINGS]  # a live view of the counters
+        diverged_before = bad_state.tobytes()
         if self.control_mode == "torque_pd":
             for _ in range(n):
                 self._apply_pd(data)
@@ -259,7 +256,7 @@ class MujocoArmHAL:
         else:
             mujoco.mj_step(model, data, nstep=n)
         self._last_step_ns = time.monotonic_ns()
-        if _instability_count(data) != diverged_before:
+        if bad_state.tobytes() != diverged_before:
             raise SimulationDiverged(
                 f"{self.mjcf_path.name}: the simulation diverged (NaN/Inf state) and MuJoCo "
                 "reset it; lower the gains or the targets"
@@ -318,36 +315,16 @@ class MujocoArmHAL:
             )
 
 
-def hal_kwargs(wiring: Mapping[str, Any]) -> dict[str, Any]:
-    """:class:`MujocoArmHAL` keyword arguments from a wiring table (``HalWiring`` as a dict).
+def hal_kwargs(wiring: HalWiring) -> dict[str, Any]:
+    """:class:`MujocoArmHAL` keyword arguments from a resolved wiring table.
 
-    The generated ``tables/<id>.json`` files hold exactly this dict under ``hal_wiring``.
+    The generated ``tables/<id>.json`` files hold one under ``hal_wiring``
+    (``HalWiring.from_dict`` reads it back).
     """
-    kwargs = {k: v for k, v in wiring.items() if k not in ("mjcf_uri", "settle_steps_default")}
-    kwargs["settle_steps"] = wiring["settle_steps_default"]
-    kwargs["grippers"] = tuple(
-        g if isinstance(g, GripperWiring) else _gripper_from_dict(g) for g in wiring["grippers"]
-    )
+    kwargs = {f.name: getattr(wiring, f.name) for f in fields(wiring)}
+    del kwargs["mjcf_uri"]
+    kwargs["settle_steps"] = kwargs.pop("settle_steps_default")
     return kwargs
-
-
-def _gripper_from_dict(data: Mapping[str, Any]) -> GripperWiring:
-    return GripperWiring(
-        **{**data, "ctrl_range": tuple(data["ctrl_range"]), "qpos_addrs": tuple(data["qpos_addrs"])}
-    )
-
-
-def _instability_count(data: mujoco.MjData) -> int:
-    """How often MuJoCo has met a NaN/Inf position, velocity or acceleration and reset."""
-    return sum(int(data.warning[w].number) for w in _INSTABILITY_WARNINGS)
-
-
-def _ctrl_limits(model: mujoco.MjModel) -> tuple[FloatArray, FloatArray]:
-    """Per-actuator (low, high) control bounds; ±inf where ctrl is unlimited."""
-    limited = model.actuator_ctrllimited.astype(bool)
-    low: FloatArray = np.where(limited, model.actuator_ctrlrange[:, 0], -np.inf)
-    high: FloatArray = np.where(limited, model.actuator_ctrlrange[:, 1], np.inf)
-    return low, high
 
 
 def seed_position_servos(model: mujoco.MjModel, data: mujoco.MjData) -> None:
@@ -355,7 +332,7 @@ def seed_position_servos(model: mujoco.MjModel, data: mujoco.MjData) -> None:
     for actuator in range(model.nu):
         if model.actuator_trntype[actuator] != mujoco.mjtTrn.mjTRN_JOINT:
             continue
-        if model.actuator_biastype[actuator] != mujoco.mjtBias.mjBIAS_AFFINE:
+        if not is_position_servo(model, actuator):
             continue
         joint = model.actuator_trnid[actuator, 0]
         if model.jnt_type[joint] not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):

@@ -30,6 +30,7 @@ from pathlib import Path
 import mujoco
 
 from openral_hal.errors import HalError
+from openral_hal.mjcf_model import fixed_tendon_joints, is_motor, is_position_servo, root_is_free
 from openral_hal.mjcf_uri import resolve_mjcf_uri
 
 SCHEMA_LINE = "# yaml-language-server: $schema=../../schema/robot.schema.json"
@@ -135,7 +136,7 @@ def _driven_joints(model: mujoco.MjModel) -> tuple[list[_Driven], list[str], set
         if kind in (int(mujoco.mjtTrn.mjTRN_JOINT), int(mujoco.mjtTrn.mjTRN_JOINTINPARENT)):
             jid = target
         elif kind == int(mujoco.mjtTrn.mjTRN_TENDON):
-            coupled = _fixed_tendon_joints(model, target)
+            coupled = fixed_tendon_joints(model, target)
             if not coupled:
                 skipped.append(f"{label} (spatial tendon)")
                 continue
@@ -163,20 +164,6 @@ def _driven_joints(model: mujoco.MjModel) -> tuple[list[_Driven], list[str], set
         names.add(canonical)
         driven.append(_Driven(jid, mjcf_name, canonical, actuator, coupled))
     return driven, skipped, seen
-
-
-def _fixed_tendon_joints(model: mujoco.MjModel, tendon: int) -> tuple[int, ...]:
-    """Joints of a fixed tendon in wrap order, or () for a spatial tendon."""
-    start, count = int(model.tendon_adr[tendon]), int(model.tendon_num[tendon])
-    wraps = range(start, start + count)
-    if not wraps or any(model.wrap_type[w] != mujoco.mjtWrap.mjWRAP_JOINT for w in wraps):
-        return ()
-    joints: list[int] = []
-    for w in wraps:
-        jid = int(model.wrap_objid[w])
-        if jid not in joints:
-            joints.append(jid)
-    return tuple(joints)
 
 
 def _canonical_joint_name(mjcf_name: str) -> str:
@@ -213,22 +200,6 @@ def _actuator_label(model: mujoco.MjModel, actuator: int) -> str:
     return f"actuator {actuator} ({name})" if name else f"actuator {actuator}"
 
 
-def _root_is_free(model: mujoco.MjModel) -> bool:
-    return (
-        model.njnt > 0
-        and int(model.jnt_type[0]) == int(mujoco.mjtJoint.mjJNT_FREE)
-        and int(model.jnt_qposadr[0]) == 0
-    )
-
-
-def _is_motor(model: mujoco.MjModel, actuator: int) -> bool:
-    return int(model.actuator_biastype[actuator]) == int(mujoco.mjtBias.mjBIAS_NONE)
-
-
-def _is_position_servo(model: mujoco.MjModel, actuator: int) -> bool:
-    return int(model.actuator_biastype[actuator]) == int(mujoco.mjtBias.mjBIAS_AFFINE)
-
-
 # --------------------------------------------------------------------------- writing
 
 
@@ -240,7 +211,7 @@ def _manifest_lines(
     skipped: Sequence[str],
     actuated: set[int],
 ) -> list[str]:
-    floating = _root_is_free(model)
+    floating = root_is_free(model)
     one_line_uri = mjcf_uri.replace("\n", " ")
     lines = [
         SCHEMA_LINE,
@@ -348,7 +319,7 @@ def _effort(model: mujoco.MjModel, joint: _Driven) -> tuple[float | None, str]:
         candidates.append((float(model.jnt_actfrcrange[jid, 1]), "actuatorfrcrange"))
     if model.actuator_forcelimited[actuator]:
         candidates.append((float(model.actuator_forcerange[actuator, 1]), "forcerange"))
-    if _is_motor(model, actuator) and model.actuator_ctrllimited[actuator]:
+    if is_motor(model, actuator) and model.actuator_ctrllimited[actuator]:
         gear = abs(float(model.actuator_gear[actuator, 0]))
         ctrl_high = float(model.actuator_ctrlrange[actuator, 1])
         candidates.append((ctrl_high * gear, "motor ctrlrange x gear"))
@@ -408,7 +379,7 @@ def _sim_lines(
     if model.nkey > 0:
         lines.append("  keyframe_index: 0")
     actuators = [d.actuator for d in driven]
-    if any(_is_position_servo(model, a) for a in actuators):
+    if any(is_position_servo(model, a) for a in actuators):
         lines.append("  seed_ctrl_from_qpos: true")
     gripper_lines = [line for d in driven for line in _gripper_lines(model, d)]
     notes = [line for line in gripper_lines if line.startswith("  #")]
@@ -416,7 +387,7 @@ def _sim_lines(
     lines += notes
     if entries:
         lines += ["  grippers:", *entries]
-    if all(_is_motor(model, a) for a in actuators):
+    if all(is_motor(model, a) for a in actuators):
         lines.append(
             f"  control: {{mode: torque_pd, kp: {_num(PLACEHOLDER_KP)}, "
             f"kd: {_num(PLACEHOLDER_KD)}}}{_REVIEW} gains are placeholders"

@@ -26,6 +26,7 @@ from openral_core.errors import OpenralError
 from openral_core.models import DeployScene, DepthSensor, RgbSensor, RobotDescription
 from openral_core.registry import manifest_path
 from openral_core.tables import hal_wiring
+from openral_hal.mjcf_model import ctrl_limits
 from openral_hal.mjcf_uri import resolve_mjcf_uri
 from openral_hal.mujoco_arm import seed_position_servos
 
@@ -69,6 +70,7 @@ class NativeScene:
         control_hz = options.control_freq_hz if options and options.control_freq_hz else 20.0
         self.substeps = max(1, round(1.0 / (control_hz * self.model.opt.timestep)))
         self.horizon = options.horizon if options and options.horizon else None
+        self._ctrl_low, self._ctrl_high = ctrl_limits(self.model)
         self._pd = _pd_law(robot, self.model) if wiring.control_mode == "torque_pd" else None
         self._renderer: mujoco.Renderer | None = None
         self._steps = 0
@@ -108,10 +110,8 @@ class NativeScene:
         values = np.asarray(action, dtype=np.float64)
         if values.shape != (self.action_dim,):
             raise SceneError(f"action has shape {values.shape}; expected ({self.action_dim},)")
-        low, high = self.model.actuator_ctrlrange.T
-        limited = self.model.actuator_ctrllimited.astype(bool)
         if self._pd is None:
-            self.data.ctrl[:] = np.where(limited, np.clip(values, low, high), values)
+            self.data.ctrl[:] = np.clip(values, self._ctrl_low, self._ctrl_high)
             mujoco.mj_step(self.model, self.data, nstep=self.substeps)
         else:
             for _ in range(self.substeps):
@@ -216,9 +216,12 @@ def _compose(
     reach = _reach(child)  # before attach: an attached spec must not be compiled again
     _add_mounted_cameras(child, robot, cameras)
     spec.attach(child, frame=frame, prefix="")
-    for sensor_name, camera in cameras.items():
-        if camera == f"openral_{sensor_name}" and not _has_mount(robot, sensor_name):
-            _add_fixed_camera(spec, camera, base, yaw, reach, _fovy(robot, sensor_name))
+    for sensor in robot.sensors:  # neither a model camera nor mounted: a fixed camera
+        if not isinstance(sensor, RgbSensor | DepthSensor) or sensor.name not in cameras:
+            continue
+        if sensor.camera is None and sensor.mount_body is None:
+            fovy = sensor.fovy_deg or 45.0
+            _add_fixed_camera(spec, cameras[sensor.name], base, yaw, reach, fovy)
     try:
         return spec.compile()
     except ValueError as error:
@@ -315,25 +318,11 @@ def _reach(child: mujoco.MjSpec) -> float:
     return max(0.3, float(np.linalg.norm(points, axis=1).max()) if len(points) else 0.3)
 
 
-def _has_mount(robot: RobotDescription, sensor_name: str) -> bool:
-    return any(
-        getattr(s, "mount_body", None) is not None for s in robot.sensors if s.name == sensor_name
-    )
-
-
-def _fovy(robot: RobotDescription, sensor_name: str) -> float:
-    for sensor in robot.sensors:
-        if sensor.name == sensor_name and getattr(sensor, "fovy_deg", None):
-            return float(sensor.fovy_deg)  # type: ignore[union-attr]
-    return 45.0
-
-
 def _pd_law(robot: RobotDescription, model: mujoco.MjModel) -> Any:
     """ctrl = clip(kp * (target - q) - kd * qdot) for each actuator on a manifest joint."""
     wiring = hal_wiring(robot)
     assert wiring is not None
     canonical = {j.sim_joint_name or j.name: j.name for j in robot.joints}
-    actuators = np.arange(model.nu)
     joints = model.actuator_trnid[:, 0]
     qpos_addr = model.jnt_qposadr[joints]
     dof_addr = model.jnt_dofadr[joints]
@@ -343,7 +332,7 @@ def _pd_law(robot: RobotDescription, model: mujoco.MjModel) -> Any:
     ]
     kp = np.array([wiring.kp.get(n, 0.0) for n in names])
     kd = np.array([wiring.kd.get(n, 0.0) for n in names])
-    low, high = model.actuator_ctrlrange[actuators].T
+    low, high = ctrl_limits(model)
 
     def law(data: mujoco.MjData, targets: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         torque = kp * (targets - data.qpos[qpos_addr]) - kd * data.qvel[dof_addr]

@@ -159,12 +159,7 @@ def validate(
 
     Exits 1 when any file is invalid, 2 when nothing was named.
     """
-    files = [_manifest_file(t) for t in targets or []]
-    if all_robots:
-        files += [manifest_path(robot_id) for robot_id in robot_ids()]
-    if not files:
-        err.print("name robot ids or files to validate, or pass --all")
-        raise typer.Exit(2)
+    files = _named_manifests(targets, all_robots, "validate")
     failures = 0
     for file in files:
         try:
@@ -179,6 +174,17 @@ def validate(
     if failures:
         err.print(f"{failures} of {len(files)} file(s) invalid")
         raise typer.Exit(1)
+
+
+def _named_manifests(targets: list[str] | None, all_robots: bool, verb: str) -> list[Path]:
+    """Manifest files named on the command line (plus every robot with --all); exit 2 if none."""
+    files = [_manifest_file(t) for t in targets or []]
+    if all_robots:
+        files += [manifest_path(robot_id) for robot_id in robot_ids()]
+    if not files:
+        err.print(f"name robot ids or files to {verb}, or pass --all")
+        raise typer.Exit(2)
+    return files
 
 
 def _manifest_file(target: str) -> Path:
@@ -211,12 +217,7 @@ def check(
     from openral_hal.mjcf_uri import resolve_mjcf_uri
     from openral_hal.model_check import check_robot
 
-    files = [_manifest_file(t) for t in targets or []]
-    if all_robots:
-        files += [manifest_path(robot_id) for robot_id in robot_ids()]
-    if not files:
-        err.print("name robot ids or files to check, or pass --all")
-        raise typer.Exit(2)
+    files = _named_manifests(targets, all_robots, "check")
     summary = Table(title="robot check")
     for column in ("robot", "model", "checks", "failed"):
         summary.add_column(column)

@@ -58,6 +58,7 @@ def run(
         obs = env.reset(scene.seed)
         handles = env.mujoco_handles()
         hold = np.array(handles[1].ctrl) if handles else np.zeros(env.action_dim or 0)
+        addresses = _joint_addresses(handles, joint_names)
         if out_dir:
             out_dir.mkdir(parents=True, exist_ok=True)
         with Progress(console=out, transient=True) as progress:
@@ -66,7 +67,7 @@ def run(
                 phase = math.sin(2 * math.pi * step / max(steps, 20))
                 action = hold + (SWAY_RAD * phase if motion == "sway" else 0.0)
                 obs = env.step(action).obs
-                records.append(_joint_record(step, handles, joint_names))
+                records.append(_joint_record(step, handles, addresses))
                 if out_dir:
                     for camera, image in obs["images"].items():
                         write_png(out_dir / f"{camera}_{step:04d}.png", image)
@@ -88,19 +89,25 @@ def run(
     out.print(table)
 
 
+def _joint_addresses(
+    handles: tuple[mujoco.MjModel, mujoco.MjData] | None, joint_names: list[str]
+) -> dict[str, int]:
+    """qpos address of every manifest (MJCF) joint name present in the scene's model."""
+    if handles is None:
+        return {}
+    model = handles[0]
+    ids = {name: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) for name in joint_names}
+    return {name: int(model.jnt_qposadr[jid]) for name, jid in ids.items() if jid >= 0}
+
+
 def _joint_record(
-    step: int, handles: tuple[mujoco.MjModel, mujoco.MjData] | None, joint_names: list[str]
+    step: int, handles: tuple[mujoco.MjModel, mujoco.MjData] | None, addresses: dict[str, int]
 ) -> dict[str, object]:
     """Joint positions by manifest (MJCF) name at one step."""
     record: dict[str, object] = {"step": step}
     if handles is None:
         return record
-    model, data = handles
-    positions = {}
-    for name in joint_names:
-        jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
-        if jid >= 0:
-            positions[name] = float(data.qpos[model.jnt_qposadr[jid]])
+    data = handles[1]
     record["time"] = float(data.time)
-    record["positions"] = positions
+    record["positions"] = {name: float(data.qpos[addr]) for name, addr in addresses.items()}
     return record
