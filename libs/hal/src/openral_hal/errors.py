@@ -23,3 +23,7 @@ class ActionRejected(HalError):
 
 class SimulationDiverged(HalError):
     """MuJoCo met a NaN/Inf acceleration and reset the simulation to its initial state."""
+
+
+class ConfigurationError(HalError):
+    """A HAL cannot be built or connected as configured (mode, scene, driver or action width)."""

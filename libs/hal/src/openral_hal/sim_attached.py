@@ -1,0 +1,298 @@
+"""SimAttachedHAL: a HAL that drives a scene it does not own the physics of.
+
+Under ``deploy sim`` with a scene file, the scene backend (a :class:`SimRollout`) owns
+physics and pixels; this HAL is the robot-side view of it. Joint state is read from the
+scene's MuJoCo data by joint name (or from ``obs["joint_positions"]`` for a non-MuJoCo
+backend), camera frames from the last observation, and every action is one ``env.step``.
+Between skills the sensor bridge keeps the scene alive with :meth:`SimAttachedHAL.idle_step`,
+which exists only on this simulated HAL.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from typing import Any
+
+import mujoco
+import numpy as np
+import numpy.typing as npt
+from openral_core.models import RgbSensor, RobotDescription
+from openral_core.tables import joint_name_map
+from openral_sim.rollout import Observation, SimRollout, StepResult
+
+from openral_hal.action import validated_action
+from openral_hal.errors import ConfigurationError, EStopLatched, HalError, NotConnected
+from openral_hal.name_resolution import resolve_joint_names
+from openral_hal.state import FloatArray, JointStateSample
+
+_log = logging.getLogger(__name__)
+_SCALAR_JOINTS = (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
+
+
+class SimAttachedHAL:
+    """A robot inside a simulated scene; one action is one step of the scene.
+
+    The action is the scene's own action (``action_dim`` values, whatever its controller
+    takes), not necessarily one value per manifest joint.
+    """
+
+    is_real = False
+    """A simulation, never real hardware."""
+
+    def __init__(
+        self,
+        env: SimRollout,
+        description: RobotDescription,
+        *,
+        env_reset_seed: int | None = 0,
+        env_action_dim: int | None = None,
+    ) -> None:
+        """Attach to ``env``; nothing is reset until :meth:`connect`.
+
+        Args:
+            env: The scene backend.
+            description: The robot's manifest (joint order, names and sensors).
+            env_reset_seed: Seed of every episode reset (None: the backend's own choice).
+            env_action_dim: Action width, for a backend that does not report ``action_dim``.
+        """
+        self.env = env
+        self.description = description
+        self.env_reset_seed = env_reset_seed
+        self.env_action_dim = env_action_dim
+        self.joint_names = tuple(j.name for j in description.joints)
+        self.last_action_ns = 0
+        """``time.monotonic_ns()`` of the last :meth:`send_action` call (0: never)."""
+        self._mjcf_names = tuple(joint_name_map(description)[n] for n in self.joint_names)
+        self._rgb = tuple(s.name for s in description.sensors if isinstance(s, RgbSensor))
+        self._action_dim: int | None = None
+        self._action_names: tuple[str, ...] = ()
+        self._obs: Observation | None = None
+        self._last_env_action: FloatArray = np.zeros(0)
+        self._episode_done = False
+        self._estopped = False
+        self._closed = False
+        self._addr_model: mujoco.MjModel | None = None
+        self._qpos = self._dof = np.zeros(0, dtype=np.intp)
+        self._warned_width = False
+
+    # -- lifecycle -------------------------------------------------------------------------
+
+    @property
+    def connected(self) -> bool:
+        """True between :meth:`connect` and :meth:`disconnect`."""
+        return self._obs is not None
+
+    @property
+    def action_dim(self) -> int:
+        """Width of the scene's action."""
+        if self._action_dim is None:
+            raise NotConnected("the HAL is not connected; call connect() first")
+        return self._action_dim
+
+    def connect(self) -> None:
+        """Resolve the action width, reset the scene and find every manifest joint in it.
+
+        Raises:
+            ConfigurationError: The action width is unknown (the backend reports none and
+                no ``env_action_dim`` was given) or not positive.
+            HalError: A manifest joint is missing from the scene's model.
+        """
+        if self._closed:
+            raise HalError("the scene was closed by disconnect(); build a new HAL")
+        width = self.env_action_dim if self.env_action_dim is not None else self.env.action_dim
+        if width is None:
+            raise ConfigurationError(
+                f"{type(self.env).__name__} does not report action_dim and no env_action_dim "
+                "was given; cannot tell how wide an action must be"
+            )
+        if width < 1:
+            raise ConfigurationError(f"{type(self.env).__name__}: action width {width} < 1")
+        obs = self.env.reset(seed=self.env_reset_seed)
+        handles = self.env.mujoco_handles()
+        if handles is not None:
+            self._resolve_addresses(handles[0])
+        self._action_dim = width
+        names = self.joint_names if width == len(self.joint_names) else ()
+        self._action_names = names or tuple(f"env_action[{i}]" for i in range(width))
+        self._last_env_action = np.zeros(width)
+        self._episode_done = False
+        self._obs = obs
+
+    def disconnect(self) -> None:
+        """Close the scene (renderers and all); the HAL cannot be connected again."""
+        if not self._closed:
+            self.env.close()
+            self._closed = True
+        self._obs = None
+        self._action_dim = None
+
+    def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
+        """The scene's live MuJoCo (model, data), or None for a non-MuJoCo backend."""
+        return self.env.mujoco_handles()
+
+    # -- state and sensors -----------------------------------------------------------------
+
+    def read_state(self) -> JointStateSample:
+        """Every manifest joint, in manifest order, under its canonical name.
+
+        A MuJoCo scene gives positions, velocities and actuator efforts; another backend
+        gives positions from ``obs["joint_positions"]`` (zeros when absent) and zero
+        velocities and efforts.
+        """
+        obs = self._require_obs()
+        handles = self.env.mujoco_handles()
+        count = len(self.joint_names)
+        if handles is None:
+            zeros = np.zeros(count)
+            return JointStateSample(
+                names=self.joint_names,
+                positions=self._positions_from_obs(obs),
+                velocities=zeros,
+                efforts=zeros.copy(),
+                stamp_ns=time.monotonic_ns(),
+            )
+        model, data = handles
+        if model is not self._addr_model:  # a backend rebuilt its model on reset
+            self._resolve_addresses(model)
+        return JointStateSample(
+            names=self.joint_names,
+            positions=data.qpos[self._qpos].astype(np.float64),
+            velocities=data.qvel[self._dof].astype(np.float64),
+            efforts=data.qfrc_actuator[self._dof].astype(np.float64),
+            stamp_ns=time.monotonic_ns(),
+            sim_time_s=float(data.time),
+        )
+
+    def read_images(self) -> dict[str, npt.NDArray[np.uint8]]:
+        """Last frame of each manifest RGB sensor the scene renders, by sensor name."""
+        images = self._require_obs().get("images") or {}
+        return {name: images[name] for name in self._rgb if name in images}
+
+    # -- commands --------------------------------------------------------------------------
+
+    @property
+    def episode_done(self) -> bool:
+        """True when the last step ended the episode; the next step resets first."""
+        return self._episode_done
+
+    @property
+    def last_env_action(self) -> FloatArray:
+        """A copy of the last commanded scene action (zeros before the first)."""
+        return self._last_env_action.copy()
+
+    def send_action(self, action: object) -> None:
+        """Step the scene with ``action`` (``action_dim`` values).
+
+        The call is time-stamped before anything else, so even a rejected action keeps the
+        idle stepper off the scene.
+
+        Raises:
+            ActionRejected: Wrong type, width, or a non-finite value; nothing is changed.
+            EStopLatched: The E-stop is latched.
+        """
+        self.last_action_ns = time.monotonic_ns()
+        self._require_obs()
+        values = validated_action(action, self._action_names)
+        if self._estopped:
+            raise EStopLatched("E-stop is latched; call release_estop() before sending actions")
+        self._reset_if_done()
+        self._last_env_action = self.merge(values)
+        self._step(self._last_env_action.copy())
+
+    def merge(self, action: FloatArray) -> FloatArray:
+        """The scene action to step, from a validated ``action`` and ``_last_env_action``.
+
+        Here the action already is the whole scene action; a HAL that commands only some
+        slots of a wider action overrides this to keep the others from the last one.
+        """
+        return np.array(action, dtype=np.float64)
+
+    def idle_step(self) -> bool:
+        """Advance the scene one step with a zero action while no skill is commanding.
+
+        Keeps physics and cameras live between skills. The commanded action and
+        :attr:`last_action_ns` are left as they were. A zero action holds still for
+        velocity and delta controllers; a position-controlled scene drifts towards zero.
+
+        Returns:
+            True when the scene stepped; False (nothing done) while E-stopped.
+        """
+        self._require_obs()
+        if self._estopped:
+            return False
+        self._reset_if_done()
+        self._step(np.zeros(self.action_dim, dtype=np.float32))
+        return True
+
+    # -- E-stop ----------------------------------------------------------------------------
+
+    @property
+    def estopped(self) -> bool:
+        """True while the E-stop is latched."""
+        return self._estopped
+
+    def estop(self) -> None:
+        """Latch the E-stop: actions are refused and the scene is not idle-stepped."""
+        self._estopped = True
+
+    def release_estop(self) -> None:
+        """Unlatch the E-stop."""
+        self._estopped = False
+
+    # -- internals -------------------------------------------------------------------------
+
+    def _require_obs(self) -> Observation:
+        if self._obs is None:
+            raise NotConnected("the HAL is not connected; call connect() first")
+        return self._obs
+
+    def _reset_if_done(self) -> None:
+        if self._episode_done:
+            self._obs = self.env.reset(seed=self.env_reset_seed)
+            self._episode_done = False
+
+    def _step(self, action: npt.NDArray[Any]) -> StepResult:
+        result = self.env.step(action)
+        self._obs = result.obs
+        self._episode_done = bool(result.terminated or result.truncated)
+        return result
+
+    def _resolve_addresses(self, model: mujoco.MjModel) -> None:
+        joint = mujoco.mjtObj.mjOBJ_JOINT
+        available = [mujoco.mj_id2name(model, joint, i) for i in range(model.njnt)]
+        resolved = resolve_joint_names(self._mjcf_names, [n for n in available if n])
+        ids = [mujoco.mj_name2id(model, joint, resolved[n]) for n in self._mjcf_names]
+        bad = [
+            resolved[n]
+            for n, i in zip(self._mjcf_names, ids, strict=True)
+            if model.jnt_type[i] not in _SCALAR_JOINTS
+        ]
+        if bad:
+            raise HalError(
+                f"scene joints {', '.join(bad)} are not hinge or slide joints; a manifest "
+                "joint must map to a one-value joint"
+            )
+        self._qpos = np.array([model.jnt_qposadr[i] for i in ids], dtype=np.intp)
+        self._dof = np.array([model.jnt_dofadr[i] for i in ids], dtype=np.intp)
+        self._addr_model = model
+
+    def _positions_from_obs(self, obs: Observation) -> FloatArray:
+        count = len(self.joint_names)
+        raw = obs.get("joint_positions")
+        if raw is None:
+            return np.zeros(count)
+        values = np.asarray(raw, dtype=np.float64).ravel()
+        if values.size != count:
+            if not self._warned_width:
+                _log.warning(
+                    "%s reports %d joint positions but the manifest of %s has %d joints; "
+                    "padding with zeros or truncating",
+                    type(self.env).__name__,
+                    values.size,
+                    self.description.name,
+                    count,
+                )
+                self._warned_width = True
+            values = np.concatenate([values, np.zeros(max(0, count - values.size))])[:count]
+        return values

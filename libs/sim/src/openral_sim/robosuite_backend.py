@@ -1,0 +1,282 @@
+"""The robosuite scene backend: a robosuite environment as a SimRollout.
+
+A deploy scene with ``scene.backend: robosuite`` maps onto ``robosuite.make`` like this:
+
+- **environment**: ``scene.assets`` names the robosuite environment exactly (``Lift``,
+  ``PickPlaceCan``, ...). When the file leaves ``assets`` out, ``scene.id`` is the environment
+  name written in snake case (``lift`` → ``Lift``, ``pick_place_can`` → ``PickPlaceCan``): the
+  schema keeps ids lower case, so the id is matched against robosuite's environments ignoring
+  case and underscores.
+- **robot**: ``robot_id`` through :data:`ROBOSUITE_ROBOTS` (``franka_panda`` → ``Panda``).
+- **cameras**: ``scene.cameras`` through :data:`ROBOSUITE_CAMERAS` (``wrist`` →
+  ``robot0_eye_in_hand``); any other name is passed to robosuite unchanged.
+- **options**: ``control_freq_hz``, ``horizon`` (robosuite's own default of 1000 steps when
+  left out) and ``controller`` (a composite controller name such as ``BASIC``; the robot's
+  default composite controller when left out). ``seed`` seeds object placement and
+  initialisation noise.
+
+The action is whatever the robosuite controller takes (``env.action_dim`` values; for the
+Panda's default controller: a 6-D OSC pose delta and one gripper value, each in [-1, 1]).
+Images come out top row first (robosuite renders them upside down). ``mujoco_handles`` gives
+the environment's raw ``mujoco.MjModel`` / ``MjData``; resets keep them (``hard_reset`` is off),
+so a HAL attached once stays attached.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from typing import Any, cast
+
+os.environ.setdefault("MUJOCO_GL", "egl")  # robosuite picks its GL backend on import
+
+import mujoco
+import numpy as np
+import numpy.typing as npt
+import robosuite
+from openral_core.errors import OpenralError
+from openral_core.models import DeployScene
+
+from openral_sim.rollout import Observation, StepResult
+
+ROBOSUITE_ROBOTS: dict[str, str] = {"franka_panda": "Panda", "ur5e": "UR5e"}
+"""openral robot id → robosuite robot name."""
+
+ROBOSUITE_CAMERAS: dict[str, str] = {"agentview": "agentview", "wrist": "robot0_eye_in_hand"}
+"""openral camera name → robosuite camera name; names not listed pass through unchanged."""
+
+_NATIVE_ONLY_OPTIONS = ("table_height_m", "objects")
+
+
+class RobosuiteError(OpenralError):
+    """A scene the robosuite backend cannot build."""
+
+
+def robosuite_camera(name: str) -> str:
+    """The robosuite camera an openral camera name renders."""
+    return ROBOSUITE_CAMERAS.get(name, name)
+
+
+class RobosuiteRollout:
+    """A robosuite environment with offscreen cameras (a SimRollout)."""
+
+    def __init__(
+        self,
+        env_name: str,
+        robot: str,
+        camera_names: Sequence[str],
+        width: int,
+        height: int,
+        control_freq_hz: float = 20.0,
+        horizon: int | None = None,
+        controller: str | None = None,
+        seed: int = 0,
+    ) -> None:
+        """Build the environment.
+
+        Args:
+            env_name: robosuite environment name, such as ``Lift``.
+            robot: robosuite robot name, such as ``Panda``.
+            camera_names: openral camera names (mapped by :data:`ROBOSUITE_CAMERAS`).
+            width: Image width [px] of every camera.
+            height: Image height [px] of every camera.
+            control_freq_hz: Actions per simulated second.
+            horizon: Steps per episode; robosuite's default (1000) when None.
+            controller: Composite controller name (``BASIC``, ...) or a JSON config path;
+                the robot's default composite controller when None.
+            seed: Seed of object placement and initialisation noise.
+
+        Raises:
+            RobosuiteError: Unknown environment, robot, controller or camera.
+        """
+        if env_name not in robosuite.ALL_ENVIRONMENTS:
+            raise RobosuiteError(
+                f"unknown robosuite environment {env_name!r}; "
+                f"available: {', '.join(sorted(robosuite.ALL_ENVIRONMENTS))}"
+            )
+        if robot not in robosuite.ALL_ROBOTS:
+            raise RobosuiteError(
+                f"unknown robosuite robot {robot!r}; "
+                f"available: {', '.join(sorted(robosuite.ALL_ROBOTS))}"
+            )
+        if (
+            controller is not None
+            and not controller.endswith(".json")
+            and controller not in robosuite.ALL_COMPOSITE_CONTROLLERS
+        ):
+            raise RobosuiteError(
+                f"unknown robosuite composite controller {controller!r}; "
+                f"available: {', '.join(sorted(robosuite.ALL_COMPOSITE_CONTROLLERS))}"
+            )
+        self._names = tuple(camera_names)
+        self._cameras = {name: robosuite_camera(name) for name in self._names}
+        kwargs: dict[str, Any] = {}
+        if horizon is not None:
+            kwargs["horizon"] = horizon
+        if controller is not None:
+            kwargs["controller_configs"] = robosuite.load_composite_controller_config(
+                controller=controller, robot=robot
+            )
+        try:
+            self.env: Any = robosuite.make(
+                env_name,
+                robots=robot,
+                has_renderer=False,
+                has_offscreen_renderer=bool(self._names),
+                use_camera_obs=bool(self._names),
+                camera_names=list(self._cameras.values()) or "agentview",
+                camera_heights=height,
+                camera_widths=width,
+                control_freq=control_freq_hz,
+                ignore_done=False,
+                hard_reset=False,  # keep one MjModel/MjData and render context for life
+                seed=seed,
+                **kwargs,
+            )
+        except (AssertionError, ValueError, KeyError) as error:
+            # robosuite reports e.g. a camera missing from the model this way
+            raise RobosuiteError(
+                f"robosuite could not build {env_name!r} with {robot!r} and cameras "
+                f"{list(self._cameras.values())}: {error!r}"
+            ) from error
+        self._flip = robosuite.macros.IMAGE_CONVENTION == "opengl"
+        self._last: Observation | None = None
+
+    # -- SimRollout ------------------------------------------------------------------------
+
+    @property
+    def action_dim(self) -> int:
+        """Width of the controller's action (``env.action_dim``)."""
+        return int(self.env.action_dim)
+
+    @property
+    def action_limits(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """Lower and upper bound of every action value (``env.action_spec``)."""
+        low, high = self.env.action_spec
+        return np.asarray(low, dtype=np.float64), np.asarray(high, dtype=np.float64)
+
+    @property
+    def camera_names(self) -> tuple[str, ...]:
+        """openral camera names rendered into ``obs["images"]``."""
+        return self._names
+
+    def reset(self, seed: int | None = None) -> Observation:
+        """New episode; ``seed`` reseeds object placement and initialisation noise."""
+        if seed is not None:
+            # the env's generator is shared with its placement sampler: reseed it in place
+            rng: np.random.Generator = self.env.rng
+            rng.bit_generator.state = np.random.default_rng(seed).bit_generator.state
+        self._make_current()
+        return self._observe(self.env.reset())
+
+    def step(self, action: npt.NDArray[np.floating[Any]]) -> StepResult:
+        """Apply ``action`` (``action_dim`` values) for one control period.
+
+        The episode ends at the horizon (``truncated``) or when the task itself says so
+        (``terminated``, e.g. Wipe on a collision).
+        """
+        values = np.asarray(action, dtype=np.float64)
+        if values.shape != (self.action_dim,):
+            raise RobosuiteError(f"action has shape {values.shape}; expected ({self.action_dim},)")
+        self._make_current()
+        raw, reward, done, info = self.env.step(values)
+        at_horizon = bool(done) and int(self.env.timestep) >= int(self.env.horizon)
+        return StepResult(
+            obs=self._observe(raw),
+            reward=float(reward),
+            terminated=bool(done) and not at_horizon,
+            truncated=at_horizon,
+            info={**info, "steps": int(self.env.timestep)},
+        )
+
+    def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData]:
+        """The environment's raw MuJoCo model and data (not robosuite's wrappers)."""
+        sim = self.env.sim
+        return cast(mujoco.MjModel, sim.model._model), cast(mujoco.MjData, sim.data._data)
+
+    def close(self) -> None:
+        """Free the simulation and its render context."""
+        if getattr(self.env, "sim", None) is not None:
+            self.env.close()
+
+    # -- internals -------------------------------------------------------------------------
+
+    def _make_current(self) -> None:
+        """robosuite renders into whichever GL context is current; make it ours, so several
+        rollouts in one process do not draw into each other's context."""
+        context = getattr(self.env.sim, "_render_context_offscreen", None)
+        if context is not None:
+            context.gl_ctx.make_current()
+
+    def _observe(self, raw: dict[str, Any]) -> Observation:
+        images: dict[str, npt.NDArray[np.uint8]] = {}
+        for name, camera in self._cameras.items():
+            image = np.asarray(raw[f"{camera}_image"], dtype=np.uint8)
+            images[name] = np.ascontiguousarray(image[::-1] if self._flip else image)
+        state = {
+            key: np.asarray(value)
+            for key, value in raw.items()
+            if not key.endswith(("_image", "_depth", "_segmentation"))
+        }
+        obs: Observation = {
+            "images": images,
+            "time": float(self.env.sim.data.time),
+            "robosuite": state,
+        }
+        if "robot0_joint_pos" in state:
+            obs["joint_positions"] = state["robot0_joint_pos"].copy()
+        return obs
+
+
+def robosuite_env_name(scene: DeployScene) -> str:
+    """The robosuite environment a scene names (see the module docstring)."""
+    spec = scene.scene
+    if "assets" in spec.model_fields_set:
+        return spec.assets
+    wanted = spec.id.replace("_", "").lower()
+    for name in robosuite.ALL_ENVIRONMENTS:
+        if name.lower() == wanted:
+            return str(name)
+    raise RobosuiteError(
+        f"scene.id {spec.id!r} names no robosuite environment and scene.assets is not set; "
+        f"set scene.assets to one of: {', '.join(sorted(robosuite.ALL_ENVIRONMENTS))}"
+    )
+
+
+def build_robosuite_rollout(scene: DeployScene) -> RobosuiteRollout:
+    """The robosuite environment a deploy scene describes.
+
+    Raises:
+        RobosuiteError: No or unsupported robot, unknown environment, or an option that
+            belongs to another backend.
+    """
+    robot_id = scene.robot_id
+    if robot_id is None:
+        raise RobosuiteError("robot_id: the scene names no robot")
+    robot = ROBOSUITE_ROBOTS.get(robot_id)
+    if robot is None:
+        raise RobosuiteError(
+            f"robot_id {robot_id!r} has no robosuite model; the robosuite backend supports: "
+            f"{', '.join(sorted(ROBOSUITE_ROBOTS))}"
+        )
+    options = scene.scene.options
+    if options is not None:
+        foreign = [key for key in _NATIVE_ONLY_OPTIONS if getattr(options, key) is not None]
+        if foreign:
+            raise RobosuiteError(
+                f"scene.options: {', '.join(foreign)} apply to the native backend only"
+            )
+    pose = scene.base_pose
+    if pose is not None and (any(pose.position_m) or pose.yaw_deg):
+        raise RobosuiteError("base_pose: robosuite environments place the robot themselves")
+    return RobosuiteRollout(
+        env_name=robosuite_env_name(scene),
+        robot=robot,
+        camera_names=scene.scene.cameras,
+        width=scene.scene.observation.width,
+        height=scene.scene.observation.height,
+        control_freq_hz=options.control_freq_hz if options else 20.0,
+        horizon=options.horizon if options else None,
+        controller=options.controller if options else None,
+        seed=scene.seed,
+    )

@@ -1,0 +1,191 @@
+"""The robosuite backend: Lift with the Panda and the UR5e, two cameras, built from scene files."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterator
+from pathlib import Path
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import mujoco
+import numpy as np
+import pytest
+
+pytest.importorskip("robosuite")
+
+from openral_core.errors import OpenralError
+from openral_core.loader import load_scene
+from openral_sim.robosuite_backend import (
+    ROBOSUITE_ROBOTS,
+    RobosuiteError,
+    RobosuiteRollout,
+    build_robosuite_rollout,
+)
+from openral_sim.rollout import SimRollout
+from openral_sim.scene import build_sim_env_from_yaml
+
+from tests.conftest import REPO
+
+SIZE = 64
+HORIZON = 5
+# The Panda scene names the environment in `assets`; the UR5e scene only by its id.
+SCENES = {
+    "franka_panda": "id: lift_panda\n  assets: Lift",
+    "ur5e": "id: lift",
+}
+
+
+def scene_text(robot_id: str, scene: str, options: str = f"horizon: {HORIZON}") -> str:
+    return f"""schema_version: "0.1"
+robot_id: {robot_id}
+seed: 3
+scene:
+  {scene}
+  backend: robosuite
+  observation: {{width: {SIZE}, height: {SIZE}}}
+  cameras: [agentview, wrist]
+  options: {{control_freq_hz: 20.0, {options}}}
+"""
+
+
+def write_scene(folder: Path, robot_id: str, scene: str, options: str | None = None) -> Path:
+    file = folder / f"{robot_id}.yaml"
+    text = scene_text(robot_id, scene) if options is None else scene_text(robot_id, scene, options)
+    file.write_text(text)
+    return file
+
+
+@pytest.fixture(scope="module")
+def rollouts(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, RobosuiteRollout]]:
+    """Both rollouts stay alive together: each must still render into its own GL context."""
+    folder = tmp_path_factory.mktemp("scenes")
+    built: dict[str, RobosuiteRollout] = {}
+    try:
+        for robot_id, scene in SCENES.items():
+            rollout = build_sim_env_from_yaml(write_scene(folder, robot_id, scene))
+            assert isinstance(rollout, RobosuiteRollout)
+            built[robot_id] = rollout
+        yield built
+    finally:
+        for rollout in built.values():
+            rollout.close()
+
+
+@pytest.fixture(params=sorted(SCENES))
+def rollout(request: pytest.FixtureRequest, rollouts: dict[str, RobosuiteRollout]) -> SimRollout:
+    env = rollouts[request.param]
+    assert isinstance(env, SimRollout)
+    return env
+
+
+def test_reset_renders_both_cameras(rollout: RobosuiteRollout) -> None:
+    images = rollout.reset(0)["images"]
+    assert rollout.camera_names == ("agentview", "wrist")
+    assert set(images) == {"agentview", "wrist"}
+    for name, image in images.items():
+        assert image.dtype == np.uint8 and image.shape == (SIZE, SIZE, 3), name
+        assert image.std() > 0, f"{name} is blank"
+    assert not np.array_equal(images["agentview"], images["wrist"])
+
+
+def test_action_dim_is_the_controllers(rollout: RobosuiteRollout) -> None:
+    # default composite controllers: 6-D OSC pose + 1 gripper value for both arms
+    assert rollout.action_dim == rollout.env.action_dim == 7
+    low, high = rollout.action_limits
+    assert low.shape == high.shape == (7,)
+
+
+def test_random_steps_move_the_arm_and_the_picture(rollout: RobosuiteRollout) -> None:
+    first = rollout.reset(0)
+    model, data = rollout.mujoco_handles()
+    qpos = data.qpos.copy()
+    rng = np.random.default_rng(0)
+    for _ in range(3):
+        result = rollout.step(rng.uniform(-1.0, 1.0, rollout.action_dim))
+        assert not (result.terminated or result.truncated)
+    frame = result.obs["images"]["agentview"]
+    assert not np.array_equal(frame, first["images"]["agentview"])
+    assert not np.allclose(data.qpos, qpos)
+    assert result.obs["time"] == pytest.approx(3 / 20.0)
+    assert result.info["steps"] == 3
+    assert model.nq == data.qpos.size
+
+
+def test_same_seed_same_first_frame_and_handles_survive_reset(rollout: RobosuiteRollout) -> None:
+    first = rollout.reset(7)["images"]["agentview"]
+    handles = rollout.mujoco_handles()
+    rollout.step(np.ones(rollout.action_dim))
+    again = rollout.reset(7)["images"]["agentview"]
+    assert np.array_equal(first, again)
+    model, data = rollout.mujoco_handles()
+    assert model is handles[0] and data is handles[1]
+
+
+def test_horizon_truncates(rollout: RobosuiteRollout) -> None:
+    rollout.reset(0)
+    results = [rollout.step(np.zeros(rollout.action_dim)) for _ in range(HORIZON)]
+    assert [r.truncated for r in results] == [False] * (HORIZON - 1) + [True]
+    assert not any(r.terminated for r in results)
+
+
+def test_panda_handles_are_raw_mujoco(rollouts: dict[str, RobosuiteRollout]) -> None:
+    model, data = rollouts["franka_panda"].mujoco_handles()
+    assert isinstance(model, mujoco.MjModel) and isinstance(data, mujoco.MjData)
+    joints = [model.joint(i).name for i in range(model.njnt)]
+    assert joints[:7] == [f"robot0_joint{i}" for i in range(1, 8)]
+    obs = rollouts["franka_panda"].reset(0)
+    qpos = [data.qpos[model.joint(f"robot0_joint{i}").qposadr[0]] for i in range(1, 8)]
+    np.testing.assert_allclose(obs["joint_positions"], qpos)
+
+
+def test_frames_match_a_plain_mujoco_render(rollout: RobosuiteRollout) -> None:
+    """Each frame is what mujoco.Renderer draws of the same model and data (top row first),
+    also while another rollout and a foreign GL context are alive: robosuite draws into
+    whichever context is current, so the rollout must make its own current."""
+    model, data = rollout.mujoco_handles()
+    frames = rollout.reset(0)["images"]
+    cameras = {"agentview": "agentview", "wrist": "robot0_eye_in_hand"}
+    with mujoco.Renderer(model, SIZE, SIZE) as renderer:
+        for name, camera in cameras.items():
+            renderer.update_scene(data, camera=camera)
+            reference = renderer.render().astype(float)
+            # multisampling differs; an upside-down or foreign-context frame is off by > 60
+            assert np.abs(frames[name] - reference).mean() < 30, name
+        again = rollout.reset(0)["images"]  # the renderer's context is current now
+    for name in cameras:
+        assert np.array_equal(again[name], frames[name]), name
+
+
+def test_unknown_robot_names_the_supported_ones(tmp_path: Path) -> None:
+    scene = load_scene(write_scene(tmp_path, "so100", "id: lift"))
+    with pytest.raises(OpenralError, match="supports: franka_panda, ur5e"):
+        build_robosuite_rollout(scene)
+    assert set(ROBOSUITE_ROBOTS) == {"franka_panda", "ur5e"}
+
+
+@pytest.mark.parametrize(
+    ("scene", "options", "message"),
+    [
+        ("id: tabletop", "horizon: 5", "names no robosuite environment"),
+        ("id: lift", "table_height_m: 0.7", "table_height_m apply to the native backend"),
+        ("id: lift\n  assets: Lfit", "horizon: 5", "unknown robosuite environment 'Lfit'"),
+        ("id: lift", "controller: NOPE", "unknown robosuite composite controller 'NOPE'"),
+    ],
+)
+def test_scene_errors(tmp_path: Path, scene: str, options: str, message: str) -> None:
+    loaded = load_scene(write_scene(tmp_path, "franka_panda", scene, options))
+    with pytest.raises(RobosuiteError, match=message):
+        build_robosuite_rollout(loaded)
+
+
+def test_wrong_action_width_is_refused(rollouts: dict[str, RobosuiteRollout]) -> None:
+    env = rollouts["ur5e"]
+    env.reset(0)
+    with pytest.raises(RobosuiteError, match=r"expected \(7,\)"):
+        env.step(np.zeros(3))
+
+
+def test_nothing_lands_in_the_repository() -> None:
+    """robosuite keeps its macros and numba caches in site-packages, not in our tree."""
+    assert not list(REPO.glob("**/macros_private.py"))
