@@ -11,11 +11,10 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 import mujoco
 import numpy as np
 import pytest
-
-pytest.importorskip("robosuite")
-
+from openral_core import load_robot_by_id
 from openral_core.errors import OpenralError
 from openral_core.loader import load_scene
+from openral_hal.sim_attached import SimAttachedHAL
 from openral_sim.robosuite_backend import (
     ROBOSUITE_ROBOTS,
     RobosuiteError,
@@ -189,3 +188,21 @@ def test_wrong_action_width_is_refused(rollouts: dict[str, RobosuiteRollout]) ->
 def test_nothing_lands_in_the_repository() -> None:
     """robosuite keeps its macros and numba caches in site-packages, not in our tree."""
     assert not list(REPO.glob("**/macros_private.py"))
+
+
+def test_robosuite_and_native_scenes_give_the_same_joint_names() -> None:
+    """Both committed Panda scenes, attached through SimAttachedHAL, read the same joints."""
+    franka = load_robot_by_id("franka_panda")
+    scenes = REPO / "robots" / "franka_panda" / "scenes"
+    states = {}
+    for name in ("lift_robosuite.yaml", "tabletop.yaml"):
+        hal = SimAttachedHAL(build_sim_env_from_yaml(scenes / name), franka)
+        hal.connect()
+        try:
+            states[name] = hal.read_state()
+        finally:
+            hal.disconnect()
+    robosuite, native = states["lift_robosuite.yaml"], states["tabletop.yaml"]
+    assert robosuite.names == native.names == tuple(j.name for j in franka.joints)
+    for state in (robosuite, native):  # real joint angles, not zeros: the arm starts bent
+        assert np.isfinite(state.positions).all() and np.abs(state.positions).max() > 0.1

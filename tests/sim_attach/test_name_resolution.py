@@ -9,7 +9,7 @@ from openral_hal.errors import HalError
 from openral_hal.name_resolution import resolve_joint_names, strip_robot_prefix
 
 BASES = ("joint1", "joint2", "shoulder", "elbow", "wrist", "finger_joint1")
-PREFIXES = ("", "robot0_", "robot1_", "robot12_")
+PREFIXES = ("", "robot0_", "robot1_", "robot12_", "gripper0_right_", "gripper0_left_", "gripper1_")
 
 model_joints = st.lists(
     st.builds(lambda p, b: p + b, st.sampled_from(PREFIXES), st.sampled_from(BASES)),
@@ -68,3 +68,17 @@ def test_the_error_lists_a_few_available_names() -> None:
     message = str(error.value)
     assert "shoulder" in message and "elbow" in message
     assert "robot0_j0" in message and "robot0_j19" not in message and "12 more" in message
+
+
+@pytest.mark.parametrize(
+    ("name", "stripped"),
+    [
+        ("robot0_joint1", "joint1"),
+        ("gripper0_right_finger_joint1", "finger_joint1"),
+        ("gripper1_finger_joint2", "finger_joint2"),
+        ("robotic_joint", "robotic_joint"),  # no digits: not a robosuite prefix
+        ("joint_robot0_x", "joint_robot0_x"),  # only a leading prefix counts
+    ],
+)
+def test_robosuite_prefixes(name: str, stripped: str) -> None:
+    assert strip_robot_prefix(name) == stripped

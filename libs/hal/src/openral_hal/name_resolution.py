@@ -2,10 +2,11 @@
 
 The manifest names each joint as the robot's own MJCF does (``sim_joint_name``, else the
 canonical name). A native scene keeps those names; robosuite prefixes them per robot
-(``robot0_joint1``). Resolution takes an exact name first and falls back to the name with
-the ``robot<k>_`` prefix removed, but only where that fallback is unambiguous: a stripped
-name that two models' joints share (a bimanual ``robot0_``/``robot1_`` pair) or that equals
-another joint's exact name resolves to nothing, so a joint is never silently mis-wired.
+(``robot0_joint1``, and ``gripper0_right_finger_joint1`` for a gripper mounted on it).
+Resolution takes an exact name first and falls back to the name with that prefix removed,
+but only where that fallback is unambiguous: a stripped name that two models' joints share
+(a bimanual ``robot0_``/``robot1_`` pair) or that equals another joint's exact name
+resolves to nothing, so a joint is never silently mis-wired.
 """
 
 from __future__ import annotations
@@ -16,14 +17,15 @@ from collections.abc import Sequence
 
 from openral_hal.errors import HalError
 
-ROBOSUITE_PREFIX = re.compile(r"^robot\d+_")
-"""The per-robot prefix robosuite gives every joint of a robot."""
+ROBOSUITE_PREFIX = re.compile(r"^(?:robot\d+|gripper\d+(?:_(?:right|left))?)_")
+"""The prefixes robosuite gives the joints of robot ``k`` and of its grippers."""
 SHOWN_AVAILABLE = 8
 """How many model joint names an error message lists."""
 
 
 def strip_robot_prefix(name: str) -> str:
-    """``robot0_joint1`` → ``joint1``; names without the prefix are returned unchanged."""
+    """``robot0_joint1`` → ``joint1``, ``gripper0_right_finger_joint1`` → ``finger_joint1``;
+    names without such a prefix are returned unchanged."""
     return ROBOSUITE_PREFIX.sub("", name, count=1)
 
 

@@ -19,7 +19,7 @@ import numpy as np
 import numpy.typing as npt
 from openral_core.models import RgbSensor, RobotDescription
 from openral_core.tables import joint_name_map
-from openral_sim.rollout import Observation, SimRollout, StepResult
+from openral_sim.rollout import HoldingRollout, Observation, SimRollout, StepResult
 
 from openral_hal.action import validated_action
 from openral_hal.errors import ConfigurationError, EStopLatched, HalError, NotConnected
@@ -113,11 +113,31 @@ class SimAttachedHAL:
         if handles is not None:
             self._resolve_addresses(handles[0])
         self._action_dim = width
-        names = self.joint_names if width == len(self.joint_names) else ()
-        self._action_names = names or tuple(f"env_action[{i}]" for i in range(width))
+        self._action_names = self._slot_names(width)
         self._last_env_action = np.zeros(width)
         self._episode_done = False
         self._obs = obs
+
+    @property
+    def action_names(self) -> tuple[str, ...]:
+        """One name per action slot: the backend's, else the manifest joints when the widths
+        agree, else ``env_action[i]``."""
+        if self._action_dim is None:
+            raise NotConnected("the HAL is not connected; call connect() first")
+        return self._action_names
+
+    def hold_action(self) -> FloatArray:
+        """The action that keeps the robot still: the backend's hold, else zeros.
+
+        Zeros hold velocity and delta controllers; a position-controlled backend provides its
+        current targets instead (zeros would send every joint towards 0 rad).
+        """
+        width = self.action_dim
+        if isinstance(self.env, HoldingRollout):
+            hold = np.asarray(self.env.hold_action(), dtype=np.float64).ravel()
+            if hold.size == width:
+                return hold
+        return np.zeros(width)
 
     def disconnect(self) -> None:
         """Close the scene (renderers and all); the HAL cannot be connected again."""
@@ -209,11 +229,11 @@ class SimAttachedHAL:
         return np.array(action, dtype=np.float64)
 
     def idle_step(self) -> bool:
-        """Advance the scene one step with a zero action while no skill is commanding.
+        """Advance the scene one step with :meth:`hold_action` while no skill is commanding.
 
-        Keeps physics and cameras live between skills. The commanded action and
-        :attr:`last_action_ns` are left as they were. A zero action holds still for
-        velocity and delta controllers; a position-controlled scene drifts towards zero.
+        Keeps physics and cameras live between skills: a robot still moving towards its last
+        target gets there, objects settle, time advances. The commanded action and
+        :attr:`last_action_ns` are left as they were.
 
         Returns:
             True when the scene stepped; False (nothing done) while E-stopped.
@@ -222,7 +242,7 @@ class SimAttachedHAL:
         if self._estopped:
             return False
         self._reset_if_done()
-        self._step(np.zeros(self.action_dim, dtype=np.float32))
+        self._step(self.hold_action())
         return True
 
     # -- E-stop ----------------------------------------------------------------------------
@@ -276,6 +296,13 @@ class SimAttachedHAL:
         self._qpos = np.array([model.jnt_qposadr[i] for i in ids], dtype=np.intp)
         self._dof = np.array([model.jnt_dofadr[i] for i in ids], dtype=np.intp)
         self._addr_model = model
+
+    def _slot_names(self, width: int) -> tuple[str, ...]:
+        if isinstance(self.env, HoldingRollout) and len(self.env.action_names) == width:
+            return tuple(self.env.action_names)
+        if width == len(self.joint_names):
+            return self.joint_names
+        return tuple(f"env_action[{i}]" for i in range(width))
 
     def _positions_from_obs(self, obs: Observation) -> FloatArray:
         count = len(self.joint_names)

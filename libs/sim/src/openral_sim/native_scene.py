@@ -10,6 +10,8 @@ lists, and a camera for every manifest camera sensor the scene file names:
 
 The action is one control value per actuator of the robot model. For a ``torque_pd`` robot
 the values are position targets, turned into torques by the manifest's PD law every step.
+The hold action (what an idle scene is stepped with) is the current targets, so an idle
+robot stays where it was last sent.
 """
 
 from __future__ import annotations
@@ -72,6 +74,7 @@ class NativeScene:
         self.horizon = options.horizon if options and options.horizon else None
         self._ctrl_low, self._ctrl_high = ctrl_limits(self.model)
         self._pd = _pd_law(robot, self.model) if wiring.control_mode == "torque_pd" else None
+        self._targets = np.zeros(self.model.nu)
         self._renderer: mujoco.Renderer | None = None
         self._steps = 0
         self._rng = np.random.default_rng(scene.seed)
@@ -82,6 +85,19 @@ class NativeScene:
     def action_dim(self) -> int:
         """One value per actuator of the robot model."""
         return int(self.model.nu)
+
+    @property
+    def action_names(self) -> tuple[str, ...]:
+        """The actuator names of the model (``actuator[i]`` for an unnamed one)."""
+        names = (
+            mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, i)
+            for i in range(self.model.nu)
+        )
+        return tuple(name or f"actuator[{i}]" for i, name in enumerate(names))
+
+    def hold_action(self) -> npt.NDArray[np.float64]:
+        """The targets in force now (the start pose after a reset)."""
+        return self._targets.copy()
 
     @property
     def camera_names(self) -> tuple[str, ...]:
@@ -102,6 +118,7 @@ class NativeScene:
         if self._pd is not None:  # targets are joint positions: hold the current ones
             joints = self.model.actuator_trnid[:, 0]
             self.data.ctrl[:] = self.data.qpos[self.model.jnt_qposadr[joints]]
+        self._targets = self.data.ctrl.astype(np.float64)
         self._steps = 0
         return self._observe()
 
@@ -111,9 +128,11 @@ class NativeScene:
         if values.shape != (self.action_dim,):
             raise SceneError(f"action has shape {values.shape}; expected ({self.action_dim},)")
         if self._pd is None:
-            self.data.ctrl[:] = np.clip(values, self._ctrl_low, self._ctrl_high)
+            self._targets = np.clip(values, self._ctrl_low, self._ctrl_high)
+            self.data.ctrl[:] = self._targets
             mujoco.mj_step(self.model, self.data, nstep=self.substeps)
         else:
+            self._targets = values.copy()
             for _ in range(self.substeps):
                 self.data.ctrl[:] = self._pd(self.data, values)
                 mujoco.mj_step(self.model, self.data)

@@ -54,3 +54,22 @@ class SimRollout(Protocol):
     def close(self) -> None:
         """Release renderers and other resources."""
         ...
+
+
+@runtime_checkable
+class HoldingRollout(SimRollout, Protocol):
+    """A rollout that can say which action keeps its robot still, slot by slot.
+
+    A position-controlled scene holds with its current targets, not with zeros (which
+    would drive every joint towards 0 rad); a backend that does not implement this is
+    held with a zero action, the hold of velocity and delta controllers.
+    """
+
+    @property
+    def action_names(self) -> tuple[str, ...]:
+        """One name per action slot."""
+        ...
+
+    def hold_action(self) -> npt.NDArray[np.float64]:
+        """The action that keeps the robot where it is commanded to be now."""
+        ...

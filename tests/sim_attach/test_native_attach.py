@@ -1,0 +1,83 @@
+"""SimAttachedHAL on the real native scene: the project's default franka tabletop.
+
+The native scene is position-controlled, so its hold action is the targets in force; idle
+steps keep the robot where it was last sent (never towards 0 rad) while time and pictures
+go on.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+import numpy.typing as npt
+import pytest
+from openral_core import load_robot_by_id
+from openral_hal.factory import build_hal
+from openral_hal.sim_attached import SimAttachedHAL
+
+from tests.conftest import ROBOTS
+
+SCENE = ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml"
+
+
+@pytest.fixture
+def hal() -> Iterator[SimAttachedHAL]:
+    built = build_hal(load_robot_by_id("franka_panda"), mode="sim", sim_env_yaml=SCENE)
+    assert isinstance(built, SimAttachedHAL)
+    built.connect()
+    yield built
+    built.disconnect()
+
+
+def _changed(a: npt.NDArray[np.uint8], b: npt.NDArray[np.uint8]) -> float:
+    return float(np.abs(a.astype(int) - b.astype(int)).mean())
+
+
+def test_action_slots_are_the_scene_actuators(hal: SimAttachedHAL) -> None:
+    model, _ = hal.mujoco_handles() or (None, None)
+    assert model is not None
+    assert hal.action_dim == model.nu == len(hal.action_names)
+    assert len(set(hal.action_names)) == hal.action_dim
+
+
+def test_idle_holds_the_start_pose(hal: SimAttachedHAL) -> None:
+    start = hal.read_state()
+    hold = hal.hold_action()
+    for _ in range(40):  # two seconds of scene time
+        assert hal.idle_step()
+    later = hal.read_state()
+    assert later.sim_time_s is not None and start.sim_time_s is not None
+    assert later.sim_time_s == pytest.approx(start.sim_time_s + 2.0, abs=0.01)
+    arm = slice(0, 7)
+    np.testing.assert_allclose(later.positions[arm], start.positions[arm], atol=0.02)
+    assert np.abs(start.positions[arm]).max() > 0.5  # a bent pose, far from all-zeros
+    np.testing.assert_array_equal(hal.hold_action(), hold)
+
+
+def test_idle_finishes_the_last_move_and_the_frame_follows(hal: SimAttachedHAL) -> None:
+    target = hal.hold_action()
+    target[0] += 0.6  # swing the base joint
+    hal.send_action(target)
+    moved_once = hal.read_state().positions[0]
+    frames = [hal.read_images()["agentview"]]
+    for _ in range(30):
+        assert hal.idle_step()
+        frames.append(hal.read_images()["agentview"])
+    settled = hal.read_state().positions[0]
+    np.testing.assert_allclose(hal.hold_action(), target)  # idle holds the command
+    np.testing.assert_allclose(hal.last_env_action, target)
+    assert abs(settled - target[0]) < 0.05 < abs(moved_once - target[0])
+    assert _changed(frames[0], frames[10]) > 0.1, "idle steps did not advance the picture"
+
+
+def test_estop_freezes_the_scene(hal: SimAttachedHAL) -> None:
+    target = hal.hold_action()
+    target[0] -= 0.5
+    hal.send_action(target)  # still moving when the E-stop latches
+    hal.estop()
+    frame, state = hal.read_images()["wrist"], hal.read_state()
+    for _ in range(5):
+        assert not hal.idle_step()
+    np.testing.assert_array_equal(hal.read_images()["wrist"], frame)
+    np.testing.assert_array_equal(hal.read_state().positions, state.positions)
