@@ -1,0 +1,187 @@
+"""rclpy plumbing shared by the openral nodes and commands: a context and a spinning executor.
+
+Every openral process gets its own rclpy :class:`~rclpy.context.Context` (never the global
+one) with no rclpy signal handlers, so Ctrl-C is ours to handle, and one
+:class:`~rclpy.executors.SingleThreadedExecutor`: the idle-step hand-off between the sensor
+bridge and ``/openral/safe_action`` relies on callbacks never running concurrently, and the
+multi-threaded executor of rclpy 7.1 busy-loops on two cores.
+
+Example::
+
+    with ros_session(domain_id=7) as context, Spinner(context) as spinner:
+        node = MyNode(context=context)
+        spinner.add_node(node)
+        spinner.call(node.trigger_configure)  # runs on the executor thread
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from types import TracebackType
+from typing import Any, TypeVar
+
+import rclpy
+from openral_core.errors import OpenralError
+from rclpy.context import Context
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
+
+T = TypeVar("T")
+
+SPIN_PERIOD_S = 0.1
+"""Longest wait of one ``spin_once`` [s]; bounds how late a stop request is noticed."""
+
+
+class RosRuntimeError(OpenralError):
+    """The ROS runtime could not do what was asked (a call on a stopped spinner, a timeout)."""
+
+
+@contextmanager
+def ros_session(domain_id: int | None = None, args: list[str] | None = None) -> Iterator[Context]:
+    """A fresh rclpy context, initialised without signal handlers and shut down on exit.
+
+    Args:
+        domain_id: ROS domain id; None keeps ``ROS_DOMAIN_ID`` (or 0).
+        args: ROS command-line arguments (``--ros-args ...``); None for none.
+    """
+    context = Context()
+    rclpy.init(
+        args=args,
+        context=context,
+        domain_id=domain_id,
+        signal_handler_options=SignalHandlerOptions.NO,
+    )
+    try:
+        yield context
+    finally:
+        context.try_shutdown()
+
+
+class Spinner:
+    """A single-threaded executor spinning its nodes on a background thread.
+
+    Stop it (or leave the ``with`` block) before destroying its nodes. Work that must not
+    race the node's callbacks (lifecycle transitions, reading HAL state) goes through
+    :meth:`call`, which runs it on the executor thread.
+    """
+
+    def __init__(self, context: Context) -> None:
+        self.context = context
+        self.executor = SingleThreadedExecutor(context=context)
+        self._thread: threading.Thread | None = None
+        self._stop = threading.Event()
+
+    def add_node(self, node: Node) -> None:
+        """Spin ``node`` too (allowed while running)."""
+        self.executor.add_node(node)
+
+    def remove_node(self, node: Node) -> None:
+        """Stop spinning ``node``; its callbacks no longer run after the current one."""
+        self.executor.remove_node(node)
+
+    @property
+    def running(self) -> bool:
+        """True while the spin thread is alive."""
+        return self._thread is not None and self._thread.is_alive()
+
+    def start(self) -> Spinner:
+        """Start the spin thread; returns self."""
+        if self.running:
+            return self
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._spin, name="openral-spin", daemon=True)
+        self._thread.start()
+        return self
+
+    def stop(self, timeout_s: float = 5.0) -> None:
+        """Stop spinning, shut the executor down and join the thread (idempotent).
+
+        Raises:
+            RosRuntimeError: The spin thread did not end within ``timeout_s`` [s].
+        """
+        self._stop.set()
+        self.executor.wake()
+        thread, self._thread = self._thread, None
+        if thread is not None:
+            thread.join(timeout_s)
+            if thread.is_alive():
+                raise RosRuntimeError(f"the spin thread did not stop within {timeout_s} s")
+        self.executor.shutdown(timeout_sec=timeout_s)
+
+    def call(self, function: Callable[..., T], *args: Any, timeout_s: float = 30.0) -> T:
+        """Run ``function(*args)`` on the executor thread and return its result.
+
+        Runs it directly when the spinner is not running (nothing can race it then). After
+        a timeout the queued call may still run later.
+
+        Raises:
+            RosRuntimeError: No result within ``timeout_s`` [s].
+            Exception: Whatever ``function`` raised.
+        """
+        if not self.running or threading.current_thread() is self._thread:
+            return function(*args)
+        done = threading.Event()
+        outcome: list[Any] = []
+
+        def run() -> None:
+            try:
+                outcome.append((True, function(*args)))
+            except Exception as error:  # handed to the caller below
+                outcome.append((False, error))
+            finally:
+                done.set()
+
+        self.executor.create_task(run)
+        if not done.wait(timeout_s):
+            name = getattr(function, "__name__", repr(function))
+            raise RosRuntimeError(f"{name} did not finish within {timeout_s} s on the spin thread")
+        ok, value = outcome[0]
+        if not ok:
+            raise value
+        result: T = value
+        return result
+
+    def __enter__(self) -> Spinner:
+        return self.start()
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        self.stop()
+
+    def _spin(self) -> None:
+        try:
+            while not self._stop.is_set() and self.context.ok():
+                self.executor.spin_once(timeout_sec=SPIN_PERIOD_S)
+        except ExternalShutdownException:  # the context was shut down under us
+            pass
+
+
+def spin_until(
+    executor: SingleThreadedExecutor,
+    stop: threading.Event,
+    *,
+    timeout_s: float | None = None,
+) -> bool:
+    """Spin ``executor`` on the calling thread until ``stop`` is set or ``timeout_s`` passes.
+
+    Returns:
+        True when ``stop`` was set, False when the timeout elapsed or the context ended.
+    """
+    deadline = None if timeout_s is None else time.monotonic() + timeout_s
+    try:
+        while not stop.is_set() and executor.context.ok():
+            left = SPIN_PERIOD_S if deadline is None else deadline - time.monotonic()
+            if left <= 0:
+                return False
+            executor.spin_once(timeout_sec=min(SPIN_PERIOD_S, left))
+    except ExternalShutdownException:
+        return False
+    return stop.is_set()
