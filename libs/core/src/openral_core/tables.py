@@ -57,6 +57,8 @@ class HalWiring:
     control_mode: str
     kp: dict[str, float] = field(default_factory=dict)
     kd: dict[str, float] = field(default_factory=dict)
+    velocity_limit: dict[str, float] = field(default_factory=dict)
+    """Arm joint → fastest its target may move (rad/s or m/s); grippers are not limited."""
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> HalWiring:
@@ -146,7 +148,8 @@ def hal_wiring(robot: RobotDescription) -> HalWiring | None:
         )
         for g in sim.grippers
     )
-    kp, kd = _gains(sim, names, {g.joint for g in grippers})
+    gripper_joints = {g.joint for g in grippers}
+    kp, kd = _gains(sim, names, gripper_joints)
     return HalWiring(
         mjcf_uri=sim.mjcf_uri,
         joint_names=names,
@@ -161,6 +164,9 @@ def hal_wiring(robot: RobotDescription) -> HalWiring | None:
         control_mode=sim.control.mode if sim.control else "position",
         kp=kp,
         kd=kd,
+        velocity_limit={
+            j.name: j.velocity_limit for j in robot.joints if j.name not in gripper_joints
+        },
     )
 
 

@@ -32,6 +32,8 @@ _BAD_STATE_WARNINGS = slice(
     int(mujoco.mjtWarning.mjWARN_BADQPOS), int(mujoco.mjtWarning.mjWARN_BADQACC) + 1
 )
 """MuJoCo's NaN/Inf position, velocity and acceleration warnings (consecutive in mjtWarning)."""
+SLEW_CHUNK_STEPS = 5
+"""Physics steps per set-point update while a target is being approached."""
 
 
 class MujocoArmHAL:
@@ -59,6 +61,7 @@ class MujocoArmHAL:
         control_mode: str = "position",
         kp: Mapping[str, float] | None = None,
         kd: Mapping[str, float] | None = None,
+        velocity_limit: Mapping[str, float] | None = None,
         gravity_enabled: bool = True,
         staleness_limit_s: float = 0.5,
     ) -> None:
@@ -81,6 +84,9 @@ class MujocoArmHAL:
                 torque; the HAL applies ``kp * (target - q) - kd * qdot`` every step).
             kp: Per-joint proportional gains for ``torque_pd``.
             kd: Per-joint derivative gains for ``torque_pd``.
+            velocity_limit: Per-joint speed limit of the set point: a new target is
+                approached no faster than this, as a real arm's controller interpolates
+                (a joint without a limit jumps straight to its target).
             gravity_enabled: False zeroes the model's gravity.
             staleness_limit_s: A state sample is flagged stale when physics has not advanced
                 for longer than this (wall time).
@@ -111,11 +117,15 @@ class MujocoArmHAL:
         arm = [self.joint_names[i] for i in self._arm_slots]
         self._kp = np.array([gains_kp.get(n, 0.0) for n in arm])
         self._kd = np.array([gains_kd.get(n, 0.0) for n in arm])
+        limits = velocity_limit or {}
+        self._vmax = np.array([limits.get(n, np.inf) for n in arm])
         self.gravity_enabled = gravity_enabled
         self.staleness_limit_s = staleness_limit_s
         self._model: mujoco.MjModel | None = None
         self._data: mujoco.MjData | None = None
         self._targets = np.zeros(len(self._arm_slots))
+        self._setpoint = self._targets.copy()
+        self._slewing = False
         self._estopped = False
         self._last_step_ns = 0
 
@@ -182,7 +192,7 @@ class MujocoArmHAL:
         self._arm_low = self._ctrl_low[self._arm_act]
         self._arm_high = self._ctrl_high[self._arm_act]
         self._model, self._data = model, data
-        self._targets = data.qpos[self._arm_qpos]
+        self._hold_current_pose(data)
         self._estopped = False
         self.step(self.settle_steps)
 
@@ -228,10 +238,7 @@ class MujocoArmHAL:
         if self._estopped:
             raise EStopLatched("E-stop is latched; call release_estop() before sending actions")
         self._targets = values[self._arm_slots]
-        if self.control_mode == "position":
-            data.ctrl[self._arm_act] = np.minimum(
-                np.maximum(self._targets, self._arm_low), self._arm_high
-            )
+        self._slewing = True
         for slot, gripper in self._gripper_slots.items():
             ctrl = gripper_ctrl(gripper.write_mode, float(values[slot]), gripper.ctrl_range)
             self._set_ctrl(data, gripper.actuator_index, ctrl)
@@ -249,12 +256,18 @@ class MujocoArmHAL:
             return False
         bad_state = data.warning.number[_BAD_STATE_WARNINGS]  # a live view of the counters
         diverged_before = bad_state.tobytes()
-        if self.control_mode == "torque_pd":
-            for _ in range(n):
-                self._apply_pd(data)
-                mujoco.mj_step(model, data)
-        else:
-            mujoco.mj_step(model, data, nstep=n)
+        remaining = n
+        while remaining > 0:
+            chunk = min(remaining, SLEW_CHUNK_STEPS) if self._slewing else remaining
+            if self._slewing:
+                self._advance_setpoint(chunk * model.opt.timestep, data)
+            if self.control_mode == "torque_pd":
+                for _ in range(chunk):
+                    self._apply_pd(data)
+                    mujoco.mj_step(model, data)
+            else:
+                mujoco.mj_step(model, data, nstep=chunk)
+            remaining -= chunk
         self._last_step_ns = time.monotonic_ns()
         if bad_state.tobytes() != diverged_before:
             raise SimulationDiverged(
@@ -277,7 +290,7 @@ class MujocoArmHAL:
     def release_estop(self) -> None:
         """Unlatch the E-stop; targets are reset to the current pose so nothing jumps."""
         _, data = self._handles()
-        self._targets = data.qpos[self._arm_qpos]
+        self._hold_current_pose(data)
         self._estopped = False
 
     # -- internals -------------------------------------------------------------------------
@@ -287,8 +300,25 @@ class MujocoArmHAL:
             raise NotConnected("the HAL is not connected; call connect() first")
         return self._model, self._data
 
+    def _hold_current_pose(self, data: mujoco.MjData) -> None:
+        self._targets = data.qpos[self._arm_qpos]
+        self._setpoint = self._targets.copy()
+        self._slewing = False
+
+    def _advance_setpoint(self, dt: float, data: mujoco.MjData) -> None:
+        """Move the set point towards the targets by at most ``velocity_limit * dt``."""
+        reach = self._vmax * dt
+        self._setpoint = np.minimum(
+            np.maximum(self._targets, self._setpoint - reach), self._setpoint + reach
+        )
+        self._slewing = not np.array_equal(self._setpoint, self._targets)
+        if self.control_mode == "position":
+            data.ctrl[self._arm_act] = np.minimum(
+                np.maximum(self._setpoint, self._arm_low), self._arm_high
+            )
+
     def _apply_pd(self, data: mujoco.MjData) -> None:
-        error = self._targets - data.qpos[self._arm_qpos]
+        error = self._setpoint - data.qpos[self._arm_qpos]
         torque = self._kp * error - self._kd * data.qvel[self._arm_qvel]
         data.ctrl[self._arm_act] = np.minimum(np.maximum(torque, self._arm_low), self._arm_high)
 
