@@ -13,7 +13,7 @@ import typer
 from openral_core.errors import OpenralError
 from rich.console import Console
 
-from openral_cli.commands import robot, sim
+from openral_cli.commands import deploy, robot, ros, rskill, sim
 
 app = typer.Typer(
     name="openral",
@@ -23,6 +23,9 @@ app = typer.Typer(
 )
 app.add_typer(robot.app, name="robot")
 app.add_typer(sim.app, name="sim")
+app.add_typer(deploy.app, name="deploy")
+app.add_typer(ros.app, name="ros")
+app.add_typer(rskill.app, name="rskill")
 
 
 def run() -> None:

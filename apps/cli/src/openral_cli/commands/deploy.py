@@ -1,0 +1,154 @@
+"""``openral deploy``: run a robot as a live ROS 2 graph.
+
+Example::
+
+    openral deploy sim --config robots/franka_panda/scenes/tabletop.yaml --no-viewer
+
+The scene's robot comes up as one :class:`~openral_nodes.manifest_node.ManifestLifecycleNode`
+in this process, driven through configure and activate here (there is no ``ros2 launch``).
+It runs until Ctrl-C or SIGTERM (or ``--duration``), then deactivates, cleans up and
+exits 0. ``openral ros topics`` in a second terminal lists what it publishes.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+import time
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from openral_core.errors import OpenralError
+from rich.console import Console
+from rich.table import Table
+
+app = typer.Typer(help="Run robots as ROS 2 graphs.", no_args_is_help=True)
+out = Console()
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+    # Headless: render offscreen with EGL. MuJoCo reads this once, when it is first imported,
+    # so it is set here, at import of this module (main.py imports it before any module
+    # that imports mujoco).
+    os.environ.setdefault("MUJOCO_GL", "egl")
+
+
+@app.command("sim")
+def sim(
+    config: Annotated[Path, typer.Option("--config", help="Deploy-scene YAML file.")],
+    no_viewer: Annotated[
+        bool, typer.Option("--no-viewer", help="Never open the MuJoCo viewer.")
+    ] = False,
+    camera_rate: Annotated[
+        float, typer.Option("--camera-rate", min=0.1, help="Camera and idle-step rate [Hz].")
+    ] = 10.0,
+    joint_state_rate: Annotated[
+        float, typer.Option("--joint-state-rate", min=0.1, help="/joint_states rate [Hz].")
+    ] = 50.0,
+    duration: Annotated[
+        float | None,
+        typer.Option(
+            "--duration", min=0.0, help="Stop after this many seconds (default: run until Ctrl-C)."
+        ),
+    ] = None,
+    domain_id: Annotated[
+        int | None,
+        typer.Option("--domain-id", min=0, max=232, help="ROS domain id (default: ROS_DOMAIN_ID)."),
+    ] = None,
+) -> None:
+    """Bring SCENE's robot up as a ROS 2 graph: joint states, cameras, actions, E-stop."""
+    robot_id = _scene_robot(config)
+    try:
+        from openral_nodes.manifest_node import ManifestLifecycleNode
+        from openral_nodes.runtime import ros_session, spin_until
+        from rclpy.executors import SingleThreadedExecutor
+    except ImportError as error:
+        raise OpenralError(
+            f"ROS 2 is not importable ({error}); install the 'ros' extra (pip install "
+            "'openral[ros]') or run ./bootstrap"
+        ) from None
+
+    parameters: dict[str, Any] = {
+        "robot_id": robot_id,
+        "sim_env_yaml": str(config.resolve()),
+        "hal_mode": "sim",
+        "viewer_enabled": not no_viewer,
+        "camera_publish_rate_hz": float(camera_rate),
+        "joint_state_rate_hz": float(joint_state_rate),
+    }
+    stop = threading.Event()
+    with ros_session(domain_id=domain_id) as context:
+        node = ManifestLifecycleNode(
+            context=context, parameter_overrides=parameters, log_boot_errors=False
+        )
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in STOP_SIGNALS}
+        started = time.monotonic()
+        try:
+            _transition(node, "configure")
+            _transition(node, "activate")
+            _print_interfaces(node, config)
+            spin_until(executor, stop, timeout_s=duration)
+        finally:
+            _shut_down(node)
+            executor.shutdown()
+            node.destroy_node()  # type: ignore[no-untyped-call]
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+    reason = "signal" if stop.is_set() else "--duration"
+    out.print(f"stopped ({reason}) after {time.monotonic() - started:.1f} s; clean shutdown")
+
+
+def _scene_robot(config: Path) -> str:
+    """The robot id a scene file names (checked before any ROS work starts)."""
+    from openral_core.loader import load_scene
+
+    if not config.is_file():
+        raise OpenralError(
+            f"{config}: no such scene file; expected a deploy-scene YAML such as "
+            "robots/franka_panda/scenes/tabletop.yaml"
+        )
+    scene = load_scene(config)
+    if not scene.robot_id:
+        raise OpenralError(f"{config}: robot_id: the scene names no robot; add robot_id")
+    return scene.robot_id
+
+
+def _transition(node: Any, name: str) -> None:
+    """Run one lifecycle transition; a failure becomes one clear error."""
+    from rclpy.lifecycle import TransitionCallbackReturn
+
+    result = getattr(node, f"trigger_{name}")()
+    if result != TransitionCallbackReturn.SUCCESS:
+        raise OpenralError(f"{name} failed: {node.boot_error or result}")
+
+
+def _shut_down(node: Any) -> None:
+    """Deactivate and clean up from whatever state the node reached."""
+    state = node.lifecycle_state
+    if state == "active":
+        node.trigger_deactivate()
+        state = "inactive"
+    if state == "inactive":
+        node.trigger_cleanup()
+
+
+def _print_interfaces(node: Any, config: Path) -> None:
+    from openral_nodes.manifest_node import ESTOP, RELEASE_ESTOP, SAFE_ACTION
+
+    names, _ = node.action_layout()
+    table = Table(title=f"deploy sim: {node.description.name} in {config}")
+    for column in ("", "name", "type", "rate"):
+        table.add_column(column, overflow="fold")
+    for topic in node.topics():
+        rate = "latched" if topic.rate_hz is None else f"{topic.rate_hz:g} Hz"
+        table.add_row("pub", topic.name, topic.type, rate)
+    table.add_row("sub", SAFE_ACTION, "std_msgs/msg/Float64MultiArray", f"{len(names)} values")
+    for service in (ESTOP, RELEASE_ESTOP):
+        table.add_row("srv", service, "std_srvs/srv/Trigger", "")
+    out.print(table)
+    out.print("running; stop with Ctrl-C. In a second terminal: openral ros topics")

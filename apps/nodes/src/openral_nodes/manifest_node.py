@@ -1,0 +1,337 @@
+"""ManifestLifecycleNode: one ROS 2 lifecycle node that runs any robot from its manifest.
+
+Parameters (all read at configure):
+
+- ``robot_id`` (str) or ``manifest_path`` (str): which robot; with neither, the robot the
+  ``sim_env_yaml`` scene names;
+- ``hal_mode`` (``sim`` | ``real``), ``sim_env_yaml`` (a deploy-scene file, ``""`` for none);
+- ``viewer_enabled`` (bool), ``camera_publish_rate_hz`` (float), ``joint_state_rate_hz``
+  (float), ``idle_hold_ms`` (float).
+
+Transitions:
+
+- configure → ``build_hal`` (a bad manifest, scene or mode fails here with one message);
+- activate → connect the HAL, publish ``/joint_states``, ``/clock`` and the latched
+  ``/openral/action_spec``, subscribe ``/openral/safe_action``, offer the E-stop services and
+  start the :class:`~openral_bridge.SimSensorBridge`;
+- deactivate → stop all of that (the HAL stays connected and holds still);
+- cleanup / shutdown / error → also disconnect and drop the HAL.
+
+The command on ``/openral/safe_action`` (``std_msgs/Float64MultiArray``) is ``data`` = one
+value per HAL action slot, in the order and meaning ``/openral/action_spec`` announces
+(``sensor_msgs/JointState``: ``name`` = slot names, ``position`` = the hold action when
+activated). An action of the wrong width or with a non-finite value is refused with a
+warning and changes nothing. Run it on a single-threaded executor only.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from openral_bridge import ros_messages
+from openral_bridge.sim_sensor_bridge import SimSensorBridge, TopicInfo
+from openral_core.errors import OpenralError
+from openral_core.loader import load_robot, load_scene
+from openral_core.models import RobotDescription
+from openral_core.registry import load_robot_by_id
+from openral_hal.errors import HalError
+from openral_hal.factory import build_hal
+from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
+from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock  # type: ignore[import-untyped]
+from sensor_msgs.msg import JointState  # type: ignore[import-untyped]
+from std_msgs.msg import Float64MultiArray  # type: ignore[import-untyped]
+from std_srvs.srv import Trigger  # type: ignore[import-untyped]
+
+NODE_NAME = "openral_manifest_node"
+JOINT_STATES = "/joint_states"
+CLOCK = "/clock"
+ACTION_SPEC = "/openral/action_spec"
+SAFE_ACTION = "/openral/safe_action"
+ESTOP = "/openral/estop"
+RELEASE_ESTOP = "/openral/release_estop"
+LATCHED = QoSProfile(  # type: ignore[no-untyped-call]
+    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
+)
+"""QoS of ``/openral/action_spec``: a late subscriber still gets the last message."""
+WARN_EVERY_S = 2.0
+"""At most one warning per this many seconds for a stream of refused actions [s]."""
+
+PARAMETERS: dict[str, Any] = {
+    "robot_id": "",
+    "manifest_path": "",
+    "hal_mode": "sim",
+    "sim_env_yaml": "",
+    "viewer_enabled": True,
+    "camera_publish_rate_hz": 10.0,
+    "joint_state_rate_hz": 50.0,
+    "idle_hold_ms": 200.0,
+}
+"""Every parameter and its default."""
+
+Result = TransitionCallbackReturn
+"""Transition outcome (a pybind enum, typed Any; hence the ``-> Any`` of the callbacks)."""
+
+
+class ManifestLifecycleNode(LifecycleNode):
+    """Any robot of ``robots/`` as a lifecycle node, through its HAL (see the module doc)."""
+
+    def __init__(
+        self,
+        *,
+        node_name: str = NODE_NAME,
+        parameter_overrides: dict[str, Any] | None = None,
+        log_boot_errors: bool = True,
+        **kwargs: Any,
+    ) -> None:
+        """Declare the parameters; ``parameter_overrides`` replaces their defaults.
+
+        Args:
+            node_name: ROS node name.
+            parameter_overrides: Parameter values by name (see :data:`PARAMETERS`).
+            log_boot_errors: Log why configure failed; off when the caller reports
+                :attr:`boot_error` itself (the CLI), so the reason is printed once.
+            kwargs: Passed to :class:`rclpy.lifecycle.LifecycleNode` (e.g. ``context``).
+
+        Raises:
+            ValueError: An override names no parameter of this node.
+        """
+        unknown = sorted(set(parameter_overrides or {}) - set(PARAMETERS))
+        if unknown:
+            raise ValueError(f"unknown parameters {unknown}; known: {sorted(PARAMETERS)}")
+        overrides = [
+            Parameter(k, value=v)  # type: ignore[no-untyped-call]
+            for k, v in (parameter_overrides or {}).items()
+        ]
+        super().__init__(node_name, parameter_overrides=overrides, **kwargs)
+        for name, default in PARAMETERS.items():
+            self.declare_parameter(name, default)
+        self.description: RobotDescription | None = None
+        self.hal: Any = None
+        self.bridge: SimSensorBridge | None = None
+        self.log_boot_errors = log_boot_errors
+        self.boot_error: str | None = None
+        """Why the last configure failed (None after a successful one)."""
+        self.actions_applied = 0
+        self.actions_refused = 0
+        self._entities: list[tuple[str, Any]] = []
+        self._state_rate_hz = 0.0
+
+    # -- transitions -----------------------------------------------------------------------
+
+    def on_configure(self, state: LifecycleState) -> Any:
+        """Load the manifest and build the HAL; FAILURE (stay unconfigured) with the reason."""
+        try:
+            self._check_rates()
+            self.description = self._load_description()
+            scene = self._param("sim_env_yaml") or None
+            self.hal = build_hal(self.description, mode=self._param("hal_mode"), sim_env_yaml=scene)
+        except (OpenralError, ValueError) as error:
+            return self._fail_configure(str(error))
+        except Exception as error:  # anything else is a bug; report it the same way
+            return self._fail_configure(f"{type(error).__name__}: {error}")
+        self.boot_error = None
+        self._log().info(f"configured {self.description.name} ({type(self.hal).__name__})")
+        return Result.SUCCESS
+
+    def on_activate(self, state: LifecycleState) -> Any:
+        """Connect the HAL and start publishing, subscribing and serving; FAILURE (stay
+        inactive) with :attr:`boot_error` set when the HAL does not connect."""
+        try:
+            if not self.hal.connected:
+                self.hal.connect()
+        except Exception as error:  # a HAL or renderer failure; report it, stay inactive
+            text = (
+                str(error)
+                if isinstance(error, OpenralError)
+                else f"{type(error).__name__}: {error}"
+            )
+            self.boot_error = text
+            if self.log_boot_errors:
+                self._log().error(f"activate failed: {text}")
+            return Result.FAILURE
+        self._state_rate_hz = float(self._param("joint_state_rate_hz"))
+        self._create_entities()
+        assert self.description is not None
+        self.bridge = SimSensorBridge(
+            self,
+            self.hal,
+            self.description,
+            viewer_enabled=bool(self._param("viewer_enabled")),
+            camera_rate_hz=float(self._param("camera_publish_rate_hz")),
+            idle_hold_ms=float(self._param("idle_hold_ms")),
+        )
+        self.bridge.setup()
+        super().on_activate(state)
+        return Result.SUCCESS
+
+    def on_deactivate(self, state: LifecycleState) -> Any:
+        """Stop the bridge and every publisher, subscription, service and timer."""
+        self._stop()
+        super().on_deactivate(state)
+        return Result.SUCCESS
+
+    def on_cleanup(self, state: LifecycleState) -> Any:
+        """Disconnect and drop the HAL."""
+        self._release()
+        return Result.SUCCESS
+
+    def on_shutdown(self, state: LifecycleState) -> Any:
+        """Stop everything and disconnect."""
+        self._release()
+        return Result.SUCCESS
+
+    def on_error(self, state: LifecycleState) -> Any:
+        """Stop everything and disconnect; the node returns to unconfigured."""
+        self._release()
+        return Result.SUCCESS
+
+    # -- what the node offers --------------------------------------------------------------
+
+    @property
+    def lifecycle_state(self) -> str:
+        """Label of the current lifecycle state (``unconfigured``, ``inactive``, ``active``,
+        ``finalized``); rclpy 7 has no public accessor."""
+        label: str = self._state_machine.current_state[1]
+        return label
+
+    def topics(self) -> list[TopicInfo]:
+        """Every topic published now, with its nominal rate (None: latched or on change)."""
+        if not self._entities:
+            return []
+        rows = [
+            TopicInfo(JOINT_STATES, "sensor_msgs/msg/JointState", self._state_rate_hz),
+            TopicInfo(CLOCK, "rosgraph_msgs/msg/Clock", self._state_rate_hz),
+            TopicInfo(ACTION_SPEC, "sensor_msgs/msg/JointState", None),
+        ]
+        return rows + (self.bridge.topics() if self.bridge else [])
+
+    def action_layout(self) -> tuple[tuple[str, ...], list[float]]:
+        """Slot names and hold action of the connected HAL (what ``action_spec`` carries)."""
+        names = getattr(self.hal, "action_names", None) or tuple(self.hal.joint_names)
+        hold_action = getattr(self.hal, "hold_action", None)
+        if callable(hold_action):
+            hold = np.asarray(hold_action(), dtype=np.float64)
+        else:
+            hold = np.asarray(self.hal.read_state().positions, dtype=np.float64)
+        return tuple(names), hold.tolist()
+
+    # -- internals -------------------------------------------------------------------------
+
+    def _log(self) -> Any:
+        return self.get_logger()  # type: ignore[no-untyped-call]
+
+    def _param(self, name: str) -> Any:
+        return self.get_parameter(name).value
+
+    def _check_rates(self) -> None:
+        for name in ("camera_publish_rate_hz", "joint_state_rate_hz"):
+            value = float(self._param(name))
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"parameter {name} must be a positive rate in Hz, got {value}")
+
+    def _load_description(self) -> RobotDescription:
+        robot_id, manifest = self._param("robot_id"), self._param("manifest_path")
+        if manifest:
+            return load_robot(Path(manifest))
+        if not robot_id and self._param("sim_env_yaml"):
+            robot_id = load_scene(Path(self._param("sim_env_yaml"))).robot_id or ""
+        if not robot_id:
+            raise ValueError(
+                "no robot: set parameter robot_id or manifest_path, or a sim_env_yaml scene "
+                "that names its robot_id"
+            )
+        return load_robot_by_id(robot_id)
+
+    def _fail_configure(self, message: str) -> Any:
+        self.boot_error = message
+        if self.log_boot_errors:
+            self._log().error(f"configure failed: {message}")
+        self.description = self.hal = None
+        return Result.FAILURE
+
+    def _create_entities(self) -> None:
+        spec = self.create_publisher(JointState, ACTION_SPEC, LATCHED)
+        names, hold = self.action_layout()
+        spec_msg = JointState(name=list(names), position=hold)
+        spec_msg.header.stamp = self.get_clock().now().to_msg()
+        spec.publish(spec_msg)
+        self._joint_pub = self.create_publisher(JointState, JOINT_STATES, 10)
+        self._clock_pub = self.create_publisher(Clock, CLOCK, 10)
+        self._entities = [
+            ("publisher", spec),
+            ("publisher", self._joint_pub),
+            ("publisher", self._clock_pub),
+            (
+                "subscription",
+                self.create_subscription(Float64MultiArray, SAFE_ACTION, self._on_safe_action, 10),
+            ),
+            ("service", self.create_service(Trigger, ESTOP, self._on_estop)),
+            ("service", self.create_service(Trigger, RELEASE_ESTOP, self._on_release_estop)),
+            ("timer", self.create_timer(1.0 / self._state_rate_hz, self._publish_state)),
+        ]
+        self._publish_state()
+
+    def _publish_state(self) -> None:
+        sample = self.hal.read_state()
+        sim_time = sample.sim_time_s
+        stamp_msg = (
+            ros_messages.stamp(sim_time)
+            if sim_time is not None
+            else self.get_clock().now().to_msg()
+        )
+        self._joint_pub.publish(
+            ros_messages.joint_state_msg(
+                sample.names, sample.positions, sample.velocities, sample.efforts, stamp_msg
+            )
+        )
+        if sim_time is not None:
+            self._clock_pub.publish(Clock(clock=stamp_msg))
+
+    def _on_safe_action(self, msg: Any) -> None:
+        values = np.asarray(msg.data, dtype=np.float64)
+        try:
+            self.hal.send_action(values)
+        except HalError as error:
+            self.actions_refused += 1
+            self._log().warning(f"action refused: {error}", throttle_duration_sec=WARN_EVERY_S)
+            return
+        self.actions_applied += 1
+
+    def _on_estop(self, request: Any, response: Any) -> Any:
+        self.hal.estop()
+        self._log().warning("E-stop latched: actions are refused and the scene is frozen")
+        response.success, response.message = True, "E-stop latched"
+        return response
+
+    def _on_release_estop(self, request: Any, response: Any) -> Any:
+        self.hal.release_estop()
+        self._log().info("E-stop released")
+        response.success, response.message = True, "E-stop released"
+        return response
+
+    def _stop(self) -> None:
+        if self.bridge is not None:
+            self.bridge.teardown()
+            self.bridge = None
+        destroy: dict[str, Callable[[Any], object]] = {
+            "publisher": self.destroy_publisher,
+            "subscription": self.destroy_subscription,
+            "service": self.destroy_service,
+            "timer": self.destroy_timer,
+        }
+        for kind, entity in reversed(self._entities):
+            destroy[kind](entity)
+        self._entities = []
+
+    def _release(self) -> None:
+        self._stop()
+        if self.hal is not None and getattr(self.hal, "connected", False):
+            self.hal.disconnect()
+        self.hal = None
+        self.description = None
