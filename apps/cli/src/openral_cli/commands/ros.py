@@ -1,0 +1,177 @@
+"""``openral ros``: inspect a ROS 2 graph without ros2cli (which is not on PyPI).
+
+Examples::
+
+    openral ros topics --rate
+    openral ros echo /joint_states --once
+    openral ros snapshot /openral/cameras/agentview/image --out agentview.png
+
+rclpy is imported only when a command runs, so the rest of the CLI works without the
+``ros`` extra.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+if TYPE_CHECKING:
+    from openral_nodes.topic_probe import Inbox
+    from rclpy.node import Node
+
+app = typer.Typer(
+    help="Inspect the ROS 2 graph: topics, messages, camera frames.", no_args_is_help=True
+)
+out = Console(soft_wrap=True)
+err = Console(stderr=True, soft_wrap=True)
+
+DomainId = Annotated[
+    int | None,
+    typer.Option("--domain-id", min=0, max=232, help="ROS domain [default: $ROS_DOMAIN_ID or 0]"),
+]
+Timeout = Annotated[
+    float,
+    typer.Option("--timeout", min=0.0, help="Seconds to wait for the topic and its first message."),
+]
+
+
+@contextmanager
+def _probe_node(domain_id: int | None) -> Iterator[Node]:
+    """A short-lived, spun node on its own rclpy context."""
+    from openral_nodes.runtime import Spinner, ros_session
+    from rclpy.node import Node
+
+    with ros_session(domain_id) as context:
+        node = Node(
+            f"openral_cli_{os.getpid()}",
+            context=context,
+            enable_rosout=False,
+            start_parameter_services=False,
+        )
+        try:
+            with Spinner(context) as spinner:
+                spinner.add_node(node)
+                yield node
+        finally:
+            node.destroy_node()  # type: ignore[no-untyped-call]
+
+
+@app.command("topics")
+def topics(
+    wait: Annotated[
+        float, typer.Option("--wait", min=0.0, help="Seconds to let discovery run first.")
+    ] = 2.0,
+    rate: Annotated[bool, typer.Option("--rate", help="Measure each topic's rate.")] = False,
+    window: Annotated[
+        float, typer.Option("--window", min=0.1, help="Seconds to measure rates over.")
+    ] = 2.0,
+    all_topics: Annotated[
+        bool, typer.Option("--all", help="Include /rosout and /parameter_events.")
+    ] = False,
+    domain_id: DomainId = None,
+) -> None:
+    """Table of the topics in the graph: name, type(s), publishers and (--rate) rate."""
+    from openral_nodes.topic_graph import graph_topics
+    from openral_nodes.topic_probe import measure_rates
+
+    with _probe_node(domain_id) as node:
+        time.sleep(wait)
+        infos = graph_topics(node, include_hidden=all_topics)
+        rates = measure_rates(node, infos, window) if rate else {}
+        domain = node.context.get_domain_id()
+    if not infos:
+        err.print(f"no topics on ROS_DOMAIN_ID={domain} after {wait:g} s")
+        return
+    table = Table(title=f"ROS_DOMAIN_ID={domain}")
+    table.add_column("topic", overflow="fold")
+    table.add_column("type", overflow="fold")
+    table.add_column("publishers", justify="right")
+    if rate:
+        table.add_column("rate (Hz)", justify="right")
+    for info in infos:
+        row = [info.name, ", ".join(info.types), str(info.publishers)]
+        if rate:
+            hz = rates.get(info.name)
+            row.append("-" if hz is None else f"{hz:.1f}")
+        table.add_row(*row)
+    out.print(table)
+
+
+@app.command("echo")
+def echo(
+    topic: Annotated[str, typer.Argument(help="Topic name, e.g. /joint_states.")],
+    once: Annotated[bool, typer.Option("--once", help="Print one message and exit.")] = False,
+    timeout: Timeout = 5.0,
+    domain_id: DomainId = None,
+) -> None:
+    """Print messages of TOPIC (any type in the graph); big arrays are summarised."""
+    from openral_nodes.topic_format import format_message
+    from openral_nodes.topic_graph import wait_for_topic
+    from openral_nodes.topic_probe import subscribe
+
+    deadline = time.monotonic() + timeout
+    with _probe_node(domain_id) as node:
+        info = wait_for_topic(node, topic, timeout)
+        with subscribe(node, info) as inbox:
+            msg = inbox.get(deadline - time.monotonic())
+            try:
+                while True:
+                    out.print(format_message(msg), highlight=False, markup=False)
+                    if once:
+                        return
+                    out.print("---")
+                    msg = _next(inbox)
+            except KeyboardInterrupt:
+                return
+
+
+def _next(inbox: Inbox) -> Any:
+    """Block until the inbox's next message, waking every second so Ctrl-C is noticed."""
+    from openral_nodes.topic_probe import NoMessage
+
+    while True:
+        try:
+            return inbox.get(1.0)
+        except NoMessage:
+            continue
+
+
+@app.command("snapshot")
+def snapshot(
+    topic: Annotated[str, typer.Argument(help="A sensor_msgs/Image topic.")],
+    out_file: Annotated[Path, typer.Option("--out", help="PNG file to write.")],
+    timeout: Timeout = 5.0,
+    domain_id: DomainId = None,
+) -> None:
+    """Save one frame of an Image topic (rgb8, bgr8 or mono8) as PNG."""
+    from openral_core.errors import OpenralError
+    from openral_nodes.topic_codec import image_to_rgb
+    from openral_nodes.topic_graph import wait_for_topic
+    from openral_nodes.topic_probe import subscribe
+    from openral_sim.png import write_png
+
+    deadline = time.monotonic() + timeout
+    with _probe_node(domain_id) as node:
+        info = wait_for_topic(node, topic, timeout)
+        if "sensor_msgs/msg/Image" not in info.types:
+            raise OpenralError(
+                f"{info.name} carries {', '.join(info.types)}, not sensor_msgs/msg/Image"
+            )
+        with subscribe(node, info) as inbox:
+            msg = inbox.get(deadline - time.monotonic())
+    rgb = image_to_rgb(msg)
+    out_file.parent.mkdir(parents=True, exist_ok=True)
+    write_png(out_file, rgb)
+    out.print(
+        f"wrote {out_file} ({rgb.shape[1]}x{rgb.shape[0]} {msg.encoding}, "
+        f"frame {msg.header.frame_id or '-'}) from {info.name}",
+        highlight=False,
+    )

@@ -1,0 +1,121 @@
+"""``openral rskill``: run a policy against a live openral ROS graph.
+
+Example (with ``openral deploy sim`` running in another terminal)::
+
+    openral rskill run --robot franka_panda --policy wave --duration 10
+    openral rskill run --robot franka_panda -p amplitude=0.3 -p action_slots=panda_joint1
+
+The runner realigns camera frames to VLA slots, calls the policy at ``--rate`` and
+publishes on ``/openral/safe_action``. It exits 0 on Ctrl-C, SIGTERM or after
+``--duration``; 1 with one message when it aborts (e.g. a camera slot the policy needs
+never delivered frames).
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from types import FrameType
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+from rich.console import Console
+
+if TYPE_CHECKING:
+    from openral_nodes.rskill_runner import RskillRunnerNode
+
+app = typer.Typer(help="Run robot skills (policies) on the ROS graph.", no_args_is_help=True)
+out = Console(soft_wrap=True)
+
+STATUS_PERIOD_S = 0.2
+"""How often the status line refreshes [s]."""
+
+
+@app.command("run")
+def run(
+    robot: Annotated[str, typer.Option("--robot", help="Robot id (folder under robots/).")],
+    policy: Annotated[str, typer.Option("--policy", help="Built-in policy name.")] = "wave",
+    params: Annotated[
+        list[str] | None,
+        typer.Option("--param", "-p", help="Policy parameter key=value (repeatable)."),
+    ] = None,
+    rate: Annotated[float, typer.Option("--rate", min=0.1, help="Actions per second.")] = 10.0,
+    duration: Annotated[
+        float | None, typer.Option("--duration", min=0.0, help="Stop after this many seconds.")
+    ] = None,
+    frame_timeout: Annotated[
+        float,
+        typer.Option("--frame-timeout", min=0.1, help="Seconds a required input may be missing."),
+    ] = 5.0,
+    domain_id: Annotated[
+        int | None,
+        typer.Option("--domain-id", min=0, max=232, help="ROS domain [default: $ROS_DOMAIN_ID]"),
+    ] = None,
+) -> None:
+    """Run POLICY for ROBOT: camera frames by VLA slot in, /openral/safe_action out."""
+    from openral_nodes.rskill_runner import RskillRunnerNode, runner_parameters
+    from openral_nodes.runtime import Spinner, ros_session
+
+    overrides = runner_parameters(
+        robot,
+        policy=policy,
+        policy_params=params or [],
+        rate_hz=rate,
+        frame_timeout_s=frame_timeout,
+    )
+    with ros_session(domain_id) as context:
+        node = RskillRunnerNode(context=context, parameter_overrides=overrides)
+        try:
+            with Spinner(context) as spinner, _sigterm_as_interrupt():
+                spinner.add_node(node)
+                elapsed = _watch(node, policy, duration)
+        finally:
+            node.destroy_node()  # type: ignore[no-untyped-call]
+    if node.abort_error is not None:
+        raise node.abort_error
+    routes = ", ".join(f"{e.slot} <- {e.sensor}" for e in node.slot_table)
+    out.print(
+        f"{policy} on {node.robot}: {node.status.actions} action(s) on /openral/safe_action "
+        f"in {elapsed:.1f} s ({routes or 'no cameras'})",
+        highlight=False,
+    )
+
+
+def _watch(node: RskillRunnerNode, policy: str, duration: float | None) -> float:
+    """Show the runner's status until it aborts, ``duration`` passes or Ctrl-C; the seconds run."""
+    start = time.monotonic()
+    try:
+        with out.status("starting") as status:
+            while node.abort_error is None:
+                elapsed = time.monotonic() - start
+                if duration is not None and elapsed >= duration:
+                    break
+                state = node.status
+                status.update(
+                    f"{policy} on {node.robot}: {state.state} · slots "
+                    f"[{', '.join(state.seen_slots)}] · {state.actions} action(s)"
+                )
+                time.sleep(STATUS_PERIOD_S)
+    except KeyboardInterrupt:
+        pass
+    return time.monotonic() - start
+
+
+@contextmanager
+def _sigterm_as_interrupt() -> Iterator[None]:
+    """Within the block, SIGTERM stops the command like Ctrl-C (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(_signum: int, _frame: FrameType | None) -> None:
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

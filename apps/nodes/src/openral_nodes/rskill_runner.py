@@ -1,0 +1,264 @@
+"""The rskill runner node: camera frames realigned to VLA slots in, policy actions out.
+
+Frames arrive on ``/openral/cameras/<sensor>/image`` keyed by the manifest sensor name;
+policies look them up by VLA slot (``camera1`` …). The two are joined through the
+generated slot table (:func:`openral_core.tables.vla_slots`), the same table the sensor
+bridge and ``openral robot show`` use, so the rule lives in one place.
+
+Each tick (``rate_hz``) the node builds an :class:`~openral_nodes.policies.Observation`
+from the latest frames, ``/joint_states`` and the latched ``/openral/action_spec``, calls
+the policy and publishes its action on ``/openral/safe_action``. Until ``frame_timeout_s``
+after start it waits for missing inputs; after that a missing input (or a camera slot
+whose frames stopped for ``frame_timeout_s``) aborts the runner: ``abort_error`` is set,
+the timer stops, and nothing more is published.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any, TypeVar
+
+import numpy as np
+import numpy.typing as npt
+from openral_core import VlaSlot, load_robot_by_id, vla_slots
+from openral_core.errors import OpenralError
+from rclpy.context import Context
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import (
+    DurabilityPolicy,
+    HistoryPolicy,
+    QoSProfile,
+    ReliabilityPolicy,
+    qos_profile_sensor_data,
+)
+from sensor_msgs.msg import Image, JointState  # type: ignore[import-untyped]
+from std_msgs.msg import Float64MultiArray  # type: ignore[import-untyped]
+
+from openral_nodes.policies import Observation, PolicyAdapter, make_policy, parse_params
+from openral_nodes.topic_codec import image_to_rgb
+
+CAMERA_TOPIC = "/openral/cameras/{sensor}/image"
+JOINT_STATES_TOPIC = "/joint_states"
+ACTION_SPEC_TOPIC = "/openral/action_spec"
+SAFE_ACTION_TOPIC = "/openral/safe_action"
+ACTION_SPEC_QOS = QoSProfile(  # type: ignore[no-untyped-call]
+    history=HistoryPolicy.KEEP_LAST,
+    depth=1,
+    reliability=ReliabilityPolicy.RELIABLE,
+    durability=DurabilityPolicy.TRANSIENT_LOCAL,
+)
+"""Latched: a late subscriber still receives the one action spec."""
+
+T = TypeVar("T")
+
+
+def realign_frames(frames: Mapping[str, T], slots: Sequence[VlaSlot]) -> dict[str, T]:
+    """Re-key frames from sensor name to VLA slot; sensors outside the table are dropped."""
+    return {entry.slot: frames[entry.sensor] for entry in slots if entry.sensor in frames}
+
+
+def _slot_list(slots: Sequence[str]) -> str:
+    return ", ".join(slots) if slots else "(none)"
+
+
+class MissingSlots(OpenralError):
+    """A policy's required camera slots are not provided (by the manifest or the graph)."""
+
+    def __init__(
+        self,
+        robot: str,
+        expected: Sequence[str],
+        seen: Sequence[str],
+        table: Sequence[VlaSlot],
+        where: str,
+    ) -> None:
+        self.expected = tuple(expected)
+        self.seen = tuple(seen)
+        routes = ", ".join(f"{e.slot} <- {CAMERA_TOPIC.format(sensor=e.sensor)}" for e in table)
+        super().__init__(
+            f"policy needs camera slots [{_slot_list(expected)}] but {where} "
+            f"[{_slot_list(seen)}]; {robot}: {routes or 'no RGB sensors'}"
+        )
+
+
+class RunnerAborted(OpenralError):
+    """The runner stopped: an input never arrived or the policy misbehaved."""
+
+
+@dataclass(frozen=True)
+class RunnerStatus:
+    """Snapshot of the runner for status displays."""
+
+    state: str
+    """``waiting``, ``running`` or ``aborted``."""
+    seen_slots: tuple[str, ...]
+    actions: int
+    """Actions published so far."""
+
+
+def runner_parameters(
+    robot_id: str,
+    *,
+    policy: str = "wave",
+    policy_params: Sequence[str] = (),
+    rate_hz: float = 10.0,
+    frame_timeout_s: float = 5.0,
+) -> list[Parameter]:
+    """Typed ``parameter_overrides`` for :class:`RskillRunnerNode`."""
+    values = (
+        ("robot_id", Parameter.Type.STRING, robot_id),
+        ("policy", Parameter.Type.STRING, policy),
+        ("policy_params", Parameter.Type.STRING_ARRAY, list(policy_params)),
+        ("rate_hz", Parameter.Type.DOUBLE, float(rate_hz)),
+        ("frame_timeout_s", Parameter.Type.DOUBLE, float(frame_timeout_s)),
+    )
+    return [Parameter(n, t, v) for n, t, v in values]  # type: ignore[no-untyped-call]
+
+
+class RskillRunnerNode(Node):
+    """Runs one policy against the openral topic contract (see the module docstring).
+
+    ROS parameters: ``robot_id`` (str), ``policy`` (built-in policy name, default
+    ``wave``), ``policy_params`` (``key=value`` strings), ``rate_hz`` (float, default 10.0),
+    ``frame_timeout_s`` (float, default 5.0: covers DDS discovery, 0.02-3.5 s here).
+    ``policy`` overrides the ``policy``/``policy_params`` parameters (tests, embedding).
+    """
+
+    def __init__(
+        self,
+        *,
+        context: Context | None = None,
+        parameter_overrides: list[Parameter] | None = None,
+        policy: PolicyAdapter | None = None,
+    ) -> None:
+        super().__init__("rskill_runner", context=context, parameter_overrides=parameter_overrides)
+        robot_id = str(self.declare_parameter("robot_id", "").value)
+        policy_name = str(self.declare_parameter("policy", "wave").value)
+        params = self.declare_parameter("policy_params", Parameter.Type.STRING_ARRAY).value
+        rate_hz = float(self.declare_parameter("rate_hz", 10.0).value)
+        self.frame_timeout_s = float(self.declare_parameter("frame_timeout_s", 5.0).value)
+        if rate_hz <= 0:
+            raise RunnerAborted(f"rate_hz must be > 0, got {rate_hz:g}")
+        description = load_robot_by_id(robot_id)
+        self.robot = description.name
+        self.slot_table = vla_slots(description)
+        self.policy = policy or make_policy(policy_name, parse_params(params or []))
+        provided = [entry.slot for entry in self.slot_table]
+        if any(slot not in provided for slot in self.policy.required_slots):
+            raise MissingSlots(
+                self.robot,
+                self.policy.required_slots,
+                provided,
+                self.slot_table,
+                "the manifest provides",
+            )
+        self._joint_names = [joint.name for joint in description.joints]
+        self._frames: dict[str, tuple[float, Any]] = {}
+        self._joints: dict[str, float] = {}
+        self._spec: tuple[tuple[str, ...], npt.NDArray[np.float64]] | None = None
+        self._started = time.monotonic()
+        self._first_act: float | None = None
+        self.abort_error: OpenralError | None = None
+        self.status = RunnerStatus("waiting", (), 0)
+        for entry in self.slot_table:
+            self.create_subscription(
+                Image,
+                CAMERA_TOPIC.format(sensor=entry.sensor),
+                self._frame_callback(entry.sensor),
+                qos_profile_sensor_data,
+            )
+        self.create_subscription(
+            JointState, JOINT_STATES_TOPIC, self._on_joint_state, qos_profile_sensor_data
+        )
+        self.create_subscription(
+            JointState, ACTION_SPEC_TOPIC, self._on_action_spec, ACTION_SPEC_QOS
+        )
+        self._publisher = self.create_publisher(Float64MultiArray, SAFE_ACTION_TOPIC, 10)
+        self._timer = self.create_timer(1.0 / rate_hz, self._tick)
+
+    def _frame_callback(self, sensor: str) -> Callable[[Any], None]:
+        def on_frame(msg: Any) -> None:
+            self._frames[sensor] = (time.monotonic(), msg)
+
+        return on_frame
+
+    def _on_joint_state(self, msg: Any) -> None:
+        self._joints.update(zip(msg.name, msg.position, strict=False))
+
+    def _on_action_spec(self, msg: Any) -> None:
+        names, hold = tuple(msg.name), np.asarray(msg.position, dtype=np.float64)
+        if len(names) != hold.size:
+            self._abort(
+                RunnerAborted(f"{ACTION_SPEC_TOPIC}: {len(names)} names, {hold.size} holds")
+            )
+            return
+        self._spec = (names, hold)
+
+    def _tick(self) -> None:
+        if self.abort_error is not None:
+            return
+        now = time.monotonic()
+        fresh = {s: msg for s, (t, msg) in self._frames.items() if now - t <= self.frame_timeout_s}
+        by_slot = realign_frames(fresh, self.slot_table)
+        seen = tuple(by_slot)
+        missing_slots = [s for s in self.policy.required_slots if s not in by_slot]
+        waiting = missing_slots or self._spec is None or not self._joints
+        if waiting:
+            self.status = RunnerStatus("waiting", seen, self.status.actions)
+            if now - self._started > self.frame_timeout_s:
+                self._abort(self._missing_input_error(missing_slots, list(by_slot)))
+            return
+        assert self._spec is not None
+        try:
+            obs = Observation(
+                images={slot: image_to_rgb(msg) for slot, msg in by_slot.items()},
+                joint_positions=np.array(
+                    [self._joints.get(name, np.nan) for name in self._joint_names]
+                ),
+                action_spec=self._spec,
+                time_s=now - (self._first_act if self._first_act is not None else now),
+            )
+            self._first_act = self._first_act if self._first_act is not None else now
+            action = np.asarray(self.policy.act(obs), dtype=np.float64)
+        except OpenralError as error:
+            self._abort(error)
+            return
+        except Exception as error:  # a policy bug must stop the runner, not the executor
+            self._abort(RunnerAborted(f"policy raised {type(error).__name__}: {error}"))
+            return
+        width = len(self._spec[0])
+        if action.shape != (width,) or not np.all(np.isfinite(action)):
+            self._abort(
+                RunnerAborted(
+                    f"policy returned an action of shape {action.shape} (finite: "
+                    f"{bool(np.all(np.isfinite(action)))}); the HAL expects {width} finite values"
+                )
+            )
+            return
+        self._publisher.publish(Float64MultiArray(data=action.tolist()))
+        self.status = RunnerStatus("running", seen, self.status.actions + 1)
+
+    def _missing_input_error(self, missing_slots: list[str], seen: list[str]) -> OpenralError:
+        if missing_slots:
+            where = f"got frames within {self.frame_timeout_s:g} s only for"
+            return MissingSlots(
+                self.robot, self.policy.required_slots, seen, self.slot_table, where
+            )
+        absent = [
+            topic
+            for topic, ok in ((ACTION_SPEC_TOPIC, self._spec), (JOINT_STATES_TOPIC, self._joints))
+            if not ok
+        ]
+        return RunnerAborted(
+            f"no message on {' or '.join(absent)} within {self.frame_timeout_s:g} s; "
+            "is `openral deploy sim` running on this ROS domain?"
+        )
+
+    def _abort(self, error: OpenralError) -> None:
+        self.abort_error = error
+        self.status = RunnerStatus("aborted", self.status.seen_slots, self.status.actions)
+        self._timer.cancel()  # type: ignore[no-untyped-call]
+        self.get_logger().error(str(error))  # type: ignore[no-untyped-call]

@@ -1,0 +1,153 @@
+"""Real-rclpy fixtures for the rskill runner and ``openral ros`` tests.
+
+Every test process claims its own ROS domain (a lock file per domain id, held until the
+process exits) and keeps discovery on loopback, so parallel test runs and other agents'
+graphs on this machine never see each other. ``FakeGraph`` plays the part of
+``openral deploy sim``: franka camera frames of distinct solid colours, joint states and a
+latched action spec; it records what arrives on ``/openral/safe_action``.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import threading
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from openral_bridge.ros_messages import image_msg, joint_state_msg, stamp
+from openral_nodes.runtime import Spinner, ros_session
+from rclpy.context import Context
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+
+os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+
+DOMAIN_RANGE = range(60, 100)
+"""Domain ids this suite may claim (FastDDS ports stay valid below 102)."""
+_DOMAIN_LOCK: Any = None
+
+FRANKA_JOINTS = [f"panda_joint{i}" for i in range(1, 8)] + ["panda_finger_joint1"]
+HOLD = np.array([0.0, -0.4, 0.0, -2.2, 0.0, 1.9, 0.8, 0.04])
+"""The action spec's hold action: one value per franka action slot."""
+JOINT_POSITIONS = np.linspace(0.1, 0.8, len(FRANKA_JOINTS))
+COLOURS = {"agentview": (200, 40, 10), "wrist": (10, 60, 220)}
+"""Solid RGB colour of each fake camera, so a frame shows which sensor it came from."""
+FRAME_SHAPE = (48, 64)
+CAMERA_HZ = 10.0
+
+
+def _claim_domain() -> int:
+    """Lock the first free domain id of DOMAIN_RANGE for this process's lifetime."""
+    global _DOMAIN_LOCK
+    start = os.getpid() % len(DOMAIN_RANGE)
+    for offset in range(len(DOMAIN_RANGE)):
+        domain = DOMAIN_RANGE[(start + offset) % len(DOMAIN_RANGE)]
+        handle = Path(f"/tmp/openral-ros-domain-{domain}.lock").open("w")  # noqa: SIM115
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            handle.close()
+            continue
+        _DOMAIN_LOCK = handle
+        return domain
+    raise RuntimeError(f"every ROS domain in {DOMAIN_RANGE} is taken")
+
+
+DOMAIN_ID = _claim_domain()
+os.environ["ROS_DOMAIN_ID"] = str(DOMAIN_ID)
+
+
+def wait_until(condition: Callable[[], bool], timeout_s: float = 10.0) -> bool:
+    """Poll ``condition`` every 20 ms until true or ``timeout_s`` passes."""
+    deadline = time.monotonic() + timeout_s
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.02)
+    return True
+
+
+class FakeGraph(Node):
+    """What ``openral deploy sim`` publishes for franka, minus the simulation."""
+
+    def __init__(self, context: Context, cameras: tuple[str, ...]) -> None:
+        super().__init__("fake_deploy_sim", context=context)
+        self.actions: list[np.ndarray] = []
+        self._lock = threading.Lock()
+        self._cameras = {
+            name: self.create_publisher(
+                type(image_msg(np.zeros((1, 1, 3), np.uint8), stamp(0), "")),
+                f"/openral/cameras/{name}/image",
+                5,
+            )
+            for name in cameras
+        }
+        latched = QoSProfile(
+            depth=1,
+            durability=DurabilityPolicy.TRANSIENT_LOCAL,
+            reliability=ReliabilityPolicy.RELIABLE,
+        )
+        spec = JointState(name=FRANKA_JOINTS, position=HOLD.tolist())
+        self._spec_pub = self.create_publisher(JointState, "/openral/action_spec", latched)
+        self._spec_pub.publish(spec)
+        self._joints = self.create_publisher(JointState, "/joint_states", 10)
+        self.create_subscription(Float64MultiArray, "/openral/safe_action", self._on_action, 10)
+        self.create_timer(1.0 / CAMERA_HZ, self._publish)
+
+    def _publish(self) -> None:
+        now = stamp(time.monotonic())
+        for name, publisher in self._cameras.items():
+            frame = np.empty((*FRAME_SHAPE, 3), np.uint8)
+            frame[:] = COLOURS[name]
+            publisher.publish(image_msg(frame, now, name))
+        zeros = np.zeros(len(FRANKA_JOINTS))
+        self._joints.publish(joint_state_msg(FRANKA_JOINTS, JOINT_POSITIONS, zeros, zeros, now))
+
+    def _on_action(self, msg: Any) -> None:
+        with self._lock:
+            self.actions.append(np.array(msg.data))
+
+    def received(self) -> list[np.ndarray]:
+        """Actions received so far."""
+        with self._lock:
+            return list(self.actions)
+
+
+class RosHarness:
+    """One rclpy context spun on a background thread; nodes added to it spin too."""
+
+    def __init__(self, context: Context, spinner: Spinner) -> None:
+        self.context = context
+        self.spinner = spinner
+        self.nodes: list[Node] = []
+
+    def add(self, node: Node) -> Node:
+        self.nodes.append(node)
+        self.spinner.add_node(node)
+        return node
+
+    def fake_graph(self, cameras: tuple[str, ...] = ("agentview", "wrist")) -> FakeGraph:
+        graph = FakeGraph(self.context, cameras)
+        self.add(graph)
+        return graph
+
+
+@pytest.fixture
+def ros() -> Iterator[RosHarness]:
+    """A spun rclpy context on this process's domain; nodes are destroyed afterwards."""
+    with ros_session(DOMAIN_ID) as context:
+        spinner = Spinner(context)
+        harness = RosHarness(context, spinner.start())
+        try:
+            yield harness
+        finally:
+            spinner.stop()
+            for node in harness.nodes:
+                node.destroy_node()
