@@ -25,7 +25,7 @@ from openral_hal.errors import EStopLatched, HalError, NotConnected, SimulationD
 from openral_hal.gripper import gripper_ctrl, read_gripper
 from openral_hal.mjcf_model import ctrl_limits, is_position_servo
 from openral_hal.mjcf_uri import resolve_mjcf_uri
-from openral_hal.state import JointStateSample
+from openral_hal.state import FloatArray, JointStateSample
 
 CONTROL_MODES = ("position", "torque_pd")
 _BAD_STATE_WARNINGS = slice(
@@ -126,6 +126,7 @@ class MujocoArmHAL:
         self._targets = np.zeros(len(self._arm_slots))
         self._setpoint = self._targets.copy()
         self._slewing = False
+        self._reach: dict[int, FloatArray] = {}
         self._estopped = False
         self._last_step_ns = 0
 
@@ -188,6 +189,9 @@ class MujocoArmHAL:
         if self.seed_ctrl_from_qpos:
             seed_position_servos(model, data)
         mujoco.mj_forward(model, data)
+        self._reach = {
+            n: self._vmax * n * model.opt.timestep for n in range(1, SLEW_CHUNK_STEPS + 1)
+        }
         self._ctrl_low, self._ctrl_high = ctrl_limits(model)
         self._arm_low = self._ctrl_low[self._arm_act]
         self._arm_high = self._ctrl_high[self._arm_act]
@@ -237,7 +241,10 @@ class MujocoArmHAL:
         values = validated_action(action, self.joint_names)
         if self._estopped:
             raise EStopLatched("E-stop is latched; call release_estop() before sending actions")
-        self._targets = values[self._arm_slots]
+        targets = values[self._arm_slots]
+        if self.control_mode == "position":  # once here, so the set point never leaves it
+            targets = np.minimum(np.maximum(targets, self._arm_low), self._arm_high)
+        self._targets = targets
         self._slewing = True
         for slot, gripper in self._gripper_slots.items():
             ctrl = gripper_ctrl(gripper.write_mode, float(values[slot]), gripper.ctrl_range)
@@ -260,7 +267,7 @@ class MujocoArmHAL:
         while remaining > 0:
             chunk = min(remaining, SLEW_CHUNK_STEPS) if self._slewing else remaining
             if self._slewing:
-                self._advance_setpoint(chunk * model.opt.timestep, data)
+                self._advance_setpoint(self._reach[chunk], data)
             if self.control_mode == "torque_pd":
                 for _ in range(chunk):
                     self._apply_pd(data)
@@ -305,17 +312,14 @@ class MujocoArmHAL:
         self._setpoint = self._targets.copy()
         self._slewing = False
 
-    def _advance_setpoint(self, dt: float, data: mujoco.MjData) -> None:
-        """Move the set point towards the targets by at most ``velocity_limit * dt``."""
-        reach = self._vmax * dt
-        self._setpoint = np.minimum(
-            np.maximum(self._targets, self._setpoint - reach), self._setpoint + reach
-        )
-        self._slewing = not np.array_equal(self._setpoint, self._targets)
+    def _advance_setpoint(self, reach: FloatArray, data: mujoco.MjData) -> None:
+        """Move the set point towards the targets by at most ``reach`` per joint."""
+        setpoint = self._setpoint
+        setpoint = np.minimum(np.maximum(self._targets, setpoint - reach), setpoint + reach)
+        self._setpoint = setpoint
+        self._slewing = bool((setpoint != self._targets).any())
         if self.control_mode == "position":
-            data.ctrl[self._arm_act] = np.minimum(
-                np.maximum(self._setpoint, self._arm_low), self._arm_high
-            )
+            data.ctrl[self._arm_act] = setpoint
 
     def _apply_pd(self, data: mujoco.MjData) -> None:
         error = self._setpoint - data.qpos[self._arm_qpos]
