@@ -50,4 +50,8 @@ check: lint typecheck schema-check
 
 # HAL overhead per robot against a raw mj_step loop; writes benchmarks/results/hal_step.json.
 bench-hal *ARGS:
-    python benchmarks/hal_step.py {{ARGS}}
+    python -m benchmarks.hal_step {{ARGS}}
+
+# Native franka tabletop against robosuite Lift through SimAttachedHAL; writes benchmarks/results/scene_step.json.
+bench-scene *ARGS:
+    python -m benchmarks.scene_step {{ARGS}}

@@ -8,20 +8,17 @@ to ``benchmarks/results/hal_step.json``.
 from __future__ import annotations
 
 import argparse
-import json
-import platform
 import time
-from pathlib import Path
 
 import mujoco
-import numpy as np
 from openral_core import load_robot_by_id, robot_ids
 from openral_hal.mujoco_arm import MujocoArmHAL
 from rich.console import Console
 from rich.progress import track
 from rich.table import Table
 
-RESULTS = Path(__file__).parent / "results" / "hal_step.json"
+from benchmarks.results_file import write_results
+
 TARGET_RATIO = {"franka_panda": 1.15}
 """Raw-over-HAL step-rate ratio each robot should stay under (shown green when met)."""
 
@@ -106,21 +103,13 @@ def main() -> int:
             f"≤ {target}" if target else "-",
         )
     Console().print(table)
-    RESULTS.parent.mkdir(parents=True, exist_ok=True)
-    report = {
-        "machine": platform.machine(),
-        "python": platform.python_version(),
-        "mujoco": mujoco.__version__,
-        "numpy": np.__version__,
-        "steps": args.steps,
-        "repeats": args.repeats,
-        "substeps": args.substeps,
-        "results": rows,
-    }
-    RESULTS.write_text(json.dumps(report, indent=2) + "\n")
+    path = write_results(
+        "hal_step",
+        {"steps": args.steps, "repeats": args.repeats, "substeps": args.substeps, "results": rows},
+    )
     Console().print(
         f"@1: one physics step per action; @{n}: {n} steps per action (a control loop). "
-        f"Physics steps per second in both; ratio = raw / HAL. Written to {RESULTS}."
+        f"Physics steps per second in both; ratio = raw / HAL. Written to {path}."
     )
     return 0
 
