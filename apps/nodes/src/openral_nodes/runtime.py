@@ -16,12 +16,16 @@ Example::
 
 from __future__ import annotations
 
+import fcntl
+import os
+import tempfile
 import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from types import TracebackType
-from typing import Any, TypeVar
+from typing import IO, Any, TypeVar
 
 import rclpy
 from openral_core.errors import OpenralError
@@ -36,8 +40,39 @@ SPIN_PERIOD_S = 0.1
 """Longest wait of one ``spin_once`` [s]; bounds how late a stop request is noticed."""
 
 
+DOMAIN_LOCK = "openral-ros-domain-{id}.lock"
+"""Lock file (in the temp dir) that marks a ROS domain id as claimed by a live process."""
+_claimed: dict[int, IO[str]] = {}
+
+
 class RosRuntimeError(OpenralError):
     """The ROS runtime could not do what was asked (a call on a stopped spinner, a timeout)."""
+
+
+def claim_domain_id(ids: range = range(1, 100)) -> int:
+    """Claim a ROS domain id no other openral process holds, until this process exits.
+
+    Each claim is an exclusive lock on a file in the temp dir (released by the OS when the
+    process ends), so parallel test runs and benchmarks never share a graph. FastDDS ports
+    stay valid for ids below 102.
+
+    Raises:
+        RosRuntimeError: Every id in ``ids`` is claimed.
+    """
+    start = os.getpid() % len(ids)
+    for offset in range(len(ids)):
+        domain = ids[(start + offset) % len(ids)]
+        if domain in _claimed:
+            continue
+        handle = (Path(tempfile.gettempdir()) / DOMAIN_LOCK.format(id=domain)).open("w")
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            handle.close()
+            continue
+        _claimed[domain] = handle
+        return domain
+    raise RosRuntimeError(f"every ROS domain id in {ids} is claimed by another process")
 
 
 @contextmanager

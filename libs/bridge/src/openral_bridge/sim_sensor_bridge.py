@@ -95,7 +95,7 @@ class SimSensorBridge:
         """Camera ticks that published at least one image since :meth:`setup`."""
         self._cameras: dict[str, tuple[RgbSensor, float | None]] = {}
         self._publishers: list[Any] = []
-        self._image_pubs: dict[str, tuple[Any, Any]] = {}
+        self._image_pubs: dict[str, tuple[Any, Any | None]] = {}
         self._camera_timer: Any = None
         self._idle_timer: Any = None
         self._viewer: Any = None
@@ -141,10 +141,11 @@ class SimSensorBridge:
         """What the bridge publishes now."""
         rate = self.camera_rate_hz
         rows = []
-        for name in self._image_pubs:
+        for name, (_, info_pub) in self._image_pubs.items():
             rows.append(TopicInfo(CAMERA_TOPIC.format(name=name), "sensor_msgs/msg/Image", rate))
-            info = CAMERA_INFO_TOPIC.format(name=name)
-            rows.append(TopicInfo(info, "sensor_msgs/msg/CameraInfo", rate))
+            if info_pub is not None:
+                info = CAMERA_INFO_TOPIC.format(name=name)
+                rows.append(TopicInfo(info, "sensor_msgs/msg/CameraInfo", rate))
         return rows
 
     # -- cameras ---------------------------------------------------------------------------
@@ -158,14 +159,17 @@ class SimSensorBridge:
         for sensor in self.description.sensors:
             if not isinstance(sensor, RgbSensor) or sensor.name not in rendered:
                 continue
-            self._cameras[sensor.name] = (sensor, self._fovy_deg(sensor))
+            fovy = self._fovy_deg(sensor)
+            self._cameras[sensor.name] = (sensor, fovy)
             image = self.node.create_publisher(
                 Image, CAMERA_TOPIC.format(name=sensor.name), IMAGE_QUEUE_DEPTH
             )
-            info = self.node.create_publisher(
-                CameraInfo, CAMERA_INFO_TOPIC.format(name=sensor.name), IMAGE_QUEUE_DEPTH
-            )
-            self._publishers += [image, info]
+            self._publishers.append(image)
+            info = None
+            if fovy is not None:
+                topic = CAMERA_INFO_TOPIC.format(name=sensor.name)
+                info = self.node.create_publisher(CameraInfo, topic, IMAGE_QUEUE_DEPTH)
+                self._publishers.append(info)
             self._image_pubs[sensor.name] = (image, info)
         if self._image_pubs:
             self._publish_images()
@@ -183,7 +187,7 @@ class SimSensorBridge:
                 continue
             sensor, fovy = self._cameras[name]
             image_pub.publish(ros_messages.image_msg(image, stamp, sensor.frame_id))
-            if fovy is not None:
+            if info_pub is not None and fovy is not None:
                 height, width = image.shape[:2]
                 info = ros_messages.camera_info_msg(width, height, fovy, stamp, sensor.frame_id)
                 info_pub.publish(info)

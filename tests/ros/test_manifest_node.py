@@ -1,0 +1,229 @@
+"""Tests for manifest_node.py + sim_sensor_bridge.py: the franka default scene as a live graph."""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from openral_core.models import RgbSensor
+from openral_nodes.manifest_node import ACTION_SPEC, ESTOP, RELEASE_ESTOP, SAFE_ACTION
+from openral_sim.png import encode_png
+from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Trigger
+
+from tests.ros.ros_helpers import (
+    CAMERAS,
+    FRANKA_SCENE,
+    WAIT_S,
+    Deployed,
+    image_topic,
+    info_topic,
+    wait_until,
+)
+
+CONTROL_PERIOD_S = 0.05
+"""One scene step of the franka tabletop scene (control_freq_hz 20) [s]."""
+CAMERA_HZ = 10.0
+RATE_WINDOW_S = 3.0
+
+
+def stamp_s(msg: Any) -> float:
+    return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+
+
+def frame(msg: Any) -> np.ndarray:
+    return np.frombuffer(bytes(msg.data), dtype=np.uint8).reshape(msg.height, msg.width, 3)
+
+
+def call_trigger(deployed: Deployed, service: str) -> Any:
+    client = deployed.probe.node.create_client(Trigger, service)
+    try:
+        assert client.wait_for_service(timeout_sec=WAIT_S), f"{service} is not offered"
+        done = threading.Event()
+        future = client.call_async(Trigger.Request())
+        future.add_done_callback(lambda _: done.set())
+        assert done.wait(WAIT_S), f"no answer from {service}"
+        return future.result()
+    finally:
+        deployed.probe.node.destroy_client(client)
+
+
+def test_deploy_publishes_joint_states_cameras_and_action_spec(deployed: Deployed) -> None:
+    probe, description = deployed.probe, deployed.description
+    for topic in [
+        "/joint_states",
+        ACTION_SPEC,
+        *map(image_topic, CAMERAS),
+        *map(info_topic, CAMERAS),
+    ]:
+        probe.wait_count(topic, 1)
+
+    joints = probe.latest("/joint_states")
+    assert list(joints.name) == [j.name for j in description.joints]
+    assert len(joints.position) == len(description.joints)
+    assert all(math.isfinite(v) for v in joints.position)
+
+    sensors = {s.name: s for s in description.sensors if isinstance(s, RgbSensor)}
+    for camera in CAMERAS:
+        image = probe.latest(image_topic(camera))
+        assert (image.encoding, image.height, image.width) == ("rgb8", 128, 128)
+        assert image.step == 128 * 3 and len(image.data) == 128 * 128 * 3
+        assert image.header.frame_id == sensors[camera].frame_id
+        info = probe.latest(info_topic(camera))
+        assert info.header.frame_id == sensors[camera].frame_id
+        assert (info.width, info.height) == (128, 128)
+    wrist = probe.latest(info_topic("wrist"))  # mounted camera: the manifest's fovy_deg, 75
+    assert wrist.k[0] == wrist.k[4] == 64.0 / math.tan(math.radians(75.0) / 2)
+
+    spec = probe.latest(ACTION_SPEC)
+    names, hold = deployed.spinner.call(deployed.node.action_layout)
+    assert tuple(spec.name) == names and len(names) == 8
+    assert list(spec.position) == hold
+
+
+def test_camera_rate_is_within_10_percent_of_10_hz(deployed: Deployed) -> None:
+    probe = deployed.probe
+    start = time.monotonic()
+    for camera in CAMERAS:
+        probe.wait(
+            lambda c=camera: any(
+                r.at >= start + RATE_WINDOW_S for r in probe.messages[image_topic(c)]
+            ),
+            what=f"{RATE_WINDOW_S} s of {camera} frames",
+        )
+    for camera in CAMERAS:
+        arrivals = [
+            r.at for r in probe.since(image_topic(camera), start) if r.at <= start + RATE_WINDOW_S
+        ]
+        rate = (len(arrivals) - 1) / (arrivals[-1] - arrivals[0])
+        assert abs(rate - CAMERA_HZ) <= 0.1 * CAMERA_HZ, (
+            f"{camera}: {rate:.2f} Hz over {len(arrivals)} frames"
+        )
+
+
+def test_idle_scene_advances_and_estop_freezes_it(deployed: Deployed) -> None:
+    probe, topic = deployed.probe, image_topic("agentview")
+    # Idle (no action ever sent): the stepper advances the scene, one control period a tick,
+    # and the settling scene looks different from one frame to the next.
+    probe.wait(
+        lambda: any(stamp_s(r.msg) >= 1.0 for r in probe.messages[topic]),
+        what="agentview frames up to 1 s of simulated time",
+    )
+    early = [r.msg for r in probe.since(topic, 0.0) if stamp_s(r.msg) <= 1.0]
+    stamps = [stamp_s(m) for m in early]
+    assert stamps == sorted(stamps) and stamps[-1] - stamps[0] >= 0.3, stamps
+    assert len({frame(m).tobytes() for m in early}) >= 2, "idle frames never changed"
+    assert deployed.node_stats()["idle_steps"] > 0
+
+    answer = call_trigger(deployed, ESTOP)
+    assert answer.success and "latched" in answer.message
+    frozen = probe.wait_count(topic, 6, start=time.monotonic())[1:]  # the first may predate it
+    assert len({stamp_s(r.msg) for r in frozen}) == 1, "simulated time advanced while E-stopped"
+    assert len({frame(r.msg).tobytes() for r in frozen}) == 1
+
+    assert call_trigger(deployed, RELEASE_ESTOP).success
+    held = stamp_s(frozen[-1].msg)
+    probe.wait(
+        lambda: stamp_s(probe.messages[topic][-1].msg) > held,
+        what="the scene to advance again after release",
+    )
+
+
+def test_actions_move_the_arm_and_the_idle_stepper_yields(deployed: Deployed) -> None:
+    probe = deployed.probe
+    probe.wait_count(ACTION_SPEC, 1)
+    spec = probe.latest(ACTION_SPEC)
+    hold = np.array(spec.position)
+    publisher = probe.node.create_publisher(Float64MultiArray, SAFE_ACTION, 10)
+    wait_until(
+        lambda: publisher.get_subscription_count() > 0, what="the node's action subscription"
+    )
+
+    # Malformed actions are refused and change nothing.
+    before = deployed.node_stats()
+    publisher.publish(Float64MultiArray(data=[0.0, 0.0, 0.0]))
+    publisher.publish(Float64MultiArray(data=[*hold[:-1], math.nan]))
+    wait_until(lambda: deployed.node_stats()["refused"] >= before["refused"] + 2, what="refusals")
+    assert deployed.node_stats()["applied"] == before["applied"]
+
+    # A stream at 20 Hz (well inside the 500 ms idle hold) moves joint 1 and owns the scene.
+    start_q1 = probe.latest("/joint_states").position[0]
+    target = hold.copy()
+    target[0] += 0.4
+    timer = deployed.spinner.call(
+        lambda: probe.node.create_timer(
+            0.05, lambda: publisher.publish(Float64MultiArray(data=target.tolist()))
+        )
+    )
+    try:
+        wait_until(
+            lambda: deployed.node_stats()["applied"] >= before["applied"] + 3,
+            what="actions applied",
+        )
+        streaming = deployed.node_stats()
+        probe.wait(
+            lambda: probe.latest("/joint_states").position[0] > start_q1 + 0.2,
+            what="panda_joint1 to follow the commanded +0.4 rad",
+        )
+        wait_until(
+            lambda: deployed.node_stats()["applied"] >= streaming["applied"] + 20,
+            what="20 more actions",
+        )
+        assert deployed.node_stats()["idle_steps"] == streaming["idle_steps"], (
+            "idle stepper ran mid-stream"
+        )
+    finally:
+        deployed.spinner.call(probe.node.destroy_timer, timer)
+    stopped = deployed.node_stats()
+    wait_until(
+        lambda: deployed.node_stats()["idle_steps"] > stopped["idle_steps"],
+        what="idle stepping to resume",
+    )
+    probe.node.destroy_publisher(publisher)
+
+
+def test_sim_run_and_deploy_show_the_same_frames_for_the_same_seed(
+    deployed: Deployed, tmp_path: Path
+) -> None:
+    steps = 12
+    openral = Path(sys.executable).parent / "openral"
+    command = [
+        str(openral),
+        "sim",
+        "run",
+        "--config",
+        str(FRANKA_SCENE),
+        "--steps",
+        str(steps),
+        "--motion",
+        "hold",
+        "--out",
+        str(tmp_path),
+    ]
+    subprocess.run(
+        command,
+        check=True,
+        capture_output=True,
+        env={**os.environ, "MUJOCO_GL": "egl"},
+        timeout=120,
+    )
+    for camera in CAMERAS:
+        # The first stepped frame the probe caught; its simulated-time stamp says which step.
+        stepped = [
+            r.msg for r in deployed.probe.since(image_topic(camera), 0.0) if stamp_s(r.msg) > 0
+        ]
+        assert stepped, f"no {camera} frame after the first step was received"
+        first = min(stepped, key=stamp_s)
+        step = round(stamp_s(first) / CONTROL_PERIOD_S) - 1
+        assert step < steps, (
+            f"{camera}: first frame received is from step {step}; discovery too slow"
+        )
+        expected = (tmp_path / f"{camera}_{step:04d}.png").read_bytes()
+        assert encode_png(frame(first)) == expected, f"{camera} frame of step {step} differs"
