@@ -97,7 +97,7 @@ class WavePolicy:
         unknown = sorted(set(self.config.action_slots) - set(names))
         if unknown:
             raise PolicyConfigError(
-                f"wave action_slots {unknown} are not action slots; the HAL's are: "
+                f"wave action_slots {', '.join(unknown)} are not action slots; the HAL's are: "
                 f"{', '.join(names)}"
             )
         waving = self.config.action_slots or names

@@ -69,6 +69,7 @@ class MissingSlots(OpenralError):
 
     def __init__(
         self,
+        policy: str,
         robot: str,
         expected: Sequence[str],
         seen: Sequence[str],
@@ -79,8 +80,8 @@ class MissingSlots(OpenralError):
         self.seen = tuple(seen)
         routes = ", ".join(f"{e.slot} <- {CAMERA_TOPIC.format(sensor=e.sensor)}" for e in table)
         super().__init__(
-            f"policy needs camera slots [{_slot_list(expected)}] but {where} "
-            f"[{_slot_list(seen)}]; {robot}: {routes or 'no RGB sensors'}"
+            f"policy {policy} needs camera slots ({_slot_list(expected)}) but {where} "
+            f"({_slot_list(seen)}); {robot}: {routes or 'no RGB sensors'}"
         )
 
 
@@ -107,14 +108,18 @@ def runner_parameters(
     rate_hz: float = 10.0,
     frame_timeout_s: float = 5.0,
 ) -> list[Parameter]:
-    """Typed ``parameter_overrides`` for :class:`RskillRunnerNode`."""
-    values = (
+    """Typed ``parameter_overrides`` for :class:`RskillRunnerNode`.
+
+    An empty ``policy_params`` is left out: rclpy reads ``[]`` as a byte array.
+    """
+    values: list[tuple[str, Parameter.Type, object]] = [
         ("robot_id", Parameter.Type.STRING, robot_id),
         ("policy", Parameter.Type.STRING, policy),
-        ("policy_params", Parameter.Type.STRING_ARRAY, list(policy_params)),
         ("rate_hz", Parameter.Type.DOUBLE, float(rate_hz)),
         ("frame_timeout_s", Parameter.Type.DOUBLE, float(frame_timeout_s)),
-    )
+    ]
+    if policy_params:
+        values.append(("policy_params", Parameter.Type.STRING_ARRAY, list(policy_params)))
     return [Parameter(n, t, v) for n, t, v in values]  # type: ignore[no-untyped-call]
 
 
@@ -146,9 +151,11 @@ class RskillRunnerNode(Node):
         self.robot = description.name
         self.slot_table = vla_slots(description)
         self.policy = policy or make_policy(policy_name, parse_params(params or []))
+        self.policy_name = policy_name if policy is None else type(policy).__name__
         provided = [entry.slot for entry in self.slot_table]
         if any(slot not in provided for slot in self.policy.required_slots):
             raise MissingSlots(
+                self.policy_name,
                 self.robot,
                 self.policy.required_slots,
                 provided,
@@ -245,7 +252,12 @@ class RskillRunnerNode(Node):
         if missing_slots:
             where = f"got frames within {self.frame_timeout_s:g} s only for"
             return MissingSlots(
-                self.robot, self.policy.required_slots, seen, self.slot_table, where
+                self.policy_name,
+                self.robot,
+                self.policy.required_slots,
+                seen,
+                self.slot_table,
+                where,
             )
         absent = [
             topic

@@ -91,7 +91,7 @@ def topics(
         err.print(f"no topics on ROS_DOMAIN_ID={domain} after {wait:g} s")
         return
     table = Table(title=f"ROS_DOMAIN_ID={domain}")
-    table.add_column("topic", overflow="fold")
+    table.add_column("topic", no_wrap=True)
     table.add_column("type", overflow="fold")
     table.add_column("publishers", justify="right")
     if rate:

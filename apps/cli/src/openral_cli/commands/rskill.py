@@ -66,7 +66,8 @@ def run(
         rate_hz=rate,
         frame_timeout_s=frame_timeout,
     )
-    with ros_session(domain_id) as context:
+    # The node logs an abort too; this command reports it itself, as the one message.
+    with ros_session(domain_id, ["--ros-args", "--disable-stdout-logs"]) as context:
         node = RskillRunnerNode(context=context, parameter_overrides=overrides)
         try:
             with Spinner(context) as spinner, _sigterm_as_interrupt():
@@ -96,7 +97,7 @@ def _watch(node: RskillRunnerNode, policy: str, duration: float | None) -> float
                 state = node.status
                 status.update(
                     f"{policy} on {node.robot}: {state.state} · slots "
-                    f"[{', '.join(state.seen_slots)}] · {state.actions} action(s)"
+                    f"({', '.join(state.seen_slots)}) · {state.actions} action(s)",
                 )
                 time.sleep(STATUS_PERIOD_S)
     except KeyboardInterrupt:
