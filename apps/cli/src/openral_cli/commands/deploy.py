@@ -21,6 +21,7 @@ from typing import Annotated, Any
 
 import typer
 from openral_core.errors import OpenralError
+from rich import box
 from rich.console import Console
 from rich.table import Table
 
@@ -138,17 +139,25 @@ def _shut_down(node: Any) -> None:
 
 
 def _print_interfaces(node: Any, config: Path) -> None:
+    """What the graph offers: published topics in a table (fits 80 columns), then inputs."""
     from openral_nodes.manifest_node import ESTOP, RELEASE_ESTOP, SAFE_ACTION
 
     names, _ = node.action_layout()
-    table = Table(title=f"deploy sim: {node.description.name} in {config}")
-    for column in ("", "name", "type", "rate"):
+    table = Table(
+        title=f"deploy sim: {node.description.name} in {config.name}",
+        box=box.SIMPLE_HEAD,
+        pad_edge=False,
+    )
+    for column in ("published topic", "type", "rate"):
         table.add_column(column, overflow="fold")
     for topic in node.topics():
         rate = "latched" if topic.rate_hz is None else f"{topic.rate_hz:g} Hz"
-        table.add_row("pub", topic.name, topic.type, rate)
-    table.add_row("sub", SAFE_ACTION, "std_msgs/msg/Float64MultiArray", f"{len(names)} values")
-    for service in (ESTOP, RELEASE_ESTOP):
-        table.add_row("srv", service, "std_srvs/srv/Trigger", "")
+        table.add_row(topic.name, topic.type, rate)
     out.print(table)
+    out.print(
+        f"actions:  {SAFE_ACTION} (std_msgs/msg/Float64MultiArray, {len(names)} values: "
+        f"{', '.join(names)})",
+        highlight=False,
+    )
+    out.print(f"E-stop:   {ESTOP}, {RELEASE_ESTOP} (std_srvs/srv/Trigger)", highlight=False)
     out.print("running; stop with Ctrl-C. In a second terminal: openral ros topics")
