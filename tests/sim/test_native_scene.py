@@ -76,3 +76,54 @@ def test_an_invalid_scene_file_reports_file_line_and_field(tmp_path: Path) -> No
         build_sim_env_from_yaml(bad)
     line = text.splitlines().index("  backend: native") + 1
     assert f"{bad}:{line}:3: scene.backend: expected one of native, robosuite" in str(caught.value)
+
+
+def _root_position(env: SimRollout) -> np.ndarray:
+    handles = env.mujoco_handles()
+    assert handles is not None
+    model, data = handles
+    free = [j for j in range(model.njnt) if model.jnt_type[j] == 0]  # mjJNT_FREE
+    robot_free = max(free, key=lambda j: model.jnt_qposadr[j])  # objects come first
+    address = model.jnt_qposadr[robot_free]
+    return np.array(data.qpos[address : address + 3])
+
+
+def _humanoid_scene(tmp_path: Path, weld: bool, robot: str = "g1") -> Path:
+    path = tmp_path / f"{robot}_{weld}.yaml"
+    text = (ROBOTS / "g1" / "scenes" / "tabletop.yaml").read_text()
+    text = text.replace("robot_id: g1", f"robot_id: {robot}")
+    text = text.replace(
+        "position_m: [0.0, 0.0, 0], yaw_deg: 0.0, weld: true",
+        f"position_m: [0.3, -0.2, 0], yaw_deg: 90.0, weld: {str(weld).lower()}",
+    )
+    assert "yaw_deg: 90.0" in text
+    path.write_text(text)
+    return path
+
+
+def test_a_welded_floating_base_stays_where_the_scene_puts_it(tmp_path: Path) -> None:
+    """The free objects come before the robot in qpos; the robot's base still lands at
+    base_pose (not a cube), and the weld holds it there while a loose one falls over."""
+    heights = {}
+    for weld in (True, False):
+        env = build_sim_env_from_yaml(_humanoid_scene(tmp_path, weld))
+        try:
+            env.reset(0)
+            start = _root_position(env)
+            np.testing.assert_allclose(start[:2], [0.3, -0.2], atol=1e-6)
+            crouch = env.hold_action() + 0.6  # type: ignore[attr-defined]
+            for _ in range(40):  # two seconds of a pose no one can stand in
+                env.step(crouch)
+            heights[weld] = (start[2], _root_position(env)[2])
+        finally:
+            env.close()
+    held, loose = heights[True], heights[False]
+    assert abs(held[1] - held[0]) < 0.02
+    assert loose[0] - loose[1] > 0.2  # without the weld the humanoid falls
+
+
+def test_welding_a_fixed_base_is_an_error(tmp_path: Path) -> None:
+    path = _humanoid_scene(tmp_path, True, robot="ur5e")
+    path.write_text(path.read_text().replace("cameras: [head]", "cameras: [agentview]"))
+    with pytest.raises(SceneError, match=r"base_pose\.weld: .* has a fixed base"):
+        build_sim_env_from_yaml(path)

@@ -34,6 +34,10 @@ class BasePose(OpenralModel):
     """
     Base rotation about the world z axis [deg].
     """
+    weld: bool = False
+    """
+    Floating-base robots only: hold the root body at this pose with a weld constraint, as a gantry or a stand holds a humanoid that has no balance controller. The free joint stays in the model, so no joint address changes. An error on a fixed-base robot.
+    """
 
 
 class Observation(OpenralModel):

@@ -27,7 +27,7 @@ import numpy.typing as npt
 from openral_core.errors import OpenralError
 from openral_core.models import DeployScene, DepthSensor, RgbSensor, RobotDescription
 from openral_core.registry import manifest_path
-from openral_core.tables import hal_wiring
+from openral_core.tables import hal_wiring, joint_name_map
 from openral_hal.mjcf_model import ctrl_limits
 from openral_hal.mjcf_uri import resolve_mjcf_uri
 from openral_hal.mujoco_arm import seed_position_servos
@@ -39,6 +39,8 @@ ASSETS = ("tabletop", "floor")
 models that bring their own table)."""
 DEFAULT_TABLE_HEIGHT_M = 0.75
 FORWARD_LOOKING = ("torso", "head", "pelvis", "base")
+BASE_WELD = "scene_base_weld"
+"""Name of the equality constraint that holds a welded floating base."""
 
 
 class SceneError(OpenralError):
@@ -66,6 +68,8 @@ class NativeScene:
         assert wiring is not None
         self._keyframe = wiring.keyframe_index
         self._floating = wiring.floating_base
+        self._root_body = _root_body(self.model, robot)
+        self._root_qpos = int(self.model.jnt_qposadr[self.model.body_jntadr[self._root_body]])
         self._width = scene.scene.observation.width
         self._height = scene.scene.observation.height
         options = scene.scene.options
@@ -113,6 +117,7 @@ class NativeScene:
             mujoco.mj_resetDataKeyframe(self.model, self.data, self._keyframe)
             if self._floating:
                 self._place_floating_base()
+        self._hold_base_where_it_is()
         seed_position_servos(self.model, self.data)  # nothing jumps at start
         mujoco.mj_forward(self.model, self.data)
         if self._pd is not None:  # targets are joint positions: hold the current ones
@@ -162,6 +167,22 @@ class NativeScene:
             images[sensor] = self._renderer.render().copy()
         return {"images": images, "time": float(self.data.time)}
 
+    def _hold_base_where_it_is(self) -> None:
+        """Aim the base weld (if any) at the root body's pose now: relpose is the world's
+        pose in the root body's frame."""
+        weld = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_EQUALITY, BASE_WELD)
+        if weld < 0:
+            return
+        mujoco.mj_kinematics(self.model, self.data)
+        body = self._root_body
+        inverse = np.empty(4)
+        mujoco.mju_negQuat(inverse, self.data.xquat[body])
+        position = np.empty(3)
+        mujoco.mju_rotVecQuat(position, -self.data.xpos[body], inverse)
+        self.model.eq_data[weld, 0:3] = 0.0
+        self.model.eq_data[weld, 3:6] = position
+        self.model.eq_data[weld, 6:10] = inverse
+
     def _place_floating_base(self) -> None:
         """Keyframe free-joint poses are world poses: move them to the scene's base pose."""
         pose = self.scene.base_pose
@@ -169,11 +190,12 @@ class NativeScene:
             return
         position = np.asarray(pose.position_m or [0.0, 0.0, 0.0])
         yaw = math.radians(pose.yaw_deg or 0.0)
-        self.data.qpos[0:3] += position
+        free = self._root_qpos  # the robot's free joint (objects may have their own)
+        self.data.qpos[free : free + 3] += position
         turn = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
         quat = np.empty(4)
-        mujoco.mju_mulQuat(quat, turn, self.data.qpos[3:7].copy())
-        self.data.qpos[3:7] = quat
+        mujoco.mju_mulQuat(quat, turn, self.data.qpos[free + 3 : free + 7].copy())
+        self.data.qpos[free + 3 : free + 7] = quat
 
 
 def _camera_sensors(robot: RobotDescription, wanted: Sequence[str], where: str) -> dict[str, str]:
@@ -232,20 +254,45 @@ def _compose(
     for obj in options.objects if options and options.objects else []:
         _add_object(spec, obj)
     frame = spec.worldbody.add_frame(pos=base.tolist(), quat=_yaw_quat(yaw).tolist())
-    reach = _reach(child)  # before attach: an attached spec must not be compiled again
+    child_model = child.copy().compile()  # before attach: no compile after it
+    center, radius = _robot_extent(child_model, robot)
     _add_mounted_cameras(child, robot, cameras)
     spec.attach(child, frame=frame, prefix="")
+    if pose is not None and pose.weld:
+        _add_base_weld(spec, child_model, robot)
     for sensor in robot.sensors:  # neither a model camera nor mounted: a fixed camera
         if not isinstance(sensor, RgbSensor | DepthSensor) or sensor.name not in cameras:
             continue
         if sensor.camera is None and sensor.mount_body is None:
             fovy = sensor.fovy_deg or 45.0
-            _add_fixed_camera(spec, cameras[sensor.name], base, yaw, reach, fovy)
+            target = base + _rotate(yaw, center)
+            _add_fixed_camera(spec, cameras[sensor.name], target, yaw, radius, fovy)
     try:
         return spec.compile()
     except ValueError as error:
         problem = f"scene {scene.scene.id!r} for {robot.name!r} does not compile: {error}"
         raise SceneError(problem) from None
+
+
+def _add_base_weld(
+    spec: mujoco.MjSpec, child_model: mujoco.MjModel, robot: RobotDescription
+) -> None:
+    """A weld holding the floating root body; its pose is set at every reset."""
+    assert robot.sim is not None
+    if not robot.sim.floating_base:
+        raise SceneError(
+            f"base_pose.weld: robot {robot.name!r} has a fixed base; only a floating base "
+            "can be welded in place"
+        )
+    root = _root_body(child_model, robot)
+    timestep = spec.option.timestep
+    spec.add_equality(
+        name=BASE_WELD,
+        type=mujoco.mjtEq.mjEQ_WELD,
+        objtype=mujoco.mjtObj.mjOBJ_BODY,
+        name1=mujoco.mj_id2name(child_model, mujoco.mjtObj.mjOBJ_BODY, root),
+        solref=[2 * timestep, 1.0],  # as stiff as the time step allows
+    )
 
 
 def _add_world(spec: mujoco.MjSpec) -> None:
@@ -312,29 +359,51 @@ def _add_mounted_cameras(
 
 
 def _add_fixed_camera(
-    spec: mujoco.MjSpec, name: str, base: np.ndarray, yaw: float, reach: float, fovy: float
+    spec: mujoco.MjSpec, name: str, target: np.ndarray, yaw: float, radius: float, fovy: float
 ) -> None:
-    target = base + _rotate(yaw, np.array([0.4 * reach, 0.0, 0.25 * reach]))
-    eye = base + _rotate(yaw, np.array([1.9 * reach, 0.35 * reach, 1.1 * reach]))
-    forward = target - eye
-    forward /= np.linalg.norm(forward)
+    """A world camera in front of the robot, above and to one side, that fits a sphere of
+    ``radius`` around ``target`` into its field of view."""
+    direction = _rotate(yaw, np.array([1.0, 0.3, 0.55]))
+    direction /= np.linalg.norm(direction)
+    distance = 1.1 * radius / math.sin(math.radians(fovy) / 2)
+    eye = target + distance * direction
+    forward = -direction
     right = np.cross(forward, [0.0, 0.0, 1.0])
     right /= np.linalg.norm(right)
     up = np.cross(right, forward)
     spec.worldbody.add_camera(name=name, pos=eye.tolist(), xyaxes=[*right, *up], fovy=fovy)
 
 
-def _reach(child: mujoco.MjSpec) -> float:
-    """Largest distance of any body from the model origin, at least 0.3 m."""
-    model = child.copy().compile()
+def _root_body(model: mujoco.MjModel, robot: RobotDescription) -> int:
+    """The robot's root body (the world's child that carries its first manifest joint)."""
+    first = next(iter(joint_name_map(robot).values()))
+    joint = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, first)
+    return int(model.body_rootid[model.jnt_bodyid[joint]])
+
+
+def _robot_extent(model: mujoco.MjModel, robot: RobotDescription) -> tuple[np.ndarray, float]:
+    """Centre and radius (at least 0.2 m) of the robot's links in its start pose, in the
+    model's frame; only bodies moved by the manifest's joints and their bases count, so a
+    table or a prop in the robot's file does not widen the view. A floating base's
+    horizontal offset is removed (the scene puts the base at ``base_pose``)."""
     data = mujoco.MjData(model)
     if model.nkey:
         mujoco.mj_resetDataKeyframe(model, data, 0)
     mujoco.mj_kinematics(model, data)
-    points = data.xpos[1:]
-    if model.njnt and model.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE:
-        points = points - data.xpos[model.jnt_bodyid[0]] * np.array([1, 1, 0])
-    return max(0.3, float(np.linalg.norm(points, axis=1).max()) if len(points) else 0.3)
+    joint = mujoco.mjtObj.mjOBJ_JOINT
+    mjcf_names = joint_name_map(robot).values()
+    bodies = {
+        int(model.jnt_bodyid[i])
+        for i in range(model.njnt)
+        if mujoco.mj_id2name(model, joint, i) in mjcf_names
+    }
+    bodies |= {int(model.body_parentid[b]) for b in bodies}
+    bodies.discard(0)
+    points = data.xpos[sorted(bodies)] if bodies else data.xpos[1:]
+    if robot.sim is not None and robot.sim.floating_base:
+        points = points - data.xpos[_root_body(model, robot)] * np.array([1, 1, 0])
+    low, high = points.min(axis=0), points.max(axis=0)
+    return (low + high) / 2, max(0.2, float(np.linalg.norm(high - low)) / 2)
 
 
 def _pd_law(robot: RobotDescription, model: mujoco.MjModel) -> Any:
