@@ -1,37 +1,32 @@
 """Real-rclpy fixtures for the rskill runner and ``openral ros`` tests.
 
-Every test process claims its own ROS domain (a lock file per domain id, held until the
-process exits) and keeps discovery on loopback, so parallel test runs and other agents'
-graphs on this machine never see each other. ``FakeGraph`` plays the part of
-``openral deploy sim``: franka camera frames of distinct solid colours, joint states and a
-latched action spec; it records what arrives on ``/openral/safe_action``.
+Every test process claims its own ROS domain (``claim_domain_id``: a lock file held until
+the process exits, shared with the deploy-sim tests) and keeps discovery on loopback, so
+parallel test runs and other graphs on this machine never see each other. ``FakeGraph``
+plays the part of ``openral deploy sim``: franka camera frames of distinct solid colours,
+joint states and a latched action spec; it records what arrives on ``/openral/safe_action``.
 """
 
 from __future__ import annotations
 
-import fcntl
 import os
 import threading
 import time
 from collections.abc import Callable, Iterator
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 from openral_bridge.ros_messages import image_msg, joint_state_msg, stamp
-from openral_nodes.runtime import Spinner, ros_session
+from openral_nodes.rskill_runner import ACTION_SPEC_QOS
+from openral_nodes.runtime import Spinner, claim_domain_id, ros_session
 from rclpy.context import Context
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float64MultiArray
 
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-
-DOMAIN_RANGE = range(60, 100)
-"""Domain ids this suite may claim (FastDDS ports stay valid below 102)."""
-_DOMAIN_LOCK: Any = None
+DOMAIN_ID = claim_domain_id()
 
 FRANKA_JOINTS = [f"panda_joint{i}" for i in range(1, 8)] + ["panda_finger_joint1"]
 HOLD = np.array([0.0, -0.4, 0.0, -2.2, 0.0, 1.9, 0.8, 0.04])
@@ -41,27 +36,6 @@ COLOURS = {"agentview": (200, 40, 10), "wrist": (10, 60, 220)}
 """Solid RGB colour of each fake camera, so a frame shows which sensor it came from."""
 FRAME_SHAPE = (48, 64)
 CAMERA_HZ = 10.0
-
-
-def _claim_domain() -> int:
-    """Lock the first free domain id of DOMAIN_RANGE for this process's lifetime."""
-    global _DOMAIN_LOCK
-    start = os.getpid() % len(DOMAIN_RANGE)
-    for offset in range(len(DOMAIN_RANGE)):
-        domain = DOMAIN_RANGE[(start + offset) % len(DOMAIN_RANGE)]
-        handle = Path(f"/tmp/openral-ros-domain-{domain}.lock").open("w")  # noqa: SIM115
-        try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            handle.close()
-            continue
-        _DOMAIN_LOCK = handle
-        return domain
-    raise RuntimeError(f"every ROS domain in {DOMAIN_RANGE} is taken")
-
-
-DOMAIN_ID = _claim_domain()
-os.environ["ROS_DOMAIN_ID"] = str(DOMAIN_ID)
 
 
 def wait_until(condition: Callable[[], bool], timeout_s: float = 10.0) -> bool:
@@ -77,26 +51,18 @@ def wait_until(condition: Callable[[], bool], timeout_s: float = 10.0) -> bool:
 class FakeGraph(Node):
     """What ``openral deploy sim`` publishes for franka, minus the simulation."""
 
-    def __init__(self, context: Context, cameras: tuple[str, ...]) -> None:
+    def __init__(self, context: Context, cameras: tuple[str, ...], action_spec: bool) -> None:
         super().__init__("fake_deploy_sim", context=context)
         self.actions: list[np.ndarray] = []
         self._lock = threading.Lock()
         self._cameras = {
-            name: self.create_publisher(
-                type(image_msg(np.zeros((1, 1, 3), np.uint8), stamp(0), "")),
-                f"/openral/cameras/{name}/image",
-                5,
-            )
+            name: self.create_publisher(Image, f"/openral/cameras/{name}/image", 5)
             for name in cameras
         }
-        latched = QoSProfile(
-            depth=1,
-            durability=DurabilityPolicy.TRANSIENT_LOCAL,
-            reliability=ReliabilityPolicy.RELIABLE,
-        )
         spec = JointState(name=FRANKA_JOINTS, position=HOLD.tolist())
-        self._spec_pub = self.create_publisher(JointState, "/openral/action_spec", latched)
-        self._spec_pub.publish(spec)
+        self._spec_pub = self.create_publisher(JointState, "/openral/action_spec", ACTION_SPEC_QOS)
+        if action_spec:
+            self._spec_pub.publish(spec)
         self._joints = self.create_publisher(JointState, "/joint_states", 10)
         self.create_subscription(Float64MultiArray, "/openral/safe_action", self._on_action, 10)
         self.create_timer(1.0 / CAMERA_HZ, self._publish)
@@ -133,8 +99,10 @@ class RosHarness:
         self.spinner.add_node(node)
         return node
 
-    def fake_graph(self, cameras: tuple[str, ...] = ("agentview", "wrist")) -> FakeGraph:
-        graph = FakeGraph(self.context, cameras)
+    def fake_graph(
+        self, cameras: tuple[str, ...] = ("agentview", "wrist"), action_spec: bool = True
+    ) -> FakeGraph:
+        graph = FakeGraph(self.context, cameras, action_spec)
         self.add(graph)
         return graph
 

@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 from tests.ros_runner.conftest import COLOURS, DOMAIN_ID, FRAME_SHAPE, RosHarness
 
 runner = CliRunner()
-WIDE = {"COLUMNS": "200"}
+WIDE = {"COLUMNS": "200", "ROS_DOMAIN_ID": str(DOMAIN_ID)}
 
 
 def read_png(path: Path) -> np.ndarray:

@@ -24,7 +24,7 @@ def test_run_for_a_duration_publishes_waves_and_exits_0(ros: RosHarness) -> None
     result = CliRunner().invoke(
         app,
         ["rskill", "run", "--robot", "franka_panda", "--duration", "4", "-p", "amplitude=0.2"],
-        env={"COLUMNS": "300"},
+        env={"COLUMNS": "300", "ROS_DOMAIN_ID": str(DOMAIN_ID)},
     )
     assert result.exit_code == 0, result.output
     match = SUMMARY.search(result.output)

@@ -6,10 +6,17 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 from openral_nodes.policies import Observation
-from openral_nodes.rskill_runner import MissingSlots, RskillRunnerNode, runner_parameters
+from openral_nodes.rskill_runner import (
+    MissingSlots,
+    RskillRunnerNode,
+    RunnerAborted,
+    runner_parameters,
+)
+from openral_nodes.runtime import ros_session
 
 from tests.ros_runner.conftest import (
     COLOURS,
+    DOMAIN_ID,
     FRAME_SHAPE,
     HOLD,
     JOINT_POSITIONS,
@@ -92,11 +99,23 @@ def test_runner_aborts_naming_expected_and_seen_slots_when_a_camera_is_silent(
     assert runner.status.state == "aborted" and graph.received() == []
 
 
+def test_runner_aborts_naming_the_silent_topic_when_the_action_spec_never_comes(
+    ros: RosHarness,
+) -> None:
+    graph = ros.fake_graph(action_spec=False)
+    params = runner_parameters("franka_panda", frame_timeout_s=2.5)
+    runner = RskillRunnerNode(context=ros.context, parameter_overrides=params)
+    ros.add(runner)
+    assert wait_until(lambda: runner.abort_error is not None)
+    assert isinstance(runner.abort_error, RunnerAborted)
+    assert str(runner.abort_error) == (
+        "no message on /openral/action_spec within 2.5 s; is `openral deploy sim` running on "
+        f"ROS_DOMAIN_ID={DOMAIN_ID}?"
+    )
+    assert graph.received() == []
+
+
 def test_runner_refuses_a_policy_whose_slots_the_manifest_lacks() -> None:
-    from openral_nodes.runtime import ros_session
-
-    from tests.ros_runner.conftest import DOMAIN_ID
-
     with ros_session(DOMAIN_ID) as context, pytest.raises(MissingSlots) as caught:
         RskillRunnerNode(context=context, parameter_overrides=runner_parameters("g1"))
     assert str(caught.value) == (

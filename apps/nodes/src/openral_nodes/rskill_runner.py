@@ -61,7 +61,7 @@ def realign_frames(frames: Mapping[str, T], slots: Sequence[VlaSlot]) -> dict[st
 
 
 def _slot_list(slots: Sequence[str]) -> str:
-    return ", ".join(slots) if slots else "(none)"
+    return ", ".join(slots) if slots else "none"
 
 
 class MissingSlots(OpenralError):
@@ -75,13 +75,14 @@ class MissingSlots(OpenralError):
         seen: Sequence[str],
         table: Sequence[VlaSlot],
         where: str,
+        hint: str = "",
     ) -> None:
         self.expected = tuple(expected)
         self.seen = tuple(seen)
         routes = ", ".join(f"{e.slot} <- {CAMERA_TOPIC.format(sensor=e.sensor)}" for e in table)
         super().__init__(
             f"policy {policy} needs camera slots ({_slot_list(expected)}) but {where} "
-            f"({_slot_list(seen)}); {robot}: {routes or 'no RGB sensors'}"
+            f"({_slot_list(seen)}); {robot}: {routes or 'no RGB sensors'}{hint}"
         )
 
 
@@ -249,6 +250,9 @@ class RskillRunnerNode(Node):
         self.status = RunnerStatus("running", seen, self.status.actions + 1)
 
     def _missing_input_error(self, missing_slots: list[str], seen: list[str]) -> OpenralError:
+        domain = self.context.get_domain_id()
+        graph_hint = f"; is `openral deploy sim` running on ROS_DOMAIN_ID={domain}?"
+        nothing = not self._frames and self._spec is None and not self._joints
         if missing_slots:
             where = f"got frames within {self.frame_timeout_s:g} s only for"
             return MissingSlots(
@@ -258,6 +262,7 @@ class RskillRunnerNode(Node):
                 seen,
                 self.slot_table,
                 where,
+                graph_hint if nothing else "",
             )
         absent = [
             topic
@@ -265,8 +270,7 @@ class RskillRunnerNode(Node):
             if not ok
         ]
         return RunnerAborted(
-            f"no message on {' or '.join(absent)} within {self.frame_timeout_s:g} s; "
-            "is `openral deploy sim` running on this ROS domain?"
+            f"no message on {' or '.join(absent)} within {self.frame_timeout_s:g} s{graph_hint}"
         )
 
     def _abort(self, error: OpenralError) -> None:

@@ -16,12 +16,15 @@ from typing import Any
 
 from openral_core.errors import OpenralError
 from rclpy.node import Node
-from rclpy.qos import qos_profile_best_available
+from rclpy.qos import QoSProfile, qos_profile_best_available, qos_profile_sensor_data
 
 from openral_nodes.topic_graph import TopicInfo, message_class
 
 QUEUE_DEPTH = 10
-"""Messages buffered for the reader; older ones are dropped when it falls behind."""
+"""Messages buffered for the reader; newer ones are dropped when it falls behind."""
+RATE_QOS: QoSProfile = qos_profile_sensor_data
+"""Rate measurement: best effort (matches any publisher) and volatile (a latched
+message already published is not replayed and counted)."""
 
 
 class NoMessage(OpenralError):
@@ -70,8 +73,10 @@ def subscribe(node: Node, info: TopicInfo) -> Iterator[Inbox]:
 def measure_rates(
     node: Node, topics: Sequence[TopicInfo], window_s: float
 ) -> dict[str, float | None]:
-    """Receive rate [Hz] of each topic over ``window_s``; None when under two messages arrived
-    or the type is not importable here."""
+    """Receive rate [Hz] of each topic over ``window_s``.
+
+    None when fewer than two messages arrived or the type is not importable here.
+    """
     arrivals: dict[str, list[float]] = {info.name: [] for info in topics}
     subscriptions = []
     for info in topics:
@@ -80,9 +85,7 @@ def measure_rates(
         except OpenralError:
             continue
         callback = _stamper(arrivals[info.name])
-        subscriptions.append(
-            node.create_subscription(cls, info.name, callback, qos_profile_best_available)
-        )
+        subscriptions.append(node.create_subscription(cls, info.name, callback, RATE_QOS))
     try:
         time.sleep(window_s)
     finally:

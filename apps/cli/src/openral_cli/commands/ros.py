@@ -93,9 +93,9 @@ def topics(
     table = Table(title=f"ROS_DOMAIN_ID={domain}")
     table.add_column("topic", no_wrap=True)
     table.add_column("type", overflow="fold")
-    table.add_column("publishers", justify="right")
+    table.add_column("pubs", justify="right", no_wrap=True)
     if rate:
-        table.add_column("rate (Hz)", justify="right")
+        table.add_column("Hz", justify="right", no_wrap=True)
     for info in infos:
         row = [info.name, ", ".join(info.types), str(info.publishers)]
         if rate:
