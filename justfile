@@ -10,11 +10,9 @@ export MUJOCO_GL := env_var_or_default("MUJOCO_GL", "egl")
 default:
     @just --list
 
-# The main job: list the robots, validate every manifest and check it against its model.
+# The main job: the Panda's default scene as a live ROS 2 graph, headless, until Ctrl-C.
 demo:
-    openral robot list
-    openral robot validate --all
-    openral robot check --all
+    openral deploy sim --config robots/franka_panda/scenes/tabletop.yaml --no-viewer
 
 # The whole test suite (extra arguments go to pytest).
 test *ARGS:
@@ -55,3 +53,7 @@ bench-hal *ARGS:
 # Native franka tabletop against robosuite Lift through SimAttachedHAL; writes benchmarks/results/scene_step.json.
 bench-scene *ARGS:
     python -m benchmarks.scene_step {{ARGS}}
+
+# deploy sim start-up (first state, first frames), camera rate and CPU; writes benchmarks/results/deploy_startup.json.
+bench-deploy *ARGS:
+    python -m benchmarks.deploy_startup {{ARGS}}
