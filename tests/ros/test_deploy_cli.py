@@ -74,3 +74,17 @@ def test_a_missing_scene_exits_1_with_one_line(tmp_path: Path) -> None:
     lines = err.strip().splitlines()
     assert len(lines) == 1, err
     assert "no such scene file" in lines[0] and str(missing) in lines[0]
+
+
+def test_a_scene_that_fails_at_configure_exits_1_with_one_line(tmp_path: Path) -> None:
+    scene = tmp_path / "bad_camera.yaml"
+    text = FRANKA_SCENE.read_text()
+    assert text.count("cameras: [agentview, wrist]") == 1
+    scene.write_text(text.replace("cameras: [agentview, wrist]", "cameras: [agentview, nosuch]"))
+    process = deploy("--config", str(scene), domain=claim_domain_id())
+    _, err = process.communicate(timeout=EXIT_WAIT_S)
+    assert process.returncode == 1
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("error: configure failed:")
+    assert "'nosuch' is not a camera sensor" in lines[0] and "agentview, wrist" in lines[0]
