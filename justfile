@@ -35,13 +35,17 @@ schema-export:
 schema-check:
     python -m openral_codegen check
 
-# Build the docs site strictly into site/.
+# Build the docs site strictly into site/ (a warning, broken link or missing picture fails).
 docs:
-    mkdocs build --strict --site-dir site
+    NO_MKDOCS_2_WARNING=1 mkdocs build --strict --site-dir site
 
-# Serve the docs site with live reload.
+# Serve the docs site with live reload on http://127.0.0.1:8000.
 docs-serve:
-    mkdocs serve
+    NO_MKDOCS_2_WARNING=1 mkdocs serve
+
+# Render the robot pictures of the docs (all robots, or the ids given) offscreen.
+docs-images *IDS:
+    python -m openral_codegen images {{IDS}}
 
 # The static checks CI runs after the tests: lint, types, generated-tree drift.
 check: lint typecheck schema-check

@@ -1,7 +1,8 @@
 """Build the complete generated tree, then write it or compare it.
 
-The generator owns two folders outright: ``generated/`` and ``docs/reference/``. Export
-writes every file and deletes files it no longer produces; check compares both ways, so
+The generator owns three folders outright: ``generated/``, ``docs/reference/`` and
+``docs/robots/``, plus the robots-nav region of ``mkdocs.yml``. Export writes every file
+and deletes files it no longer produces in the owned folders; check compares both ways, so
 a stale, edited, missing or orphaned file is reported.
 
 Models are produced first and without importing ``openral_core`` (which imports them);
@@ -16,7 +17,8 @@ from pathlib import Path
 
 from openral_codegen.models import CodegenError, generate_models
 
-OWNED_DIRS = ("generated", "docs/reference")
+OWNED_DIRS = ("generated", "docs/reference", "docs/robots")
+"""Folders the generator owns outright (it also rewrites the robots-nav region of mkdocs.yml)."""
 MODELS_DIR = "generated/openral_generated/models"
 REPO_ROOT = Path(__file__).resolve().parents[4]
 
@@ -59,20 +61,18 @@ def model_files(root: Path) -> ExportFiles:
 def derived_files(root: Path) -> ExportFiles:
     """Per-robot tables and the schema reference pages, keyed by repo-relative path."""
     from openral_core.errors import ManifestError
-    from openral_core.loader import load_robot
+    from openral_core.loader import load_robot, load_scene
     from openral_core.registry import manifest_path, robot_ids
-    from openral_core.schemas import SchemaName
     from openral_core.tables import robot_tables
 
-    from openral_codegen.schema_docs import (
-        page_name,
-        read_schemas,
-        reference_index,
-        render_schema_page,
-    )
+    from openral_codegen.manifest_examples import collect_examples
+    from openral_codegen.robot_docs import RobotSource, robot_pages, with_robots_nav
+    from openral_codegen.rule_examples import rule_examples
+    from openral_codegen.schema_docs import read_schemas, render_reference
 
     files: ExportFiles = {}
     problems = []
+    sources: list[RobotSource] = []
     robots = root / "robots"
     for robot_id in robot_ids(robots):
         try:
@@ -80,14 +80,36 @@ def derived_files(root: Path) -> ExportFiles:
         except ManifestError as error:
             problems.append(str(error))
             continue
-        table = robot_tables(robot).to_json()
-        files[f"generated/openral_generated/tables/{robot_id}.json"] = table.encode()
+        tables = robot_tables(robot)
+        files[f"generated/openral_generated/tables/{robot_id}.json"] = tables.to_json().encode()
+        folder = robots / robot_id
+        scenes = {}
+        for scene_file in sorted(folder.glob("scenes/*.yaml"), key=lambda p: p.stem != "tabletop"):
+            try:
+                scenes[scene_file.relative_to(root).as_posix()] = load_scene(scene_file)
+            except ManifestError as error:
+                problems.append(str(error))
+        readme = folder / "README.md"
+        sources.append(
+            RobotSource(
+                robot=robot,
+                tables=tables,
+                manifest_text=(folder / "robot.yaml").read_text("utf-8"),
+                readme=readme.read_text("utf-8") if readme.is_file() else "",
+                scenes=scenes,
+            )
+        )
     if problems:
         raise CodegenError("cannot export tables of invalid manifests:\n" + "\n".join(problems))
     schemas = read_schemas(root / "schema")
-    for name in SchemaName:
-        files[f"docs/reference/{page_name(name)}"] = render_schema_page(name, schemas).encode()
-    files["docs/reference/index.md"] = reference_index(schemas).encode()
+    examples = collect_examples(root, schemas)
+    for page, text in render_reference(schemas, examples, rule_examples(root)).items():
+        files[f"docs/reference/{page}"] = text.encode()
+    for page, text in robot_pages(sources).items():
+        files[f"docs/robots/{page}"] = text.encode()
+    mkdocs_yml = root / "mkdocs.yml"
+    if mkdocs_yml.is_file():
+        files["mkdocs.yml"] = with_robots_nav(mkdocs_yml.read_text("utf-8"), sources).encode()
     return files
 
 
@@ -110,7 +132,7 @@ def check(root: Path = REPO_ROOT) -> list[str]:
     existing = set(_existing(root))
     problems = []
     for rel, content in sorted(planned.items()):
-        if rel not in existing:
+        if not (root / rel).is_file():
             problems.append(f"missing: {rel}")
         elif (root / rel).read_bytes() != content:
             problems.append(f"stale or edited: {rel}")

@@ -1,22 +1,37 @@
 """Render the JSON Schemas as Markdown reference pages for the docs site.
 
-One page per schema file: the schema's description, one table per object (top level and
-each ``$defs`` entry) listing every property with its type, constraints, default and
-description, and the cross-field rules from ``$comment``.
+Each schema file gets a page (the gripper definitions of ``sim.schema.json`` get their own).
+A page has one section per object, top level first, with a table giving every property's
+type, whether it is required, its default, its allowed values, its description and a value
+a real manifest uses; a YAML excerpt of a real instance follows the table. Rules that JSON
+Schema cannot state come last, each with the error the validator prints when it is broken.
 """
 
 from __future__ import annotations
 
 import json
 from collections.abc import Mapping
+from dataclasses import dataclass
+from io import StringIO
 from pathlib import Path
 from typing import Any
 
 from openral_core.schemas import SchemaName
+from ruamel.yaml import YAML
+
+from openral_codegen.manifest_examples import (
+    MAX_EXAMPLE_CHARS,
+    ManifestExamples,
+    Sample,
+    flow,
+    short_flow,
+)
+from openral_codegen.rule_examples import RuleExample, numbered_rules
 
 Schemas = Mapping[SchemaName, dict[str, Any]]
 
 HEADER = "<!-- GENERATED from schema/ by `just schema-export` -- do not edit. -->\n"
+MAX_SNIPPET_LINES = 25
 
 _CONSTRAINTS = (
     ("minimum", "≥ {}"),
@@ -31,9 +46,47 @@ _CONSTRAINTS = (
 )
 
 
-def page_name(name: SchemaName) -> str:
-    """File name of the reference page of ``name`` (inside docs/reference/)."""
-    return f"{name.value}.md"
+@dataclass(frozen=True)
+class ReferencePage:
+    """One reference page: a schema file, or the named ``$defs`` of one.
+
+    Attributes:
+        slug: File stem inside ``docs/reference/``.
+        schema: The schema file the page documents.
+        defs: The ``$defs`` on this page; None means the top level and every definition
+            no other page claims.
+        title: Page title; None means the schema's title.
+        intro: Text under the title; None means the schema's description.
+    """
+
+    slug: str
+    schema: SchemaName
+    defs: tuple[str, ...] | None = None
+    title: str | None = None
+    intro: str | None = None
+
+
+GRIPPER_INTRO = (
+    "A gripper is one canonical joint of the robot (its driving finger or jaw) plus a "
+    "`sim.grippers[]` entry that says how that joint is read from the model and written to "
+    "its actuator. Readers and writers are chosen per gripper, so parallel fingers, tendon "
+    "grippers and position-driven jaws share one HAL. The modes and the fields below are part "
+    "of [SimDescription](sim.md); the last table shows what every robot in `robots/` uses."
+)
+
+PAGES = (
+    ReferencePage("robot", SchemaName.ROBOT),
+    ReferencePage("sim", SchemaName.SIM),
+    ReferencePage(
+        "grippers",
+        SchemaName.SIM,
+        defs=("SimGripperDescription", "GripperReadMode", "GripperWriteMode"),
+        title="Grippers",
+        intro=GRIPPER_INTRO,
+    ),
+    ReferencePage("scene", SchemaName.SCENE),
+)
+"""Every reference page, in navigation order."""
 
 
 def read_schemas(schema_dir: Path) -> dict[SchemaName, dict[str, Any]]:
@@ -41,25 +94,9 @@ def read_schemas(schema_dir: Path) -> dict[SchemaName, dict[str, Any]]:
     return {n: json.loads((schema_dir / n.file_name).read_text("utf-8")) for n in SchemaName}
 
 
-def render_schema_page(name: SchemaName, schemas: Schemas) -> str:
-    """The Markdown reference page of schema ``name``."""
-    schema = schemas[name]
-    parts = [
-        HEADER,
-        f"# {schema['title']}\n",
-        f"{schema['description']}\n",
-        f"Source: `schema/{name.file_name}` (JSON Schema draft 2020-12, `$id` "
-        f"`{schema['$id']}`).\n",
-        _object_section(schema["title"], schema, schemas, with_description=False),
-    ]
-    for def_name, definition in schema.get("$defs", {}).items():
-        if definition.get("type") == "object":
-            parts.append(_object_section(def_name, definition, schemas))
-        else:
-            parts.append(_value_section(def_name, definition, schemas))
-    if "$comment" in schema:
-        parts.append("## Rules checked after the schema\n\n" + _rules(schema["$comment"]))
-    return "\n".join(parts)
+def page_files(name: SchemaName) -> list[str]:
+    """File names (inside docs/reference/) of the pages that document schema ``name``."""
+    return [f"{page.slug}.md" for page in PAGES if page.schema is name]
 
 
 def property_names(schema: dict[str, Any]) -> set[str]:
@@ -79,76 +116,304 @@ def property_names(schema: dict[str, Any]) -> set[str]:
     return names
 
 
-def _object_section(
-    title: str, schema: dict[str, Any], schemas: Schemas, *, with_description: bool = True
-) -> str:
-    lines = [f"## {title}\n"]
-    if with_description and schema.get("description"):
-        lines.append(f"{schema['description']}\n")
-    required = set(schema.get("required", []))
-    lines.append("| Field | Type | Required | Default | Constraints | Description |")
-    lines.append("|---|---|---|---|---|---|")
-    for prop, spec in schema.get("properties", {}).items():
-        default = f"`{json.dumps(spec['default'])}`" if "default" in spec else ""
-        lines.append(
-            "| "
-            + " | ".join(
-                [
-                    f"`{prop}`",
-                    _type_text(spec, schemas),
-                    "yes" if prop in required else "no",
-                    default,
-                    _constraint_text(spec),
-                    _cell(spec.get("description", "")),
-                ]
+def render_reference(
+    schemas: Schemas, examples: ManifestExamples, rules: list[RuleExample]
+) -> dict[str, str]:
+    """Every reference page and the index, keyed by file name inside docs/reference/."""
+    renderer = _Renderer(schemas, examples, rules)
+    pages = {f"{page.slug}.md": renderer.page(page) for page in PAGES}
+    pages["index.md"] = renderer.index()
+    return pages
+
+
+class _Renderer:
+    """Renders pages; knows which page holds each section, for cross-page links."""
+
+    def __init__(
+        self, schemas: Schemas, examples: ManifestExamples, rules: list[RuleExample]
+    ) -> None:
+        self.schemas = schemas
+        self.examples = examples
+        self.rules = rules
+        self.home: dict[tuple[SchemaName, str], str] = {}
+        for page in PAGES:
+            for def_name in self._defs_of(page):
+                self.home[page.schema, def_name] = page.slug
+            if page.defs is None:
+                self.home[page.schema, schemas[page.schema]["title"]] = page.slug
+
+    def _defs_of(self, page: ReferencePage) -> list[str]:
+        defs = list(self.schemas[page.schema].get("$defs", {}))
+        if page.defs is not None:
+            return [d for d in defs if d in page.defs]
+        claimed = {d for p in PAGES if p.schema is page.schema and p.defs for d in p.defs}
+        return [d for d in defs if d not in claimed]
+
+    # -- pages -----------------------------------------------------------------------------
+
+    def page(self, page: ReferencePage) -> str:
+        schema = self.schemas[page.schema]
+        source = f"schema/{page.schema.file_name}"
+        parts = [
+            HEADER,
+            f"# {page.title or schema['title']}\n",
+            f"{page.intro or schema['description']}\n",
+            f'!!! note "Generated page"\n    Generated from `{source}` (JSON Schema draft '
+            "2020-12) by `just schema-export`. To change it, edit the schema and regenerate.\n",
+        ]
+        if page.defs is None:
+            parts.append(self._object_section(page, schema["title"], schema, top=True))
+        for def_name in self._defs_of(page):
+            definition = schema["$defs"][def_name]
+            if definition.get("type") == "object":
+                parts.append(self._object_section(page, def_name, definition))
+            else:
+                parts.append(self._value_section(page, def_name, definition))
+        if page.slug == "grippers":
+            parts.append(self._gripper_usage())
+        if page.defs is None and "$comment" in schema:
+            parts.append(self._rules_section(page.schema, schema["$comment"]))
+        return "\n".join(parts)
+
+    def index(self) -> str:
+        lines = [
+            HEADER,
+            "# Schema reference\n",
+            "Every field of every contract file, generated from the JSON Schemas in `schema/` "
+            "(the single source of truth). Each field lists its type, whether it is required, "
+            "its default, the values it allows, what it means and a value that a manifest in "
+            "`robots/` really uses. Rules that a JSON Schema cannot express are listed at the "
+            "end of each page, together with the exact error the validator prints.\n",
+            "| Page | Documents |",
+            "|---|---|",
+        ]
+        for page in PAGES:
+            schema = self.schemas[page.schema]
+            what = (
+                f"`schema/{page.schema.file_name}`: {schema['description']}"
+                if page.defs is None
+                else f"part of `schema/{page.schema.file_name}`: "
+                + ", ".join(f"`{d}`" for d in page.defs)
             )
-            + " |"
+            lines.append(f"| [{page.title or schema['title']}]({page.slug}.md) | {_cell(what)} |")
+        return "\n".join(lines) + "\n"
+
+    # -- sections --------------------------------------------------------------------------
+
+    def _object_section(
+        self, page: ReferencePage, title: str, schema: dict[str, Any], *, top: bool = False
+    ) -> str:
+        section = (page.schema, title)
+        lines = [f"## {title}\n"]
+        if not top and schema.get("description"):
+            lines.append(f"{schema['description']}\n")
+        required = set(schema.get("required", []))
+        lines.append(
+            "| Field | Type | Required | Default | Allowed values | Description | Example |"
         )
-    conditions = _conditions(schema)
-    if conditions:
-        lines.append("\n" + conditions)
-    return "\n".join(lines) + "\n"
+        lines.append("|---|---|---|---|---|---|---|")
+        for prop, spec in schema.get("properties", {}).items():
+            default = f"`{flow(spec['default'])}`" if "default" in spec else ""
+            cells = [
+                f"`{prop}`",
+                self._type_text(page, spec),
+                "yes" if prop in required else "no",
+                default,
+                self._allowed_text(page, spec),
+                _cell(spec.get("description", "")),
+                self._example_cell(page, section, prop, spec),
+            ]
+            lines.append("| " + " | ".join(cells) + " |")
+        conditions = _conditions(schema)
+        if conditions:
+            lines.append("\n" + conditions)
+        lines.append(self._snippet(section))
+        return "\n".join(lines) + "\n"
 
+    def _value_section(self, page: ReferencePage, title: str, schema: dict[str, Any]) -> str:
+        text = f"## {title}\n\n{schema.get('description', '')}\n\n"
+        if "enum" in schema:
+            text += "Allowed values: " + ", ".join(f"`{v}`" for v in schema["enum"]) + ".\n"
+        elif "oneOf" in schema:
+            options = [self._type_text(page, option) for option in schema["oneOf"]]
+            text += "Exactly one of: " + ", ".join(options) + ".\n"
+        else:
+            kind = schema.get("type", "any")
+            found = _constraint_text(schema)
+            text += f"Type: {kind}" + (f", {found}" if found else "") + ".\n"
+        return text
 
-def _value_section(title: str, schema: dict[str, Any], schemas: Schemas) -> str:
-    text = f"## {title}\n\n{schema.get('description', '')}\n\n"
-    if "enum" in schema:
-        text += "Allowed values: " + ", ".join(f"`{v}`" for v in schema["enum"]) + ".\n"
-    if "oneOf" in schema:
-        options = [_type_text(option, schemas) for option in schema["oneOf"]]
-        text += "Exactly one of: " + ", ".join(options) + ".\n"
-    return text
+    def _rules_section(self, name: SchemaName, comment: str) -> str:
+        head, numbered = numbered_rules(comment)
+        lines = [
+            "## Rules checked after the schema\n",
+            f"{head}.\n" if numbered else f"{comment}\n",
+        ]
+        if name is SchemaName.SIM:
+            lines.append(
+                "They are listed, each with the error it produces, under "
+                "[RobotDescription: rules](robot.md#rules-checked-after-the-schema).\n"
+            )
+        examples = [e for e in self.rules if e.broken.schema is name]
+        by_rule = {e.broken.rule: e for e in examples}
+        if numbered:
+            for number, text in numbered.items():
+                lines.append(f"### Rule {number}: {text}\n")
+                example = by_rule.get(number)
+                lines.append(_broken_text(example) if example else "No example yet.\n")
+        else:
+            for example in examples:
+                lines.append(f"### {example.broken.rule}\n")
+                lines.append(_broken_text(example))
+        return "\n".join(lines) + "\n"
 
+    def _gripper_usage(self) -> str:
+        section = (SchemaName.SIM, "SimGripperDescription")
+        props = self.schemas[SchemaName.SIM]["$defs"]["SimGripperDescription"]["properties"]
+        columns = ("joint", "read_mode", "write_mode", "ctrl_range", "qpos_addrs", "qpos_scale")
+        lines = [
+            "## Grippers in the manifests\n",
+            "Every `sim.grippers[]` entry in `robots/`; a value in italics is the default.\n",
+            "| Robot | " + " | ".join(f"`{c}`" for c in columns) + " |",
+            "|---|" + "---|" * len(columns),
+        ]
+        for sample in sorted(self.examples.instances.get(section, []), key=lambda s: s.source):
+            cells = []
+            for column in columns:
+                if column in sample.value:
+                    cells.append(f"`{flow(sample.value[column])}`")
+                else:
+                    cells.append(f"*{flow(props[column].get('default', ''))}*")
+            lines.append(
+                f"| [{sample.source}](../robots/{sample.source}.md) | " + " | ".join(cells) + " |"
+            )
+        return "\n".join(lines) + "\n"
 
-def _type_text(spec: dict[str, Any], schemas: Schemas) -> str:
-    if "$ref" in spec:
-        ref = str(spec["$ref"])
+    # -- cells -----------------------------------------------------------------------------
+
+    def _link(self, page: ReferencePage, schema: SchemaName, section: str) -> str:
+        slug = self.home[schema, section]
+        anchor = section.lower()
+        target = f"#{anchor}" if slug == page.slug else f"{slug}.md#{anchor}"
+        return f"[{section}]({target})"
+
+    def _resolve(self, page: ReferencePage, ref: str) -> tuple[SchemaName, str, dict[str, Any]]:
         if ref.startswith("#/$defs/"):
             target = ref.removeprefix("#/$defs/")
-            return f"[{target}](#{target.lower()})"
+            return page.schema, target, self.schemas[page.schema]["$defs"][target]
         other = SchemaName(ref.removesuffix(".schema.json"))
-        return f"[{schemas[other]['title']}]({page_name(other)})"
-    if "const" in spec:
-        return f"`{json.dumps(spec['const'])}`"
-    if "enum" in spec:
-        return " \\| ".join(f"`{v}`" for v in spec["enum"])
-    if "oneOf" in spec:
-        return " or ".join(_type_text(option, schemas) for option in spec["oneOf"])
-    kind = spec.get("type", "any")
-    if kind == "array":
-        return f"list of {_type_text(spec.get('items', {}), schemas)}"
-    if kind == "object" and isinstance(spec.get("additionalProperties"), dict):
-        return f"map of name → {_type_text(spec['additionalProperties'], schemas)}"
-    return str(kind)
+        return other, self.schemas[other]["title"], self.schemas[other]
+
+    def _type_text(self, page: ReferencePage, spec: dict[str, Any]) -> str:
+        if "$ref" in spec:
+            schema, section, _ = self._resolve(page, str(spec["$ref"]))
+            return self._link(page, schema, section)
+        if "const" in spec:
+            return f"`{json.dumps(spec['const'])}`"
+        if "enum" in spec:
+            return "string"
+        if "oneOf" in spec:
+            return " or ".join(self._type_text(page, option) for option in spec["oneOf"])
+        kind = spec.get("type", "any")
+        if kind == "array":
+            return f"list of {self._type_text(page, spec.get('items', {}))}"
+        if kind == "object" and isinstance(spec.get("additionalProperties"), dict):
+            return f"map of name → {self._type_text(page, spec['additionalProperties'])}"
+        return str(kind)
+
+    def _allowed_text(self, page: ReferencePage, spec: dict[str, Any]) -> str:
+        target = spec
+        if "$ref" in spec:
+            _, _, target = self._resolve(page, str(spec["$ref"]))
+        if "enum" in target:
+            return " \\| ".join(f"`{v}`" for v in target["enum"])
+        if "const" in target:
+            return f"only `{json.dumps(target['const'])}`"
+        found = _constraint_text(spec)
+        values = spec.get("additionalProperties")
+        if isinstance(values, dict):
+            found = ", ".join(p for p in (found, _constraint_text(values, "each value ")) if p)
+        return found
+
+    def _example_cell(
+        self, page: ReferencePage, section: tuple[SchemaName, str], prop: str, spec: dict[str, Any]
+    ) -> str:
+        sample = self.examples.example(section, prop)
+        if sample is None:
+            if spec.get("examples"):
+                return f"`{_cell(short_flow(spec['examples'][0]))}` (schema example)"
+            return "*not used by any manifest yet*"
+        text = flow(sample.value)
+        ref = spec.get("$ref") or spec.get("items", {}).get("$ref")
+        if len(text) > MAX_EXAMPLE_CHARS and ref:
+            schema, target, _ = self._resolve(page, str(ref))
+            return f"see the {self._link(page, schema, target)} example"
+        return f"`{_cell(short_flow(sample.value))}` ({sample.source})"
+
+    def _snippet(self, section: tuple[SchemaName, str]) -> str:
+        instances = self.examples.instances.get(section, [])
+        if not instances:
+            return ""
+        sample = instances[0]
+        text = _yaml(sample.value)
+        if text.count("\n") > MAX_SNIPPET_LINES:
+            robot = sample.source.split("/")[0]
+            return (
+                f"\nA complete example: `{_file_of(sample)}`, shown on the "
+                f"[{robot} page](../robots/{robot}.md).\n"
+            )
+        return f"\nExample from `{_file_of(sample)}`:\n\n```yaml\n{text}```\n"
 
 
-def _constraint_text(spec: dict[str, Any]) -> str:
-    found = [fmt.format(spec[key]) for key, fmt in _CONSTRAINTS if key in spec]
+def _file_of(sample: Sample) -> str:
+    robot, _, scene = sample.source.partition("/")
+    return f"robots/{robot}/scenes/{scene}.yaml" if scene else f"robots/{robot}/robot.yaml"
+
+
+def _broken_text(example: RuleExample) -> str:
+    broken = example.broken
+    return (
+        f"Checked in `{broken.checked_in}`. Break it with this edit of `{broken.file}`:\n\n"
+        f"```diff\n{_diff(broken.old, broken.new)}```\n\nand the validator reports:\n\n"
+        f"```text\n{example.error}\n```\n"
+    )
+
+
+def _diff(old: str, new: str) -> str:
+    """A unified-diff body for replacing ``old`` with ``new`` (context kept on insertions)."""
+    old_lines, new_lines = old.rstrip("\n").split("\n"), new.rstrip("\n").split("\n")
+    if new_lines[: len(old_lines)] == old_lines:
+        body = [f" {line}" for line in old_lines]
+        body += [f"+{line}" for line in new_lines[len(old_lines) :]]
+    else:
+        body = [f"-{line}" for line in old_lines] + [f"+{line}" for line in new_lines]
+    return "\n".join(body) + "\n"
+
+
+def _yaml(value: Any) -> str:
+    """Block YAML with innermost lists and maps in flow style (as manifests are written)."""
+    yaml = YAML(typ="safe", pure=True)
+    yaml.default_flow_style = None
+    yaml.width = 100
+    yaml.indent(mapping=2, sequence=4, offset=2)
+    yaml.representer.sort_base_mapping_type_on_output = False
+    stream = StringIO()
+    yaml.dump(value, stream)
+    return stream.getvalue()
+
+
+def _constraint_text(spec: dict[str, Any], prefix: str = "") -> str:
+    found = [prefix + fmt.format(spec[key]) for key, fmt in _CONSTRAINTS if key in spec]
     items = spec.get("items")
     if isinstance(items, dict):
         found += [f"each {fmt.format(items[key])}" for key, fmt in _CONSTRAINTS if key in items]
+        if "enum" in items:
+            found.append("each one of " + ", ".join(f"`{v}`" for v in items["enum"]))
     if spec.get("uniqueItems"):
         found.append("unique items")
+    names = spec.get("propertyNames")
+    if isinstance(names, dict) and "pattern" in names:
+        found.append(f"names match `{names['pattern']}`")
     return _cell(", ".join(found))
 
 
@@ -181,26 +446,5 @@ def _rule_text(rule: dict[str, Any]) -> str:
     return "; ".join(parts)
 
 
-def _rules(comment: str) -> str:
-    head, _, rest = comment.partition(": (1)")
-    if not rest:
-        return comment + "\n"
-    items = ("(1)" + rest).split("; (")
-    lines = [f"{head}:\n"]
-    for item in items:
-        text = item if item.startswith("(") else "(" + item
-        lines.append(f"- {text.rstrip('.')}.")
-    return "\n".join(lines) + "\n"
-
-
 def _cell(text: str) -> str:
     return text.replace("|", "\\|").replace("\n", " ")
-
-
-def reference_index(schemas: Schemas) -> str:
-    """The landing page of the reference section."""
-    lines = [HEADER, "# Schema reference\n", "Generated from the JSON Schemas in `schema/`.\n"]
-    for name in SchemaName:
-        schema = schemas[name]
-        lines.append(f"- [{schema['title']}]({page_name(name)}) — {schema['description']}")
-    return "\n".join(lines) + "\n"

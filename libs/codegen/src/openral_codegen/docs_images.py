@@ -1,0 +1,181 @@
+"""Pictures of every robot in its default scene, for the robot pages (``just docs-images``).
+
+Each robot's ``scenes/tabletop.yaml`` is built with the native scene backend and reset with
+the scene's seed; one frame is rendered offscreen (EGL on the CPU) from a free camera aimed
+at the robot's bodies. Of a few fixed viewpoints, the one that shows the most robot pixels
+(by segmentation rendering) is kept, so a table in front of a robot never hides it.
+
+Next to the PNGs, ``renders.json`` records a SHA-256 of each picture's inputs (manifest,
+scene file, MJCF file and the render settings) and the viewpoint used. :func:`stale_images`
+compares it with the current inputs, which is cheap and needs no renderer.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from openral_codegen.models import CodegenError
+
+IMAGE_DIR = "docs/images/robots"
+RECORD_NAME = "renders.json"
+DEFAULT_SCENE = "scenes/tabletop.yaml"
+WIDTH, HEIGHT = 480, 360
+"""Picture size [px]."""
+VIEWS = ((125.0, -25.0), (235.0, -25.0), (55.0, -25.0), (305.0, -25.0), (125.0, -45.0))
+"""Candidate (azimuth, elevation) [deg] of the free camera, in order of preference."""
+DISTANCE_PER_SIZE = 1.6
+"""Camera distance as a multiple of the diagonal of the robot's body bounding box."""
+MIN_DISTANCE_M = 0.8
+SETTINGS: dict[str, Any] = {
+    "size": [WIDTH, HEIGHT],
+    "views": [list(v) for v in VIEWS],
+    "distance_per_size": DISTANCE_PER_SIZE,
+    "min_distance_m": MIN_DISTANCE_M,
+}
+
+
+@dataclass(frozen=True)
+class Render:
+    """One rendered picture and the viewpoint it was taken from."""
+
+    image: npt.NDArray[np.uint8]
+    azimuth: float
+    elevation: float
+
+
+def render_robot(root: Path, robot_id: str) -> Render:
+    """Render ``robot_id`` in its default scene (HEIGHT x WIDTH x 3, uint8)."""
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    import mujoco
+    from openral_core.loader import load_scene
+    from openral_sim.scene import build_sim_env_from_yaml
+
+    scene_file = root / "robots" / robot_id / DEFAULT_SCENE
+    env = build_sim_env_from_yaml(scene_file)
+    try:
+        env.reset(seed=load_scene(scene_file).seed)
+        handles = env.mujoco_handles()
+        if handles is None:
+            raise CodegenError(f"{robot_id}: the default scene exposes no MuJoCo model")
+        model, data = handles
+        robot_body = np.array(
+            [
+                i > 0
+                and not (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, i) or "").startswith(
+                    "scene_"
+                )
+                for i in range(model.nbody)
+            ]
+        )
+        points = data.xpos[robot_body]
+        low, high = points.min(axis=0), points.max(axis=0)
+        camera = mujoco.MjvCamera()
+        camera.type = mujoco.mjtCamera.mjCAMERA_FREE
+        camera.lookat[:] = (low + high) / 2
+        camera.distance = max(MIN_DISTANCE_M, DISTANCE_PER_SIZE * float(np.linalg.norm(high - low)))
+        renderer = mujoco.Renderer(model, HEIGHT, WIDTH)
+        try:
+            robot_geom = robot_body[model.geom_bodyid]
+            renderer.enable_segmentation_rendering()
+            counts = []
+            for azimuth, elevation in VIEWS:
+                camera.azimuth, camera.elevation = azimuth, elevation
+                renderer.update_scene(data, camera=camera)
+                ids, types = np.moveaxis(renderer.render(), -1, 0)
+                geoms = ids[(types == int(mujoco.mjtObj.mjOBJ_GEOM)) & (ids >= 0)]
+                counts.append(int(robot_geom[geoms].sum()))
+            renderer.disable_segmentation_rendering()
+            azimuth, elevation = VIEWS[int(np.argmax(counts))]
+            camera.azimuth, camera.elevation = azimuth, elevation
+            renderer.update_scene(data, camera=camera)
+            image = renderer.render().copy()
+        finally:
+            renderer.close()
+    finally:
+        env.close()
+    return Render(image, azimuth, elevation)
+
+
+def input_digest(root: Path, robot_id: str) -> str:
+    """SHA-256 over everything a picture depends on, besides the scene code itself."""
+    from openral_core.loader import load_robot
+    from openral_hal.mjcf_uri import resolve_mjcf_uri
+
+    folder = root / "robots" / robot_id
+    manifest = folder / "robot.yaml"
+    robot = load_robot(manifest)
+    if robot.sim is None:
+        raise CodegenError(f"{robot_id}: no sim block, so no picture can be rendered")
+    digest = hashlib.sha256()
+    for part in (
+        manifest.read_bytes(),
+        (folder / DEFAULT_SCENE).read_bytes(),
+        resolve_mjcf_uri(robot.sim.mjcf_uri, folder).read_bytes(),
+        json.dumps(SETTINGS, sort_keys=True).encode(),
+    ):
+        digest.update(hashlib.sha256(part).digest())
+    return digest.hexdigest()
+
+
+def write_images(root: Path, robot_ids: list[str] | None = None) -> list[str]:
+    """Render the pictures of ``robot_ids`` (default: every robot); returns the paths written."""
+    from openral_core.registry import robot_ids as all_robot_ids
+    from openral_sim.png import write_png
+
+    known = all_robot_ids(root / "robots")
+    wanted = robot_ids or known
+    unknown = sorted(set(wanted) - set(known))
+    if unknown:
+        raise CodegenError(f"unknown robot(s) {', '.join(unknown)}; known: {', '.join(known)}")
+    folder = root / IMAGE_DIR
+    folder.mkdir(parents=True, exist_ok=True)
+    record = _read_record(root)
+    written = []
+    for robot_id in wanted:
+        render = render_robot(root, robot_id)
+        path = folder / f"{robot_id}.png"
+        write_png(path, render.image)
+        written.append(path.relative_to(root).as_posix())
+        record[robot_id] = {
+            "inputs_sha256": input_digest(root, robot_id),
+            "azimuth_deg": render.azimuth,
+            "elevation_deg": render.elevation,
+        }
+    for gone in set(record) - set(known):
+        del record[gone]
+        (folder / f"{gone}.png").unlink(missing_ok=True)
+    (folder / RECORD_NAME).write_text(json.dumps(record, indent=2, sort_keys=True) + "\n")
+    return written
+
+
+def stale_images(root: Path) -> list[str]:
+    """Robots whose picture is missing or was rendered from other inputs, with the reason."""
+    from openral_core.registry import robot_ids
+
+    record = _read_record(root)
+    problems = []
+    for robot_id in robot_ids(root / "robots"):
+        if not (root / IMAGE_DIR / f"{robot_id}.png").is_file():
+            problems.append(f"{robot_id}: no picture")
+        elif record.get(robot_id, {}).get("inputs_sha256") != input_digest(root, robot_id):
+            problems.append(f"{robot_id}: manifest, scene, model or settings changed")
+    known = set(robot_ids(root / "robots"))
+    gone = sorted(set(record) - known)
+    problems += [f"{robot_id}: picture of a robot that no longer exists" for robot_id in gone]
+    return sorted(problems)
+
+
+def _read_record(root: Path) -> dict[str, dict[str, Any]]:
+    path = root / IMAGE_DIR / RECORD_NAME
+    if not path.is_file():
+        return {}
+    record: dict[str, dict[str, Any]] = json.loads(path.read_text("utf-8"))
+    return record

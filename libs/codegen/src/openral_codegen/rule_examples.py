@@ -1,0 +1,173 @@
+"""Break each cross-field rule on purpose and record the error the user would see.
+
+The reference pages list the rules JSON Schema cannot state. For each one, a single text
+edit of a real file (the franka_panda manifest or its default scene) breaks exactly that
+rule; the broken copy is run through the real validator at export time and the error it
+produces is what the page shows. A rule whose edit no longer fails, or whose edit no longer
+applies to the file, stops the export with a message saying which example to update.
+"""
+
+from __future__ import annotations
+
+import re
+import tempfile
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from openral_core.errors import OpenralError
+from openral_core.loader import validate_robot_file
+from openral_core.schemas import SchemaName
+
+from openral_codegen.models import CodegenError
+
+ROBOT_FILE = "robots/franka_panda/robot.yaml"
+SCENE_FILE = "robots/franka_panda/scenes/tabletop.yaml"
+
+
+@dataclass(frozen=True)
+class RuleBreak:
+    """One edit of a real file that breaks one rule.
+
+    Attributes:
+        schema: The schema whose ``$comment`` lists the rule.
+        rule: The rule: its number in a ``(1) …; (2) …`` comment, else a short statement.
+        file: Repo-relative path of the file the edit applies to.
+        old: Text that occurs exactly once in the file.
+        new: Its replacement.
+        checked_in: The module (and function) that enforces the rule.
+    """
+
+    schema: SchemaName
+    rule: int | str
+    file: str
+    old: str
+    new: str
+    checked_in: str = "openral_core.rules.robot_findings"
+
+
+@dataclass(frozen=True)
+class RuleExample:
+    """A rule break and the error text the validator printed for it."""
+
+    broken: RuleBreak
+    error: str
+
+
+RULE_BREAKS = (
+    RuleBreak(SchemaName.ROBOT, 1, ROBOT_FILE, "name: franka_panda", "name: franka"),
+    RuleBreak(SchemaName.ROBOT, 2, ROBOT_FILE, "{name: panda_joint2,", "{name: panda_joint1,"),
+    RuleBreak(
+        SchemaName.ROBOT, 3, ROBOT_FILE, "sim_joint_name: joint2,", "sim_joint_name: joint1,"
+    ),
+    RuleBreak(SchemaName.ROBOT, 4, ROBOT_FILE, "- name: wrist\n", "- name: agentview\n"),
+    RuleBreak(
+        SchemaName.ROBOT,
+        5,
+        ROBOT_FILE,
+        "position_limits: [-1.7628, 1.7628]",
+        "position_limits: [1.7628, -1.7628]",
+    ),
+    RuleBreak(
+        SchemaName.ROBOT,
+        6,
+        ROBOT_FILE,
+        "- joint: panda_finger_joint1",
+        "- joint: panda_finger_joint",
+    ),
+    RuleBreak(
+        SchemaName.ROBOT,
+        7,
+        ROBOT_FILE,
+        "  keyframe_index: 0\n",
+        "  keyframe_index: 0\n  joint_qpos_addr: {panda_joint8: 8}\n",
+    ),
+    RuleBreak(
+        SchemaName.ROBOT,
+        8,
+        ROBOT_FILE,
+        "  keyframe_index: 0\n",
+        "  keyframe_index: 0\n  control: {mode: torque_pd, kp: {panda_joint8: 100.0}, kd: 10.0}\n",
+    ),
+    RuleBreak(
+        SchemaName.ROBOT, 9, ROBOT_FILE, "ctrl_range: [0.0, 255.0]", "ctrl_range: [255.0, 0.0]"
+    ),
+    RuleBreak(
+        SchemaName.ROBOT,
+        10,
+        ROBOT_FILE,
+        "observation.images.camera2",
+        "observation.images.camera1",
+    ),
+    RuleBreak(
+        SchemaName.SCENE,
+        "robot_id names a robot under robots/",
+        SCENE_FILE,
+        "robot_id: franka_panda",
+        "robot_id: franka",
+        "openral_core.registry.manifest_path",
+    ),
+    RuleBreak(
+        SchemaName.SCENE,
+        "every name in scene.cameras is a camera sensor of that robot",
+        SCENE_FILE,
+        "cameras: [agentview, wrist]",
+        "cameras: [agentview, wrist_cam]",
+        "openral_sim.native_scene.NativeScene",
+    ),
+)
+"""Every rule break the reference pages show, in page order."""
+
+
+def numbered_rules(comment: str) -> tuple[str, dict[int, str]]:
+    """Split a ``$comment`` of the form ``head: (1) rule; (2) rule.`` into head and rules."""
+    head, colon, rest = comment.partition(": (1)")
+    if not colon:
+        return comment, {}
+    rules = {}
+    for match in re.finditer(r"\((\d+)\) (.*?)(?=; \(\d+\) |\.?$)", "(1)" + rest):
+        rules[int(match.group(1))] = match.group(2)
+    return head, rules
+
+
+def rule_examples(root: Path) -> list[RuleExample]:
+    """Apply every :data:`RULE_BREAKS` edit to a copy and validate it; returns the errors.
+
+    Raises:
+        CodegenError: An edit no longer applies, or the broken copy no longer fails.
+    """
+    examples = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for broken in RULE_BREAKS:
+            text = (root / broken.file).read_text("utf-8")
+            if text.count(broken.old) != 1:
+                raise CodegenError(
+                    f"rule example {broken.rule!r}: {broken.old!r} must occur once in "
+                    f"{broken.file}; update RULE_BREAKS in openral_codegen/rule_examples.py"
+                )
+            copy = Path(tmp) / broken.file
+            copy.parent.mkdir(parents=True, exist_ok=True)
+            copy.write_text(text.replace(broken.old, broken.new), "utf-8")
+            error = _robot_error(copy) if broken.schema is SchemaName.ROBOT else _scene_error(copy)
+            if not error:
+                raise CodegenError(
+                    f"rule example {broken.rule!r}: the edited {broken.file} passes; the rule "
+                    "changed, so update RULE_BREAKS in openral_codegen/rule_examples.py"
+                )
+            examples.append(RuleExample(broken, error.replace(f"{tmp}/", "")))
+    return examples
+
+
+def _robot_error(file: Path) -> str:
+    issues = validate_robot_file(file)
+    return "\n".join(replace(issue, file=file).format() for issue in issues)
+
+
+def _scene_error(file: Path) -> str:
+    from openral_sim.scene import build_sim_env_from_yaml
+
+    try:
+        env = build_sim_env_from_yaml(file)
+    except OpenralError as error:
+        return str(error)
+    env.close()
+    return ""
