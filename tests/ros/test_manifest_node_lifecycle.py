@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import threading
 from collections.abc import Iterator
 from pathlib import Path
@@ -57,6 +58,7 @@ def test_unknown_parameter_override_is_rejected(ros_context: Context) -> None:
 
 
 def open_fds() -> int:
+    gc.collect()  # count what is still referenced, not garbage of earlier tests
     return sum(1 for _ in Path("/proc/self/fd").iterdir())
 
 
