@@ -41,7 +41,7 @@ def read_png(path: Path) -> np.ndarray:
 def test_topics_lists_names_types_publishers_and_rates(ros: RosHarness) -> None:
     ros.fake_graph()
     result = runner.invoke(
-        app, ["ros", "topics", "--wait", "2", "--rate", "--window", "2"], env=WIDE
+        app, ["ros", "topics", "--wait", "3", "--rate", "--window", "2"], env=WIDE
     )
     assert result.exit_code == 0, result.output
     rows = {

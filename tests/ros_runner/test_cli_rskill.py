@@ -23,7 +23,7 @@ def test_run_for_a_duration_publishes_waves_and_exits_0(ros: RosHarness) -> None
     graph = ros.fake_graph()
     result = CliRunner().invoke(
         app,
-        ["rskill", "run", "--robot", "franka_panda", "--duration", "4", "-p", "amplitude=0.2"],
+        ["rskill", "run", "--robot", "franka_panda", "--duration", "6", "-p", "amplitude=0.2"],
         env={"COLUMNS": "300", "ROS_DOMAIN_ID": str(DOMAIN_ID)},
     )
     assert result.exit_code == 0, result.output
@@ -53,12 +53,12 @@ def test_ctrl_c_stops_the_runner_cleanly_with_exit_0(ros: RosHarness) -> None:
 def test_a_silent_camera_aborts_with_exit_1_and_one_message(ros: RosHarness) -> None:
     graph = ros.fake_graph(cameras=("agentview",))
     result = subprocess.run(
-        [*RUN, "--frame-timeout", "4"], capture_output=True, text=True, timeout=60, env=ENV
+        [*RUN, "--frame-timeout", "6"], capture_output=True, text=True, timeout=60, env=ENV
     )
     assert result.returncode == 1, result.stdout
     message = " ".join(result.stderr.split())
     assert message.startswith(
-        "error: policy wave needs camera slots (camera1, camera2) but got frames within 4 s "
+        "error: policy wave needs camera slots (camera1, camera2) but got frames within 6 s "
         "only for (camera1); franka_panda: camera1 <- /openral/cameras/agentview/image, "
         "camera2 <- /openral/cameras/wrist/image"
     ), result.stderr

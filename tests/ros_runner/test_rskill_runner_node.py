@@ -84,7 +84,7 @@ def test_runner_aborts_naming_expected_and_seen_slots_when_a_camera_is_silent(
     ros: RosHarness,
 ) -> None:
     graph = ros.fake_graph(cameras=("agentview",))
-    params = runner_parameters("franka_panda", frame_timeout_s=2.5)
+    params = runner_parameters("franka_panda", frame_timeout_s=4.0)
     runner = RskillRunnerNode(context=ros.context, parameter_overrides=params)
     ros.add(runner)
     assert wait_until(lambda: runner.abort_error is not None)
@@ -92,7 +92,7 @@ def test_runner_aborts_naming_expected_and_seen_slots_when_a_camera_is_silent(
     assert isinstance(error, MissingSlots)
     assert (error.expected, error.seen) == (("camera1", "camera2"), ("camera1",))
     assert str(error).startswith(
-        "policy wave needs camera slots (camera1, camera2) but got frames within 2.5 s only for "
+        "policy wave needs camera slots (camera1, camera2) but got frames within 4 s only for "
         "(camera1); franka_panda: camera1 <- /openral/cameras/agentview/image, "
     )
     assert "camera2 <- /openral/cameras/wrist/image" in str(error)
@@ -103,13 +103,13 @@ def test_runner_aborts_naming_the_silent_topic_when_the_action_spec_never_comes(
     ros: RosHarness,
 ) -> None:
     graph = ros.fake_graph(action_spec=False)
-    params = runner_parameters("franka_panda", frame_timeout_s=2.5)
+    params = runner_parameters("franka_panda", frame_timeout_s=4.0)
     runner = RskillRunnerNode(context=ros.context, parameter_overrides=params)
     ros.add(runner)
     assert wait_until(lambda: runner.abort_error is not None)
     assert isinstance(runner.abort_error, RunnerAborted)
     assert str(runner.abort_error) == (
-        "no message on /openral/action_spec within 2.5 s; is `openral deploy sim` running on "
+        "no message on /openral/action_spec within 4 s; is `openral deploy sim` running on "
         f"ROS_DOMAIN_ID={DOMAIN_ID}?"
     )
     assert graph.received() == []
