@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import os
+import signal
 import struct
 import subprocess
 import sys
+import threading
 import zlib
 from pathlib import Path
 
@@ -13,7 +15,7 @@ import numpy as np
 from openral_cli.main import app
 from typer.testing import CliRunner
 
-from tests.ros_runner.conftest import COLOURS, DOMAIN_ID, FRAME_SHAPE, RosHarness
+from tests.ros_runner.conftest import COLOURS, DOMAIN_ID, FRAME_SHAPE, RosHarness, wait_until
 
 runner = CliRunner()
 WIDE = {"COLUMNS": "200", "ROS_DOMAIN_ID": str(DOMAIN_ID)}
@@ -128,3 +130,28 @@ def test_echo_of_a_missing_topic_exits_1_naming_the_topics_that_exist(ros: RosHa
     for topic in ("/joint_states", "/openral/cameras/agentview/image", "/openral/action_spec"):
         assert topic in message
     assert "Traceback" not in result.stderr
+
+
+def test_echo_streams_until_ctrl_c_then_exits_0(ros: RosHarness) -> None:
+    ros.fake_graph()
+    command = [sys.executable, "-m", "openral_cli.main", "ros", "echo", "/joint_states"]
+    process = subprocess.Popen(
+        command,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "ROS_DOMAIN_ID": str(DOMAIN_ID)},
+    )
+    lines: list[str] = []
+    reader = threading.Thread(target=lambda: lines.extend(iter(process.stdout.readline, "")))
+    reader.start()
+    try:
+        assert wait_until(lambda: lines.count("---\n") >= 2, timeout_s=30.0), lines
+        process.send_signal(signal.SIGINT)
+        _, stderr = process.communicate(timeout=30)
+    finally:
+        process.kill()
+        reader.join()
+    assert process.returncode == 0, stderr
+    assert "Traceback" not in stderr
+    assert sum(line.startswith("name: [panda_joint1") for line in lines) >= 2

@@ -2,8 +2,9 @@
 
 Frames arrive on ``/openral/cameras/<sensor>/image`` keyed by the manifest sensor name;
 policies look them up by VLA slot (``camera1`` …). The two are joined through the
-generated slot table (:func:`openral_core.tables.vla_slots`), the same table the sensor
-bridge and ``openral robot show`` use, so the rule lives in one place.
+derived slot table (:func:`openral_core.tables.vla_slots`: the table ``openral robot show``
+prints and ``just schema-export`` writes under ``generated/``), so the rule lives in one
+place.
 
 Each tick (``rate_hz``) the node builds an :class:`~openral_nodes.policies.Observation`
 from the latest frames, ``/joint_states`` and the latched ``/openral/action_spec``, calls
@@ -130,7 +131,8 @@ class RskillRunnerNode(Node):
     ROS parameters: ``robot_id`` (str), ``policy`` (built-in policy name, default
     ``wave``), ``policy_params`` (``key=value`` strings), ``rate_hz`` (float, default 10.0),
     ``frame_timeout_s`` (float, default 5.0: covers DDS discovery, 0.02-3.5 s here).
-    ``policy`` overrides the ``policy``/``policy_params`` parameters (tests, embedding).
+    A ``policy`` object passed to the constructor replaces the ``policy`` and
+    ``policy_params`` parameters (tests, embedding).
     """
 
     def __init__(
@@ -213,13 +215,13 @@ class RskillRunnerNode(Node):
         by_slot = realign_frames(fresh, self.slot_table)
         seen = tuple(by_slot)
         missing_slots = [s for s in self.policy.required_slots if s not in by_slot]
-        waiting = missing_slots or self._spec is None or not self._joints
-        if waiting:
+        if missing_slots or self._spec is None or not self._joints:
             self.status = RunnerStatus("waiting", seen, self.status.actions)
             if now - self._started > self.frame_timeout_s:
-                self._abort(self._missing_input_error(missing_slots, list(by_slot)))
+                self._abort(self._missing_input_error(missing_slots, seen))
             return
-        assert self._spec is not None
+        if self._first_act is None:
+            self._first_act = now
         try:
             obs = Observation(
                 images={slot: image_to_rgb(msg) for slot, msg in by_slot.items()},
@@ -227,9 +229,8 @@ class RskillRunnerNode(Node):
                     [self._joints.get(name, np.nan) for name in self._joint_names]
                 ),
                 action_spec=self._spec,
-                time_s=now - (self._first_act if self._first_act is not None else now),
+                time_s=now - self._first_act,
             )
-            self._first_act = self._first_act if self._first_act is not None else now
             action = np.asarray(self.policy.act(obs), dtype=np.float64)
         except OpenralError as error:
             self._abort(error)
@@ -249,7 +250,7 @@ class RskillRunnerNode(Node):
         self._publisher.publish(Float64MultiArray(data=action.tolist()))
         self.status = RunnerStatus("running", seen, self.status.actions + 1)
 
-    def _missing_input_error(self, missing_slots: list[str], seen: list[str]) -> OpenralError:
+    def _missing_input_error(self, missing_slots: list[str], seen: tuple[str, ...]) -> OpenralError:
         domain = self.context.get_domain_id()
         graph_hint = f"; is `openral deploy sim` running on ROS_DOMAIN_ID={domain}?"
         nothing = not self._frames and self._spec is None and not self._joints

@@ -39,17 +39,17 @@ DomainId = Annotated[
 ]
 Timeout = Annotated[
     float,
-    typer.Option("--timeout", min=0.0, help="Seconds to wait for the topic and its first message."),
+    typer.Option("--timeout", min=0.0, help="Seconds to wait for the topic, then for a message."),
 ]
 
 
 @contextmanager
 def _probe_node(domain_id: int | None) -> Iterator[Node]:
-    """A short-lived, spun node on its own rclpy context."""
+    """A short-lived, spun node on its own rclpy context; Ctrl-C inside ends the command (0)."""
     from openral_nodes.runtime import Spinner, ros_session
     from rclpy.node import Node
 
-    with ros_session(domain_id) as context:
+    with _quiet_ctrl_c(), ros_session(domain_id) as context:
         node = Node(
             f"openral_cli_{os.getpid()}",
             context=context,
@@ -62,6 +62,15 @@ def _probe_node(domain_id: int | None) -> Iterator[Node]:
                 yield node
         finally:
             node.destroy_node()  # type: ignore[no-untyped-call]
+
+
+@contextmanager
+def _quiet_ctrl_c() -> Iterator[None]:
+    """Ctrl-C stops the command with exit code 0 and no traceback."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        raise typer.Exit(0) from None
 
 
 @app.command("topics")
@@ -117,20 +126,16 @@ def echo(
     from openral_nodes.topic_graph import wait_for_topic
     from openral_nodes.topic_probe import subscribe
 
-    deadline = time.monotonic() + timeout
     with _probe_node(domain_id) as node:
         info = wait_for_topic(node, topic, timeout)
         with subscribe(node, info) as inbox:
-            msg = inbox.get(deadline - time.monotonic())
-            try:
-                while True:
-                    out.print(format_message(msg), highlight=False, markup=False)
-                    if once:
-                        return
-                    out.print("---")
-                    msg = _next(inbox)
-            except KeyboardInterrupt:
-                return
+            msg = inbox.get(timeout)
+            while True:
+                out.print(format_message(msg), highlight=False, markup=False)
+                if once:
+                    return
+                out.print("---")
+                msg = _next(inbox)
 
 
 def _next(inbox: Inbox) -> Any:
@@ -158,7 +163,6 @@ def snapshot(
     from openral_nodes.topic_probe import subscribe
     from openral_sim.png import write_png
 
-    deadline = time.monotonic() + timeout
     with _probe_node(domain_id) as node:
         info = wait_for_topic(node, topic, timeout)
         if "sensor_msgs/msg/Image" not in info.types:
@@ -166,7 +170,7 @@ def snapshot(
                 f"{info.name} carries {', '.join(info.types)}, not sensor_msgs/msg/Image"
             )
         with subscribe(node, info) as inbox:
-            msg = inbox.get(deadline - time.monotonic())
+            msg = inbox.get(timeout)
     rgb = image_to_rgb(msg)
     out_file.parent.mkdir(parents=True, exist_ok=True)
     write_png(out_file, rgb)
