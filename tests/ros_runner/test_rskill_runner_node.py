@@ -120,5 +120,6 @@ def test_runner_refuses_a_policy_whose_slots_the_manifest_lacks() -> None:
         RskillRunnerNode(context=context, parameter_overrides=runner_parameters("g1"))
     assert str(caught.value) == (
         "policy wave needs camera slots (camera1, camera2) but the manifest provides (camera1); "
-        "g1: camera1 <- /openral/cameras/head/image"
+        "g1: camera1 <- /openral/cameras/head/image; "
+        "pick another policy or set its required_slots parameter"
     )

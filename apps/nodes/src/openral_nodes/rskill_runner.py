@@ -164,6 +164,7 @@ class RskillRunnerNode(Node):
                 provided,
                 self.slot_table,
                 "the manifest provides",
+                "; pick another policy or set its required_slots parameter",
             )
         self._joint_names = [joint.name for joint in description.joints]
         self._frames: dict[str, tuple[float, Any]] = {}
