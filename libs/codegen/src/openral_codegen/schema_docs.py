@@ -9,6 +9,7 @@ Schema cannot state come last, each with the error the validator prints when it 
 
 from __future__ import annotations
 
+import html
 import json
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -42,7 +43,6 @@ _CONSTRAINTS = (
     ("maxLength", "length ≤ {}"),
     ("minItems", "items ≥ {}"),
     ("maxItems", "items ≤ {}"),
-    ("pattern", "matches `{}`"),
 )
 
 
@@ -145,7 +145,7 @@ class _Renderer:
     def _defs_of(self, page: ReferencePage) -> list[str]:
         defs = list(self.schemas[page.schema].get("$defs", {}))
         if page.defs is not None:
-            return [d for d in defs if d in page.defs]
+            return [d for d in page.defs if d in defs]
         claimed = {d for p in PAGES if p.schema is page.schema and p.defs for d in p.defs}
         return [d for d in defs if d not in claimed]
 
@@ -157,7 +157,7 @@ class _Renderer:
         parts = [
             HEADER,
             f"# {page.title or schema['title']}\n",
-            f"{page.intro or schema['description']}\n",
+            f"{page.intro or _prose(schema['description'])}\n",
             f'!!! note "Generated page"\n    Generated from `{source}` (JSON Schema draft '
             "2020-12) by `just schema-export`. To change it, edit the schema and regenerate.\n",
         ]
@@ -195,7 +195,8 @@ class _Renderer:
                 else f"part of `schema/{page.schema.file_name}`: "
                 + ", ".join(f"`{d}`" for d in page.defs)
             )
-            lines.append(f"| [{page.title or schema['title']}]({page.slug}.md) | {_cell(what)} |")
+            title = page.title or schema["title"]
+            lines.append(f"| [{title}]({page.slug}.md) | {_cell(_prose(what))} |")
         return "\n".join(lines) + "\n"
 
     # -- sections --------------------------------------------------------------------------
@@ -206,21 +207,22 @@ class _Renderer:
         section = (page.schema, title)
         lines = [f"## {title}\n"]
         if not top and schema.get("description"):
-            lines.append(f"{schema['description']}\n")
+            lines.append(f"{_prose(schema['description'])}\n")
         required = set(schema.get("required", []))
-        lines.append(
-            "| Field | Type | Required | Default | Allowed values | Description | Example |"
-        )
-        lines.append("|---|---|---|---|---|---|---|")
+        lines.append("| Field | Type and allowed values | Description | Example |")
+        lines.append("|---|---|---|---|")
         for prop, spec in schema.get("properties", {}).items():
-            default = f"`{flow(spec['default'])}`" if "default" in spec else ""
+            if prop in required:
+                presence = "**required**"
+            elif "default" in spec:
+                presence = f"default {_code(flow(spec['default']))}"
+            else:
+                presence = "optional"
+            allowed = self._allowed_text(page, spec)
             cells = [
-                f"`{prop}`",
-                self._type_text(page, spec),
-                "yes" if prop in required else "no",
-                default,
-                self._allowed_text(page, spec),
-                _cell(spec.get("description", "")),
+                f"`{prop}`<br>{presence}",
+                self._type_text(page, spec) + (f"<br>{allowed}" if allowed else ""),
+                _cell(_prose(spec.get("description", ""))),
                 self._example_cell(page, section, prop, spec),
             ]
             lines.append("| " + " | ".join(cells) + " |")
@@ -231,7 +233,7 @@ class _Renderer:
         return "\n".join(lines) + "\n"
 
     def _value_section(self, page: ReferencePage, title: str, schema: dict[str, Any]) -> str:
-        text = f"## {title}\n\n{schema.get('description', '')}\n\n"
+        text = f"## {title}\n\n{_prose(schema.get('description', ''))}\n\n"
         if "enum" in schema:
             text += "Allowed values: " + ", ".join(f"`{v}`" for v in schema["enum"]) + ".\n"
         elif "oneOf" in schema:
@@ -247,7 +249,7 @@ class _Renderer:
         head, numbered = numbered_rules(comment)
         lines = [
             "## Rules checked after the schema\n",
-            f"{head}.\n" if numbered else f"{comment}\n",
+            f"{_prose(head)}.\n" if numbered else f"{_prose(comment)}\n",
         ]
         if name is SchemaName.SIM:
             lines.append(
@@ -258,7 +260,7 @@ class _Renderer:
         by_rule = {e.broken.rule: e for e in examples}
         if numbered:
             for number, text in numbered.items():
-                lines.append(f"### Rule {number}: {text}\n")
+                lines.append(f"### Rule {number}: {_prose(text)}\n")
                 example = by_rule.get(number)
                 lines.append(_broken_text(example) if example else "No example yet.\n")
         else:
@@ -394,7 +396,7 @@ def _yaml(value: Any) -> str:
     """Block YAML with innermost lists and maps in flow style (as manifests are written)."""
     yaml = YAML(typ="safe", pure=True)
     yaml.default_flow_style = None
-    yaml.width = 100
+    yaml.width = 4096  # never fold a long value (an mjcf_uri) onto its own line
     yaml.indent(mapping=2, sequence=4, offset=2)
     yaml.representer.sort_base_mapping_type_on_output = False
     stream = StringIO()
@@ -404,16 +406,20 @@ def _yaml(value: Any) -> str:
 
 def _constraint_text(spec: dict[str, Any], prefix: str = "") -> str:
     found = [prefix + fmt.format(spec[key]) for key, fmt in _CONSTRAINTS if key in spec]
+    if "pattern" in spec:
+        found.append(f"{prefix}matches {_code(spec['pattern'])}")
     items = spec.get("items")
     if isinstance(items, dict):
         found += [f"each {fmt.format(items[key])}" for key, fmt in _CONSTRAINTS if key in items]
+        if "pattern" in items:
+            found.append(f"each matches {_code(items['pattern'])}")
         if "enum" in items:
             found.append("each one of " + ", ".join(f"`{v}`" for v in items["enum"]))
     if spec.get("uniqueItems"):
         found.append("unique items")
     names = spec.get("propertyNames")
     if isinstance(names, dict) and "pattern" in names:
-        found.append(f"names match `{names['pattern']}`")
+        found.append(f"names match {_code(names['pattern'])}")
     return _cell(", ".join(found))
 
 
@@ -444,6 +450,21 @@ def _rule_text(rule: dict[str, Any]) -> str:
     if keys:
         parts.append("does not allow " + ", ".join(f"`{k}`" for k in keys))
     return "; ".join(parts)
+
+
+def _prose(text: str) -> str:
+    """Schema text as Markdown: ``<`` and ``>`` outside backticks are shown, not taken as HTML."""
+    parts = text.split("`")
+    for index in range(0, len(parts), 2):  # even parts lie outside code spans
+        parts[index] = html.escape(parts[index], quote=False)
+    return "`".join(parts)
+
+
+def _code(text: str) -> str:
+    """Inline code that survives a table cell (a ``|`` inside backticks would show its ``\\``)."""
+    if "|" not in text:
+        return f"`{text}`"
+    return "<code>" + html.escape(text).replace("|", "&#124;") + "</code>"
 
 
 def _cell(text: str) -> str:
