@@ -67,3 +67,19 @@ def test_unknown_robot_is_one_clear_error_without_traceback(command: list[str]) 
     assert result.returncode == 1
     assert "unknown robot 'no_such_robot'; known robots:" in result.stderr
     assert "Traceback" not in result.stderr + result.stdout
+
+
+def test_an_error_with_brackets_is_printed_verbatim(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from openral_cli import main
+    from openral_core.errors import OpenralError
+
+    def fail() -> None:
+        raise OpenralError("expected slots [camera1, camera2], saw [camera1]")
+
+    monkeypatch.setattr(main, "app", fail)
+    with pytest.raises(SystemExit) as exit_:
+        main.run()
+    assert exit_.value.code == 1
+    assert "expected slots [camera1, camera2], saw [camera1]" in capsys.readouterr().err

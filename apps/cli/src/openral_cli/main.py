@@ -12,6 +12,7 @@ import sys
 import typer
 from openral_core.errors import OpenralError
 from rich.console import Console
+from rich.markup import escape
 
 from openral_cli.commands import deploy, robot, ros, rskill, sim
 
@@ -33,7 +34,10 @@ def run() -> None:
     try:
         app()
     except OpenralError as error:
-        Console(stderr=True).print(f"[bold red]error:[/] {error}", highlight=False, soft_wrap=True)
+        message = escape(str(error))  # a message may contain [brackets]: not rich markup
+        Console(stderr=True).print(
+            f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True
+        )
         sys.exit(1)
 
 
