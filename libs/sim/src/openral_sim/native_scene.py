@@ -234,7 +234,12 @@ def _compose(
     base = np.asarray(pose.position_m if pose and pose.position_m else [0.0, 0.0, 0.0])
     yaw = math.radians(pose.yaw_deg if pose and pose.yaw_deg else 0.0)
     options = scene.scene.options
-    _add_world(spec)
+    child_model = child.copy().compile()  # before attach: no compile after it
+    own_floor = any(g.type == mujoco.mjtGeom.mjGEOM_PLANE for g in child.geoms)
+    floor_z = 0.0
+    if scene.scene.assets == "floor":  # the model brings a table: the floor goes under it
+        floor_z = min(0.0, base[2] + _lowest_static_point(child_model) - 0.001)
+    _add_world(spec, floor_z=None if own_floor else floor_z)  # one floor: two flicker
     if scene.scene.assets == "tabletop":
         table_h = (
             options.table_height_m
@@ -254,7 +259,6 @@ def _compose(
     for obj in options.objects if options and options.objects else []:
         _add_object(spec, obj)
     frame = spec.worldbody.add_frame(pos=base.tolist(), quat=_yaw_quat(yaw).tolist())
-    child_model = child.copy().compile()  # before attach: no compile after it
     center, radius = _robot_extent(child_model, robot)
     _add_mounted_cameras(child, robot, cameras)
     spec.attach(child, frame=frame, prefix="")
@@ -295,10 +299,13 @@ def _add_base_weld(
     )
 
 
-def _add_world(spec: mujoco.MjSpec) -> None:
+def _add_world(spec: mujoco.MjSpec, *, floor_z: float | None) -> None:
     spec.worldbody.add_light(name="scene_key_light", pos=[0.5, -1.0, 3.0], dir=[0, 0.3, -1])
     spec.worldbody.add_light(name="scene_fill_light", pos=[-1.0, 1.0, 2.5], dir=[0.4, -0.3, -1])
+    if floor_z is None:
+        return
     spec.worldbody.add_geom(
+        pos=[0.0, 0.0, floor_z],
         name="scene_floor",
         type=mujoco.mjtGeom.mjGEOM_PLANE,
         size=[5, 5, 0.05],
@@ -372,6 +379,23 @@ def _add_fixed_camera(
     right /= np.linalg.norm(right)
     up = np.cross(right, forward)
     spec.worldbody.add_camera(name=name, pos=eye.tolist(), xyaxes=[*right, *up], fovy=fovy)
+
+
+def _lowest_static_point(model: mujoco.MjModel) -> float:
+    """Lowest z (at most 0) of the geoms welded to the world in ``model``, e.g. the underside
+    of a table that comes with the robot's file."""
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    lowest = 0.0
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+    for geom in np.flatnonzero(model.body_weldid[model.geom_bodyid] == 0):
+        if model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_PLANE:
+            continue
+        center, half = model.geom_aabb[geom, :3], model.geom_aabb[geom, 3:]
+        local = center + corners * half
+        world = data.geom_xpos[geom] + local @ data.geom_xmat[geom].reshape(3, 3).T
+        lowest = min(lowest, float(world[:, 2].min()))
+    return lowest
 
 
 def _root_body(model: mujoco.MjModel, robot: RobotDescription) -> int:
