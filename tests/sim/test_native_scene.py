@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from openral_cli.main import app
 from openral_core import ManifestError, robot_ids
+from openral_core.errors import OpenralError
 from openral_sim.native_scene import SceneError
 from openral_sim.rollout import SimRollout
 from openral_sim.scene import build_sim_env_from_yaml
@@ -127,3 +128,11 @@ def test_welding_a_fixed_base_is_an_error(tmp_path: Path) -> None:
     path.write_text(path.read_text().replace("cameras: [head]", "cameras: [agentview]"))
     with pytest.raises(SceneError, match=r"base_pose\.weld: .* has a fixed base"):
         build_sim_env_from_yaml(path)
+
+
+def test_a_scene_for_an_unknown_robot_names_the_file(tmp_path: Path) -> None:
+    text = (ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml").read_text()
+    bad = tmp_path / "scene.yaml"
+    bad.write_text(text.replace("robot_id: franka_panda", "robot_id: nobot"))
+    with pytest.raises(OpenralError, match=r"scene\.yaml: robot_id: unknown robot 'nobot'"):
+        build_sim_env_from_yaml(bad)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import importlib
 from pathlib import Path
 
-from openral_core.errors import OpenralError
+from openral_core.errors import OpenralError, UnknownRobot
 from openral_core.loader import load_scene
 from openral_core.registry import load_robot_by_id
 
@@ -28,6 +28,10 @@ def build_sim_env_from_yaml(path: str | Path, robot_id_fallback: str | None = No
     robot_id = scene.robot_id or robot_id_fallback
     if robot_id is None:
         raise OpenralError(f"{file}: robot_id: the scene names no robot and none was given")
+    try:
+        robot = load_robot_by_id(robot_id)
+    except UnknownRobot as error:
+        raise OpenralError(f"{file}: robot_id: {error}") from None
     if scene.scene.backend.value == "robosuite":
         try:
             backend = importlib.import_module("openral_sim.robosuite_backend")
@@ -41,4 +45,4 @@ def build_sim_env_from_yaml(path: str | Path, robot_id_fallback: str | None = No
         return rollout
     from openral_sim.native_scene import NativeScene
 
-    return NativeScene(scene, load_robot_by_id(robot_id), source=file)
+    return NativeScene(scene, robot, source=file)
