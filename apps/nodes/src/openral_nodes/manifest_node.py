@@ -43,10 +43,10 @@ from openral_hal.factory import build_hal
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from rosgraph_msgs.msg import Clock  # type: ignore[import-untyped]
-from sensor_msgs.msg import JointState  # type: ignore[import-untyped]
-from std_msgs.msg import Float64MultiArray  # type: ignore[import-untyped]
-from std_srvs.srv import Trigger  # type: ignore[import-untyped]
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Trigger
 
 NODE_NAME = "openral_manifest_node"
 JOINT_STATES = "/joint_states"

@@ -35,8 +35,8 @@ from rclpy.qos import (
     ReliabilityPolicy,
     qos_profile_sensor_data,
 )
-from sensor_msgs.msg import Image, JointState  # type: ignore[import-untyped]
-from std_msgs.msg import Float64MultiArray  # type: ignore[import-untyped]
+from sensor_msgs.msg import Image, JointState
+from std_msgs.msg import Float64MultiArray
 
 from openral_nodes.policies import Observation, PolicyAdapter, make_policy, parse_params
 from openral_nodes.topic_codec import image_to_rgb

@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-from builtin_interfaces.msg import Time  # type: ignore[import-untyped]
-from sensor_msgs.msg import (  # type: ignore[import-untyped]
+from builtin_interfaces.msg import Time
+from sensor_msgs.msg import (
     CameraInfo,
     Image,
     JointState,

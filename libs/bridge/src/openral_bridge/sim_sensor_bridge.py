@@ -153,7 +153,7 @@ class SimSensorBridge:
     def _setup_cameras(self) -> None:
         if not callable(getattr(self.hal, "read_images", None)):
             return
-        from sensor_msgs.msg import CameraInfo, Image  # type: ignore[import-untyped]
+        from sensor_msgs.msg import CameraInfo, Image
 
         rendered = self.hal.read_images()
         for sensor in self.description.sensors:
