@@ -17,9 +17,10 @@ from functools import partial
 from typing import Any
 
 import pytest
+from openral_bridge.topics import ACTION_SPEC
 from openral_core.models import RobotDescription
-from openral_nodes.manifest_node import ACTION_SPEC, LATCHED, ManifestLifecycleNode
-from openral_nodes.runtime import Spinner, claim_domain_id
+from openral_nodes.manifest_node import ManifestLifecycleNode
+from openral_nodes.runtime import LATCHED, Spinner, claim_domain_id
 from rclpy.context import Context
 from rclpy.node import Node
 from sensor_msgs.msg import CameraInfo, Image, JointState

@@ -18,8 +18,8 @@ from typing import Any
 import numpy as np
 import pytest
 from openral_bridge.ros_messages import image_msg, joint_state_msg, stamp
-from openral_nodes.rskill_runner import ACTION_SPEC_QOS
-from openral_nodes.runtime import Spinner, claim_domain_id, ros_session
+from openral_bridge.topics import ACTION_SPEC
+from openral_nodes.runtime import LATCHED, Spinner, claim_domain_id, ros_session
 from rclpy.context import Context
 from rclpy.node import Node
 from sensor_msgs.msg import Image, JointState
@@ -60,7 +60,7 @@ class FakeGraph(Node):
             for name in cameras
         }
         spec = JointState(name=FRANKA_JOINTS, position=HOLD.tolist())
-        self._spec_pub = self.create_publisher(JointState, "/openral/action_spec", ACTION_SPEC_QOS)
+        self._spec_pub = self.create_publisher(JointState, ACTION_SPEC, LATCHED)
         if action_spec:
             self._spec_pub.publish(spec)
         self._joints = self.create_publisher(JointState, "/joint_states", 10)

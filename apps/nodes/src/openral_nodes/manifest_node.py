@@ -34,6 +34,14 @@ from typing import Any
 import numpy as np
 from openral_bridge import ros_messages
 from openral_bridge.sim_sensor_bridge import SimSensorBridge, TopicInfo
+from openral_bridge.topics import (
+    ACTION_SPEC,
+    CLOCK,
+    ESTOP,
+    JOINT_STATES,
+    RELEASE_ESTOP,
+    SAFE_ACTION,
+)
 from openral_core.errors import OpenralError
 from openral_core.loader import load_robot, load_scene
 from openral_core.models import RobotDescription
@@ -42,23 +50,14 @@ from openral_hal.errors import HalError
 from openral_hal.factory import build_hal
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.parameter import Parameter
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 
+from openral_nodes.runtime import LATCHED
+
 NODE_NAME = "openral_manifest_node"
-JOINT_STATES = "/joint_states"
-CLOCK = "/clock"
-ACTION_SPEC = "/openral/action_spec"
-SAFE_ACTION = "/openral/safe_action"
-ESTOP = "/openral/estop"
-RELEASE_ESTOP = "/openral/release_estop"
-LATCHED = QoSProfile(  # type: ignore[no-untyped-call]
-    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
-)
-"""QoS of ``/openral/action_spec``: a late subscriber still gets the last message."""
 WARN_EVERY_S = 2.0
 """At most one warning per this many seconds for a stream of refused actions [s]."""
 

@@ -23,35 +23,21 @@ from typing import Any, TypeVar
 
 import numpy as np
 import numpy.typing as npt
+from openral_bridge import topics
 from openral_core import VlaSlot, load_robot_by_id, vla_slots
 from openral_core.errors import OpenralError
 from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import (
-    DurabilityPolicy,
-    HistoryPolicy,
-    QoSProfile,
-    ReliabilityPolicy,
     qos_profile_sensor_data,
 )
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float64MultiArray
 
 from openral_nodes.policies import Observation, PolicyAdapter, make_policy, parse_params
+from openral_nodes.runtime import LATCHED
 from openral_nodes.topic_codec import image_to_rgb
-
-CAMERA_TOPIC = "/openral/cameras/{sensor}/image"
-JOINT_STATES_TOPIC = "/joint_states"
-ACTION_SPEC_TOPIC = "/openral/action_spec"
-SAFE_ACTION_TOPIC = "/openral/safe_action"
-ACTION_SPEC_QOS = QoSProfile(  # type: ignore[no-untyped-call]
-    history=HistoryPolicy.KEEP_LAST,
-    depth=1,
-    reliability=ReliabilityPolicy.RELIABLE,
-    durability=DurabilityPolicy.TRANSIENT_LOCAL,
-)
-"""Latched: a late subscriber still receives the one action spec."""
 
 T = TypeVar("T")
 
@@ -80,7 +66,7 @@ class MissingSlots(OpenralError):
     ) -> None:
         self.expected = tuple(expected)
         self.seen = tuple(seen)
-        routes = ", ".join(f"{e.slot} <- {CAMERA_TOPIC.format(sensor=e.sensor)}" for e in table)
+        routes = ", ".join(f"{e.slot} <- {topics.camera_image(e.sensor)}" for e in table)
         super().__init__(
             f"policy {policy} needs camera slots ({_slot_list(expected)}) but {where} "
             f"({_slot_list(seen)}); {robot}: {routes or 'no RGB sensors'}{hint}"
@@ -177,17 +163,15 @@ class RskillRunnerNode(Node):
         for entry in self.slot_table:
             self.create_subscription(
                 Image,
-                CAMERA_TOPIC.format(sensor=entry.sensor),
+                topics.camera_image(entry.sensor),
                 self._frame_callback(entry.sensor),
                 qos_profile_sensor_data,
             )
         self.create_subscription(
-            JointState, JOINT_STATES_TOPIC, self._on_joint_state, qos_profile_sensor_data
+            JointState, topics.JOINT_STATES, self._on_joint_state, qos_profile_sensor_data
         )
-        self.create_subscription(
-            JointState, ACTION_SPEC_TOPIC, self._on_action_spec, ACTION_SPEC_QOS
-        )
-        self._publisher = self.create_publisher(Float64MultiArray, SAFE_ACTION_TOPIC, 10)
+        self.create_subscription(JointState, topics.ACTION_SPEC, self._on_action_spec, LATCHED)
+        self._publisher = self.create_publisher(Float64MultiArray, topics.SAFE_ACTION, 10)
         self._timer = self.create_timer(1.0 / rate_hz, self._tick)
 
     def _frame_callback(self, sensor: str) -> Callable[[Any], None]:
@@ -203,7 +187,7 @@ class RskillRunnerNode(Node):
         names, hold = tuple(msg.name), np.asarray(msg.position, dtype=np.float64)
         if len(names) != hold.size:
             self._abort(
-                RunnerAborted(f"{ACTION_SPEC_TOPIC}: {len(names)} names, {hold.size} holds")
+                RunnerAborted(f"{topics.ACTION_SPEC}: {len(names)} names, {hold.size} holds")
             )
             return
         self._spec = (names, hold)
@@ -268,7 +252,7 @@ class RskillRunnerNode(Node):
             )
         absent = [
             topic
-            for topic, ok in ((ACTION_SPEC_TOPIC, self._spec), (JOINT_STATES_TOPIC, self._joints))
+            for topic, ok in ((topics.ACTION_SPEC, self._spec), (topics.JOINT_STATES, self._joints))
             if not ok
         ]
         return RunnerAborted(

@@ -32,9 +32,8 @@ from openral_hal.factory import can_idle_step
 
 from openral_bridge import ros_messages
 from openral_bridge.idle import should_idle_step
+from openral_bridge.topics import camera_image, camera_info
 
-CAMERA_TOPIC = "/openral/cameras/{name}/image"
-CAMERA_INFO_TOPIC = "/openral/cameras/{name}/camera_info"
 IMAGE_QUEUE_DEPTH = 5
 """Reliable queue of the image publishers: a slow subscriber drops old frames, not new."""
 
@@ -142,9 +141,9 @@ class SimSensorBridge:
         rate = self.camera_rate_hz
         rows = []
         for name, (_, info_pub) in self._image_pubs.items():
-            rows.append(TopicInfo(CAMERA_TOPIC.format(name=name), "sensor_msgs/msg/Image", rate))
+            rows.append(TopicInfo(camera_image(name), "sensor_msgs/msg/Image", rate))
             if info_pub is not None:
-                info = CAMERA_INFO_TOPIC.format(name=name)
+                info = camera_info(name)
                 rows.append(TopicInfo(info, "sensor_msgs/msg/CameraInfo", rate))
         return rows
 
@@ -161,13 +160,11 @@ class SimSensorBridge:
                 continue
             fovy = self._fovy_deg(sensor)
             self._cameras[sensor.name] = (sensor, fovy)
-            image = self.node.create_publisher(
-                Image, CAMERA_TOPIC.format(name=sensor.name), IMAGE_QUEUE_DEPTH
-            )
+            image = self.node.create_publisher(Image, camera_image(sensor.name), IMAGE_QUEUE_DEPTH)
             self._publishers.append(image)
             info = None
             if fovy is not None:
-                topic = CAMERA_INFO_TOPIC.format(name=sensor.name)
+                topic = camera_info(sensor.name)
                 info = self.node.create_publisher(CameraInfo, topic, IMAGE_QUEUE_DEPTH)
                 self._publishers.append(info)
             self._image_pubs[sensor.name] = (image, info)

@@ -140,7 +140,7 @@ def _shut_down(node: Any) -> None:
 
 def _print_interfaces(node: Any, config: Path) -> None:
     """What the graph offers: published topics in a table (fits 80 columns), then inputs."""
-    from openral_nodes.manifest_node import ESTOP, RELEASE_ESTOP, SAFE_ACTION
+    from openral_bridge.topics import ESTOP, RELEASE_ESTOP, SAFE_ACTION
 
     names, _ = node.action_layout()
     table = Table(

@@ -1,0 +1,29 @@
+"""The ROS names of the openral graph, in one place for the node, the bridge and the runner.
+
+Pure constants (no rclpy, no MuJoCo), so any process can import them cheaply.
+"""
+
+from __future__ import annotations
+
+JOINT_STATES = "/joint_states"
+"""sensor_msgs/JointState: every manifest joint under its canonical name."""
+CLOCK = "/clock"
+"""rosgraph_msgs/Clock: simulation time."""
+ACTION_SPEC = "/openral/action_spec"
+"""sensor_msgs/JointState, latched: action slot names and the hold action."""
+SAFE_ACTION = "/openral/safe_action"
+"""std_msgs/Float64MultiArray: one value per action slot."""
+ESTOP = "/openral/estop"
+"""std_srvs/Trigger: latch the E-stop."""
+RELEASE_ESTOP = "/openral/release_estop"
+"""std_srvs/Trigger: release the E-stop."""
+
+
+def camera_image(sensor: str) -> str:
+    """sensor_msgs/Image (rgb8) of one manifest RGB sensor."""
+    return f"/openral/cameras/{sensor}/image"
+
+
+def camera_info(sensor: str) -> str:
+    """sensor_msgs/CameraInfo of one manifest RGB sensor."""
+    return f"/openral/cameras/{sensor}/camera_info"
