@@ -7,7 +7,13 @@ usage errors exit 2 (typer's convention).
 
 from __future__ import annotations
 
+import os
 import sys
+
+if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+    # Headless: render offscreen with EGL. MuJoCo reads this once, when it is first
+    # imported, so it is set before any command module is.
+    os.environ.setdefault("MUJOCO_GL", "egl")
 
 import typer
 from openral_core.errors import OpenralError

@@ -12,7 +12,6 @@ exits 0. ``openral ros topics`` in a second terminal lists what it publishes.
 
 from __future__ import annotations
 
-import os
 import signal
 import threading
 import time
@@ -29,12 +28,6 @@ app = typer.Typer(help="Run robots as ROS 2 graphs.", no_args_is_help=True)
 out = Console()
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
-
-if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-    # Headless: render offscreen with EGL. MuJoCo reads this once, when it is first imported,
-    # so it is set here, at import of this module (main.py imports it before any module
-    # that imports mujoco).
-    os.environ.setdefault("MUJOCO_GL", "egl")
 
 
 @app.command("sim")
