@@ -132,3 +132,20 @@ def test_franka_page_shows_its_picture_without_errors(page: CdpPage, site_url: s
     assert visit.checks["copyButtons"] > 0
     assert visit.checks["editLink"].endswith("/edit/main/docs/robots/franka_panda.md")
     assert Path(SCREENSHOTS / "franka_panda-full.png").stat().st_size > 50_000
+
+
+def test_architecture_diagram_is_drawn_offline(page: CdpPage, site_url: str) -> None:
+    """Mermaid comes from the site itself (fetched by ./bootstrap), not from a CDN."""
+    vendored = Path(__file__).parents[2] / "docs" / "javascripts" / "vendor" / "mermaid.min.js"
+    assert vendored.is_file(), f"{vendored} is missing: ./bootstrap fetches it"
+    visit = _visit(page, f"{site_url}architecture/", "architecture")
+    assert not visit.errors, visit.errors
+    # Material draws each diagram into a closed shadow root of a div.mermaid that replaces
+    # the <pre class="mermaid"> source block; an undrawn diagram stays a <pre>.
+    drawn = page.evaluate(
+        "({source: document.querySelectorAll('pre.mermaid').length, "
+        "drawn: Array.from(document.querySelectorAll('div.mermaid'))"
+        ".map(d => Math.round(d.getBoundingClientRect().height))})"
+    )
+    assert drawn["source"] == 0 and drawn["drawn"], drawn
+    assert all(height > 150 for height in drawn["drawn"]), drawn
