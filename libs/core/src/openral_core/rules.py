@@ -81,7 +81,7 @@ def _sim_findings(robot: RobotDescription) -> Iterator[Finding]:
     joints = [j.name for j in robot.joints]
     known = set(joints)
     for field in ("joint_qpos_addr", "joint_qvel_addr", "actuator_index"):
-        yield from _keys_known(getattr(sim, field), known, ("sim", field))
+        yield from _keys_known(getattr(sim, field), joints, ("sim", field))
     gripper_joints: set[str] = set()
     for index, gripper in enumerate(sim.grippers):
         path: PathKey = ("sim", "grippers", index)
@@ -100,18 +100,20 @@ def _sim_findings(robot: RobotDescription) -> Iterator[Finding]:
             gains = getattr(control, gain_name)
             if isinstance(gains, Mapping):
                 path = ("sim", "control", gain_name)
-                yield from _keys_known(gains, known, path)
+                yield from _keys_known(gains, joints, path)
                 missing = [j for j in driven if j not in gains]
                 if missing:
                     yield path, f"no gain for joint(s) {', '.join(missing)}; give every joint one"
 
 
 def _keys_known(
-    mapping: Mapping[str, object] | None, known: set[str], path: PathKey
+    mapping: Mapping[str, object] | None, joints: Sequence[str], path: PathKey
 ) -> Iterator[Finding]:
+    """A finding for each key of ``mapping`` that is not a joint (listed in manifest order)."""
+    known = set(joints)
     for key in mapping or {}:
         if key not in known:
-            yield (*path, key), _not_a_joint(key, sorted(known))
+            yield (*path, key), _not_a_joint(key, joints)
 
 
 def _not_a_joint(name: str, joints: Sequence[str]) -> str:
