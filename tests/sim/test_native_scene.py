@@ -136,3 +136,17 @@ def test_a_scene_for_an_unknown_robot_names_the_file(tmp_path: Path) -> None:
     bad.write_text(text.replace("robot_id: franka_panda", "robot_id: nobot"))
     with pytest.raises(OpenralError, match=r"scene\.yaml: robot_id: unknown robot 'nobot'"):
         build_sim_env_from_yaml(bad)
+
+
+@pytest.mark.parametrize("axis", ["+x", "-x", "+y", "-y", "+z", "-z"])
+def test_a_mounted_camera_looks_along_its_mount_axis(axis: str) -> None:
+    from openral_sim.native_scene import _looking_along
+
+    position, xyaxes = _looking_along(axis)
+    right, up = np.array(xyaxes[:3]), np.array(xyaxes[3:])
+    look = -np.cross(right, up)  # a MuJoCo camera looks along its -z
+    expected = np.zeros(3)
+    expected["xyz".index(axis[1])] = 1.0 if axis[0] == "+" else -1.0
+    np.testing.assert_allclose(look, expected, atol=1e-12)
+    assert abs(float(np.dot(right, up))) < 1e-12
+    np.testing.assert_allclose(np.array(position) @ expected, 0.0, atol=1e-12)  # beside it

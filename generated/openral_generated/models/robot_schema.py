@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from enum import StrEnum
+from enum import Enum, StrEnum
 from typing import Annotated, Literal
 from pydantic import ConfigDict, Field
 from openral_base import OpenralModel
@@ -116,6 +116,19 @@ class ContinuousJoint(OpenralModel):
     """
 
 
+class MountAxis(Enum):
+    """
+    Axis of `mount_body` the camera looks along. Absent: forward (+x) on a torso, head, pelvis or base body, and +z (the usual tool axis) on any other body. UR arms, for example, carry their tool along +y of wrist_3_link.
+    """
+
+    field_x = "+x"
+    field_x_1 = "-x"
+    field_y = "+y"
+    field_y_1 = "-y"
+    field_z = "+z"
+    field_z_1 = "-z"
+
+
 class RgbSensor(OpenralModel):
     """
     A colour camera; optionally the input of a vision-language-action policy.
@@ -145,6 +158,10 @@ class RgbSensor(OpenralModel):
     ] = None
     """
     MJCF body (native name) the camera is rigidly attached to, such as the hand for a wrist camera. Absent means a fixed camera placed by the scene.
+    """
+    mount_axis: MountAxis | None = None
+    """
+    Axis of `mount_body` the camera looks along. Absent: forward (+x) on a torso, head, pelvis or base body, and +z (the usual tool axis) on any other body. UR arms, for example, carry their tool along +y of wrist_3_link.
     """
     fovy_deg: Annotated[float, Field(gt=0.0, lt=180.0)] = 45.0
     """
@@ -216,6 +233,10 @@ class DepthSensor(OpenralModel):
     ] = None
     """
     MJCF body (native name) the camera is rigidly attached to, such as the hand for a wrist camera. Absent means a fixed camera placed by the scene.
+    """
+    mount_axis: MountAxis | None = None
+    """
+    Axis of `mount_body` the camera looks along. Absent: forward (+x) on a torso, head, pelvis or base body, and +z (the usual tool axis) on any other body. UR arms, for example, carry their tool along +y of wrist_3_link.
     """
     fovy_deg: Annotated[float, Field(gt=0.0, lt=180.0)] = 45.0
     """

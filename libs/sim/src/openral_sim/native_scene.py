@@ -235,11 +235,12 @@ def _compose(
     yaw = math.radians(pose.yaw_deg if pose and pose.yaw_deg else 0.0)
     options = scene.scene.options
     child_model = child.copy().compile()  # before attach: no compile after it
-    own_floor = any(g.type == mujoco.mjtGeom.mjGEOM_PLANE for g in child.geoms)
+    own_floor = any(g.type == mujoco.mjtGeom.mjGEOM_PLANE for g in child.geoms)  # no 2nd
     floor_z = 0.0
     if scene.scene.assets == "floor":  # the model brings a table: the floor goes under it
         floor_z = min(0.0, base[2] + _lowest_static_point(child_model) - 0.001)
-    _add_world(spec, floor_z=None if own_floor else floor_z)  # one floor: two flicker
+    own_sky = any(t.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX for t in child.textures)
+    _add_world(spec, floor_z=None if own_floor else floor_z, sky=not own_sky)
     if scene.scene.assets == "tabletop":
         table_h = (
             options.table_height_m
@@ -299,9 +300,19 @@ def _add_base_weld(
     )
 
 
-def _add_world(spec: mujoco.MjSpec, *, floor_z: float | None) -> None:
+def _add_world(spec: mujoco.MjSpec, *, floor_z: float | None, sky: bool) -> None:
     spec.worldbody.add_light(name="scene_key_light", pos=[0.5, -1.0, 3.0], dir=[0, 0.3, -1])
     spec.worldbody.add_light(name="scene_fill_light", pos=[-1.0, 1.0, 2.5], dir=[0.4, -0.3, -1])
+    if sky:  # a camera looking up or away sees a sky, not black
+        spec.add_texture(
+            name="scene_sky",
+            type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
+            builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT,
+            rgb1=[0.62, 0.72, 0.82],
+            rgb2=[0.16, 0.18, 0.22],
+            width=256,
+            height=256,
+        )
     if floor_z is None:
         return
     spec.worldbody.add_geom(
@@ -355,14 +366,27 @@ def _add_mounted_cameras(
         if body is None:
             raise SceneError(f"sensor {sensor.name!r}: no body {sensor.mount_body!r} in the model")
         forward = any(word in sensor.mount_body.lower() for word in FORWARD_LOOKING)
+        axis = sensor.mount_axis.value if sensor.mount_axis is not None else None
         # A MuJoCo camera looks along its -z axis with +y up.
-        if forward:  # look along body +x, slightly down, from above the body origin
+        if axis is None and forward:  # along body +x, slightly down, from above the origin
             pos, xyaxes = [0.1, 0.0, 0.35], [0, -1, 0, 0.45, 0, 1]
-        else:  # look along body +z (the tool axis) from beside it
-            pos, xyaxes = [0.0, -0.07, 0.0], [1, 0, 0, 0, -1, 0]
+        else:
+            pos, xyaxes = _looking_along(axis or "+z")
         body.add_camera(
             name=cameras[sensor.name], pos=pos, xyaxes=xyaxes, fovy=sensor.fovy_deg or 60.0
         )
+
+
+def _looking_along(axis: str) -> tuple[list[float], list[float]]:
+    """Camera position and xyaxes in a body's frame that look along body ``axis`` (e.g.
+    ``+y``) from 7 cm beside it, image up pointing to that side (for ``+z``: from -y)."""
+    index = "xyz".index(axis[1])
+    look = np.zeros(3)
+    look[index] = 1.0 if axis[0] == "+" else -1.0
+    up = np.zeros(3)
+    up[(index - 1) % 3] = -1.0  # z -> -y, y -> -x, x -> -z
+    right = np.cross(up, -look)
+    return (0.07 * up).tolist(), [*right.tolist(), *up.tolist()]
 
 
 def _add_fixed_camera(
