@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
+import mujoco
 import numpy as np
 import numpy.typing as npt
 import pytest
@@ -81,3 +82,15 @@ def test_estop_freezes_the_scene(hal: SimAttachedHAL) -> None:
         assert not hal.idle_step()
     np.testing.assert_array_equal(hal.read_images()["wrist"], frame)
     np.testing.assert_array_equal(hal.read_state().positions, state.positions)
+
+
+def test_camera_fovy_comes_from_the_camera_that_renders_the_sensor(hal: SimAttachedHAL) -> None:
+    handles = hal.mujoco_handles()
+    assert handles is not None
+    model = handles[0]
+    for sensor, camera in hal.env.camera_models.items():
+        index = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera)
+        assert index >= 0, camera
+        assert hal.camera_fovy_deg(sensor) == pytest.approx(float(model.cam_fovy[index]))
+    assert hal.camera_fovy_deg("wrist") == pytest.approx(75.0)  # the manifest's, mounted
+    assert hal.camera_fovy_deg("belly") is None

@@ -91,6 +91,10 @@ class MujocoArmRollout:
     def camera_names(self) -> tuple[str, ...]:
         return ("agentview",)
 
+    @property
+    def camera_models(self) -> dict[str, str]:
+        return {"agentview": "agentview"}
+
     def reset(self, seed: int | None = None) -> Observation:
         self.resets.append(seed)
         mujoco.mj_resetData(self.model, self.data)
@@ -134,6 +138,10 @@ class NonMujocoRollout:
     @property
     def camera_names(self) -> tuple[str, ...]:
         return ("agentview",)
+
+    @property
+    def camera_models(self) -> dict[str, str]:
+        return {}  # nothing MuJoCo renders here
 
     def reset(self, seed: int | None = None) -> Observation:
         self.resets += 1

@@ -199,15 +199,10 @@ class SimSensorBridge:
 
     def _fovy_deg(self, sensor: RgbSensor) -> float | None:
         """Vertical field of view [deg]: the scene camera's, else the manifest's."""
-        handles = self._handles()
-        if handles is not None:
-            model = handles[0]
-            for name in (sensor.camera, f"openral_{sensor.name}", sensor.name):
-                if name is None:
-                    continue
-                camera = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, name)
-                if camera >= 0:
-                    return float(model.cam_fovy[camera])
+        scene_fovy = getattr(self.hal, "camera_fovy_deg", None)
+        fovy = scene_fovy(sensor.name) if callable(scene_fovy) else None
+        if fovy is not None:
+            return float(fovy)
         if sensor.fovy_deg is not None:
             return float(sensor.fovy_deg)
         self.node.get_logger().warning(

@@ -151,6 +151,16 @@ class SimAttachedHAL:
         """The scene's live MuJoCo (model, data), or None for a non-MuJoCo backend."""
         return self.env.mujoco_handles()
 
+    def camera_fovy_deg(self, sensor: str) -> float | None:
+        """Vertical field of view of the scene camera that renders ``sensor`` (None when the
+        backend has no MuJoCo model or does not render it)."""
+        handles = self.env.mujoco_handles()
+        camera = self.env.camera_models.get(sensor)
+        if handles is None or camera is None:
+            return None
+        index = mujoco.mj_name2id(handles[0], mujoco.mjtObj.mjOBJ_CAMERA, camera)
+        return float(handles[0].cam_fovy[index]) if index >= 0 else None
+
     # -- state and sensors -----------------------------------------------------------------
 
     def read_state(self) -> JointStateSample:

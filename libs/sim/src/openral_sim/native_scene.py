@@ -108,6 +108,11 @@ class NativeScene:
         """Manifest sensor names rendered into ``obs["images"]``."""
         return tuple(self._sensors)
 
+    @property
+    def camera_models(self) -> dict[str, str]:
+        """Sensor name → MJCF camera of the composed model."""
+        return dict(self._sensors)
+
     def reset(self, seed: int | None = None) -> Observation:
         """Keyframe (if any) at the scene's base pose, actuators holding the start pose."""
         if seed is not None:

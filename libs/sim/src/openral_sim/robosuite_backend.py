@@ -156,6 +156,11 @@ class RobosuiteRollout:
         return np.asarray(low, dtype=np.float64), np.asarray(high, dtype=np.float64)
 
     @property
+    def camera_models(self) -> dict[str, str]:
+        """openral camera name → robosuite (MJCF) camera name."""
+        return dict(self._cameras)
+
+    @property
     def camera_names(self) -> tuple[str, ...]:
         """openral camera names rendered into ``obs["images"]``."""
         return self._names

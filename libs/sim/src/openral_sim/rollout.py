@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
 
@@ -37,6 +38,12 @@ class SimRollout(Protocol):
     @property
     def camera_names(self) -> tuple[str, ...]:
         """Cameras rendered into ``obs["images"]``."""
+        ...
+
+    @property
+    def camera_models(self) -> Mapping[str, str]:
+        """Camera name in ``obs["images"]`` → the MJCF camera of ``mujoco_handles()``'s model
+        that renders it (empty for a non-MuJoCo backend)."""
         ...
 
     def reset(self, seed: int | None = None) -> Observation:
