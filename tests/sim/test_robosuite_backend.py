@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 from collections.abc import Iterator
 from pathlib import Path
@@ -11,6 +12,7 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 import mujoco
 import numpy as np
 import pytest
+from openral_cli.main import app as cli
 from openral_core import load_robot_by_id
 from openral_core.errors import OpenralError
 from openral_core.loader import load_scene
@@ -23,6 +25,7 @@ from openral_sim.robosuite_backend import (
 )
 from openral_sim.rollout import SimRollout
 from openral_sim.scene import build_sim_env_from_yaml
+from typer.testing import CliRunner
 
 from tests.conftest import REPO
 
@@ -206,3 +209,15 @@ def test_robosuite_and_native_scenes_give_the_same_joint_names() -> None:
     assert robosuite.names == native.names == tuple(j.name for j in franka.joints)
     for state in (robosuite, native):  # real joint angles, not zeros: the arm starts bent
         assert np.isfinite(state.positions).all() and np.abs(state.positions).max() > 0.1
+
+
+def test_sim_run_drives_the_robosuite_scene(tmp_path: Path) -> None:
+    """`openral sim run` steps robosuite with its own (7-wide) action and names the joints."""
+    scene = REPO / "robots" / "franka_panda" / "scenes" / "lift_robosuite.yaml"
+    result = CliRunner().invoke(
+        cli, ["sim", "run", "--config", str(scene), "--steps", "3", "--out", str(tmp_path)]
+    )
+    assert result.exit_code == 0, result.output
+    assert len(sorted(tmp_path.glob("wrist_*.png"))) == 3
+    last = json.loads((tmp_path / "joint_states.jsonl").read_text().splitlines()[-1])
+    assert set(last["positions"]) == {f"joint{i}" for i in range(1, 8)} | {"finger_joint1"}
