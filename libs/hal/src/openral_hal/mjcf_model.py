@@ -27,6 +27,14 @@ def is_motor(model: mujoco.MjModel, actuator: int) -> bool:
     return int(model.actuator_biastype[actuator]) == int(mujoco.mjtBias.mjBIAS_NONE)
 
 
+def is_scalar_joint(model: mujoco.MjModel, joint: int) -> bool:
+    """The joint has one coordinate (hinge or slide), as a manifest joint must."""
+    return int(model.jnt_type[joint]) in (
+        int(mujoco.mjtJoint.mjJNT_HINGE),
+        int(mujoco.mjtJoint.mjJNT_SLIDE),
+    )
+
+
 def root_is_free(model: mujoco.MjModel) -> bool:
     """The model's first joint is a free joint at qpos 0 (a floating base)."""
     return (

@@ -23,7 +23,7 @@ from openral_core.tables import GripperWiring, HalWiring, hal_wiring
 from openral_hal.action import validated_action
 from openral_hal.errors import EStopLatched, HalError, NotConnected, SimulationDiverged
 from openral_hal.gripper import gripper_ctrl, read_gripper
-from openral_hal.mjcf_model import ctrl_limits, is_position_servo
+from openral_hal.mjcf_model import ctrl_limits, is_position_servo, is_scalar_joint
 from openral_hal.mjcf_uri import resolve_mjcf_uri
 from openral_hal.state import FloatArray, JointStateSample
 
@@ -322,9 +322,15 @@ class MujocoArmHAL:
             data.ctrl[self._arm_act] = setpoint
 
     def _apply_pd(self, data: mujoco.MjData) -> None:
-        error = self._setpoint - data.qpos[self._arm_qpos]
-        torque = self._kp * error - self._kd * data.qvel[self._arm_qvel]
-        data.ctrl[self._arm_act] = np.minimum(np.maximum(torque, self._arm_low), self._arm_high)
+        data.ctrl[self._arm_act] = pd_torque(
+            self._kp,
+            self._kd,
+            self._setpoint,
+            data.qpos[self._arm_qpos],
+            data.qvel[self._arm_qvel],
+            self._arm_low,
+            self._arm_high,
+        )
 
     def _set_ctrl(self, data: mujoco.MjData, actuator: int, value: float) -> None:
         """ctrl[actuator] = value clipped to the actuator's ctrlrange."""
@@ -361,6 +367,20 @@ def hal_kwargs(wiring: HalWiring) -> dict[str, Any]:
     return kwargs
 
 
+def pd_torque(
+    kp: FloatArray,
+    kd: FloatArray,
+    target: FloatArray,
+    q: FloatArray,
+    qdot: FloatArray,
+    low: FloatArray,
+    high: FloatArray,
+) -> FloatArray:
+    """The ``torque_pd`` control law: ``kp * (target - q) - kd * qdot``, clipped to [low, high]."""
+    torque: FloatArray = np.minimum(np.maximum(kp * (target - q) - kd * qdot, low), high)
+    return torque
+
+
 def seed_position_servos(model: mujoco.MjModel, data: mujoco.MjData) -> None:
     """ctrl ← qpos of the joint for every position-servo actuator on a hinge or slide joint."""
     for actuator in range(model.nu):
@@ -369,7 +389,7 @@ def seed_position_servos(model: mujoco.MjModel, data: mujoco.MjData) -> None:
         if not is_position_servo(model, actuator):
             continue
         joint = model.actuator_trnid[actuator, 0]
-        if model.jnt_type[joint] not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
+        if not is_scalar_joint(model, joint):
             continue
         low, high = model.actuator_ctrlrange[actuator]
         value = float(data.qpos[model.jnt_qposadr[joint]])

@@ -30,7 +30,13 @@ from pathlib import Path
 import mujoco
 
 from openral_hal.errors import HalError
-from openral_hal.mjcf_model import fixed_tendon_joints, is_motor, is_position_servo, root_is_free
+from openral_hal.mjcf_model import (
+    fixed_tendon_joints,
+    is_motor,
+    is_position_servo,
+    is_scalar_joint,
+    root_is_free,
+)
 from openral_hal.mjcf_uri import resolve_mjcf_uri
 
 SCHEMA_LINE = "# yaml-language-server: $schema=../../schema/robot.schema.json"
@@ -148,10 +154,7 @@ def _driven_joints(model: mujoco.MjModel) -> tuple[list[_Driven], list[str], set
             continue
         seen.add(jid)
         mjcf_name = _joint_name(model, jid)
-        if int(model.jnt_type[jid]) not in (
-            int(mujoco.mjtJoint.mjJNT_HINGE),
-            int(mujoco.mjtJoint.mjJNT_SLIDE),
-        ):
+        if not is_scalar_joint(model, jid):
             skipped.append(f"{label} (drives the ball or free joint {mjcf_name or jid})")
             continue
         if not MJCF_NAME.fullmatch(mjcf_name):

@@ -23,11 +23,11 @@ from openral_sim.rollout import HoldingRollout, Observation, SimRollout, StepRes
 
 from openral_hal.action import validated_action
 from openral_hal.errors import ConfigurationError, EStopLatched, HalError, NotConnected
+from openral_hal.mjcf_model import is_scalar_joint
 from openral_hal.name_resolution import resolve_joint_names
 from openral_hal.state import FloatArray, JointStateSample
 
 _log = logging.getLogger(__name__)
-_SCALAR_JOINTS = (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
 
 
 class SimAttachedHAL:
@@ -296,7 +296,7 @@ class SimAttachedHAL:
         bad = [
             resolved[n]
             for n, i in zip(self._mjcf_names, ids, strict=True)
-            if model.jnt_type[i] not in _SCALAR_JOINTS
+            if not is_scalar_joint(model, i)
         ]
         if bad:
             raise HalError(

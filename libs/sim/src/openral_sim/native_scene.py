@@ -30,7 +30,7 @@ from openral_core.registry import manifest_path
 from openral_core.tables import hal_wiring, joint_name_map
 from openral_hal.mjcf_model import ctrl_limits
 from openral_hal.mjcf_uri import resolve_mjcf_uri
-from openral_hal.mujoco_arm import seed_position_servos
+from openral_hal.mujoco_arm import pd_torque, seed_position_servos
 
 from openral_sim.rollout import Observation, StepResult
 
@@ -81,7 +81,6 @@ class NativeScene:
         self._targets = np.zeros(self.model.nu)
         self._renderer: mujoco.Renderer | None = None
         self._steps = 0
-        self._rng = np.random.default_rng(scene.seed)
 
     # -- SimRollout ------------------------------------------------------------------------
 
@@ -114,9 +113,10 @@ class NativeScene:
         return dict(self._sensors)
 
     def reset(self, seed: int | None = None) -> Observation:
-        """Keyframe (if any) at the scene's base pose, actuators holding the start pose."""
-        if seed is not None:
-            self._rng = np.random.default_rng(seed)
+        """Keyframe (if any) at the scene's base pose, actuators holding the start pose.
+
+        The native scene has nothing random in it; ``seed`` is accepted for the protocol.
+        """
         mujoco.mj_resetData(self.model, self.data)
         if self._keyframe is not None:
             mujoco.mj_resetDataKeyframe(self.model, self.data, self._keyframe)
@@ -197,9 +197,8 @@ class NativeScene:
         yaw = math.radians(pose.yaw_deg or 0.0)
         free = self._root_qpos  # the robot's free joint (objects may have their own)
         self.data.qpos[free : free + 3] += position
-        turn = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
         quat = np.empty(4)
-        mujoco.mju_mulQuat(quat, turn, self.data.qpos[free + 3 : free + 7].copy())
+        mujoco.mju_mulQuat(quat, _yaw_quat(yaw), self.data.qpos[free + 3 : free + 7].copy())
         self.data.qpos[free + 3 : free + 7] = quat
 
 
@@ -460,10 +459,11 @@ def _robot_extent(model: mujoco.MjModel, robot: RobotDescription) -> tuple[np.nd
 
 
 def _pd_law(robot: RobotDescription, model: mujoco.MjModel) -> Any:
-    """ctrl = clip(kp * (target - q) - kd * qdot) for each actuator on a manifest joint."""
+    """The manifest's PD law (:func:`pd_torque`) for every actuator, as a function of the
+    data and the per-actuator position targets."""
     wiring = hal_wiring(robot)
     assert wiring is not None
-    canonical = {j.sim_joint_name or j.name: j.name for j in robot.joints}
+    canonical = {mjcf: name for name, mjcf in joint_name_map(robot).items()}
     joints = model.actuator_trnid[:, 0]
     qpos_addr = model.jnt_qposadr[joints]
     dof_addr = model.jnt_dofadr[joints]
@@ -476,9 +476,7 @@ def _pd_law(robot: RobotDescription, model: mujoco.MjModel) -> Any:
     low, high = ctrl_limits(model)
 
     def law(data: mujoco.MjData, targets: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-        torque = kp * (targets - data.qpos[qpos_addr]) - kd * data.qvel[dof_addr]
-        clipped: npt.NDArray[np.float64] = np.clip(torque, low, high)
-        return clipped
+        return pd_torque(kp, kd, targets, data.qpos[qpos_addr], data.qvel[dof_addr], low, high)
 
     return law
 
