@@ -7,20 +7,17 @@ usage errors exit 2 (typer's convention).
 
 from __future__ import annotations
 
-import os
 import sys
-
-if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-    # Headless: render offscreen with EGL. MuJoCo reads this once, when it is first
-    # imported, so it is set before any command module is.
-    os.environ.setdefault("MUJOCO_GL", "egl")
 
 import typer
 from openral_core.errors import OpenralError
+from openral_sim.display import render_offscreen_when_headless
 from rich.console import Console
 from rich.markup import escape
 
-from openral_cli.commands import deploy, robot, ros, rskill, sim
+render_offscreen_when_headless()  # before any command module imports mujoco
+
+from openral_cli.commands import deploy, robot, ros, rskill, sim  # noqa: E402
 
 app = typer.Typer(
     name="openral",

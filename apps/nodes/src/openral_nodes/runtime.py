@@ -198,11 +198,7 @@ class Spinner:
         self.stop()
 
     def _spin(self) -> None:
-        try:
-            while not self._stop.is_set() and self.context.ok():
-                self.executor.spin_once(timeout_sec=SPIN_PERIOD_S)
-        except ExternalShutdownException:  # the context was shut down under us
-            pass
+        spin_until(self.executor, self._stop)
 
 
 def spin_until(
@@ -223,6 +219,6 @@ def spin_until(
             if left <= 0:
                 return False
             executor.spin_once(timeout_sec=min(SPIN_PERIOD_S, left))
-    except ExternalShutdownException:
+    except ExternalShutdownException:  # the context was shut down under us
         return False
     return stop.is_set()

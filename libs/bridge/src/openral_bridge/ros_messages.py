@@ -58,19 +58,24 @@ def image_msg(image: npt.NDArray[Any], stamp_msg: Any, frame_id: str) -> Any:
     return msg
 
 
+def focal_px(height: int, fovy_deg: float) -> float:
+    """Focal length [px] of an ideal square-pixel pinhole: ``(height / 2) / tan(fovy / 2)``."""
+    return (height / 2.0) / math.tan(math.radians(fovy_deg) / 2.0)
+
+
 def camera_info_msg(width: int, height: int, fovy_deg: float, stamp_msg: Any, frame_id: str) -> Any:
     """``sensor_msgs/CameraInfo`` of an ideal pinhole (MuJoCo's camera model).
 
-    Square pixels, principal point at the image centre, no distortion:
-    ``f = (height / 2) / tan(fovy / 2)``; ROS puts pixel centres on integer coordinates, so
-    the centre is ``((width - 1) / 2, (height - 1) / 2)``.
+    Square pixels (:func:`focal_px`), principal point at the image centre, no distortion;
+    ROS puts pixel centres on integer coordinates, so the centre is
+    ``((width - 1) / 2, (height - 1) / 2)``.
 
     Args:
         width: Image width [px].
         height: Image height [px].
         fovy_deg: Vertical field of view [deg].
     """
-    focal = (height / 2.0) / math.tan(math.radians(fovy_deg) / 2.0)
+    focal = focal_px(height, fovy_deg)
     cx, cy = (width - 1) / 2.0, (height - 1) / 2.0
     msg = CameraInfo()
     msg.header.stamp = stamp_msg
@@ -162,7 +167,7 @@ def depth_to_points(
     """
     depth = np.asarray(depth_m, dtype=np.float32)
     height, width = depth.shape
-    focal = (height / 2.0) / math.tan(math.radians(fovy_deg) / 2.0)
+    focal = focal_px(height, fovy_deg)
     rows, cols = np.indices((height, width), dtype=np.float32)
     keep = (depth >= range_m[0]) & (depth <= range_m[1])
     z = depth[keep]

@@ -21,7 +21,6 @@ time as the node's ``/openral/safe_action`` callback, which is the whole hand-of
 
 from __future__ import annotations
 
-import os
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -29,6 +28,7 @@ from typing import Any
 import mujoco
 from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
 from openral_hal.factory import can_idle_step
+from openral_sim.display import has_display
 
 from openral_bridge import ros_messages
 from openral_bridge.idle import should_idle_step
@@ -246,7 +246,7 @@ class SimSensorBridge:
         if handles is None:
             log.warning("viewer requested but the HAL has no MuJoCo model; running without it")
             return
-        if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        if not has_display():
             log.warning("no display (DISPLAY and WAYLAND_DISPLAY unset); running headless")
             return
         try:

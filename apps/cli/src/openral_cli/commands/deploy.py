@@ -24,6 +24,8 @@ from rich import box
 from rich.console import Console
 from rich.table import Table
 
+from openral_cli.ros_available import require_ros
+
 app = typer.Typer(help="Run robots as ROS 2 graphs.", no_args_is_help=True)
 out = Console()
 
@@ -55,15 +57,10 @@ def sim(
 ) -> None:
     """Bring SCENE's robot up as a ROS 2 graph: joint states, cameras, actions, E-stop."""
     robot_id = _scene_robot(config)
-    try:
-        from openral_nodes.manifest_node import ManifestLifecycleNode
-        from openral_nodes.runtime import ros_session, spin_until
-        from rclpy.executors import SingleThreadedExecutor
-    except ImportError as error:
-        raise OpenralError(
-            f"ROS 2 is not importable ({error}); install the 'ros' extra (pip install "
-            "'openral[ros]') or run ./bootstrap"
-        ) from None
+    require_ros()
+    from openral_nodes.manifest_node import ManifestLifecycleNode
+    from openral_nodes.runtime import ros_session, spin_until
+    from rclpy.executors import SingleThreadedExecutor
 
     parameters: dict[str, Any] = {
         "robot_id": robot_id,

@@ -23,6 +23,8 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from openral_cli.ros_available import require_ros
+
 if TYPE_CHECKING:
     from openral_nodes.topic_probe import Inbox
     from rclpy.node import Node
@@ -88,6 +90,7 @@ def topics(
     domain_id: DomainId = None,
 ) -> None:
     """Table of the topics in the graph: name, type(s), publishers and (--rate) rate."""
+    require_ros()
     from openral_nodes.topic_graph import graph_topics
     from openral_nodes.topic_probe import measure_rates
 
@@ -122,6 +125,7 @@ def echo(
     domain_id: DomainId = None,
 ) -> None:
     """Print messages of TOPIC (any type in the graph); big arrays are summarised."""
+    require_ros()
     from openral_nodes.topic_format import format_message
     from openral_nodes.topic_graph import wait_for_topic
     from openral_nodes.topic_probe import subscribe
@@ -157,6 +161,7 @@ def snapshot(
     domain_id: DomainId = None,
 ) -> None:
     """Save one frame of an Image topic (rgb8, bgr8 or mono8) as PNG."""
+    require_ros()
     from openral_core.errors import OpenralError
     from openral_nodes.topic_codec import image_to_rgb
     from openral_nodes.topic_graph import wait_for_topic

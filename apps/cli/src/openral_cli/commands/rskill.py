@@ -24,6 +24,8 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 from rich.console import Console
 
+from openral_cli.ros_available import require_ros
+
 if TYPE_CHECKING:
     from openral_nodes.rskill_runner import RskillRunnerNode
 
@@ -56,6 +58,7 @@ def run(
     ] = None,
 ) -> None:
     """Run POLICY for ROBOT: camera frames by VLA slot in, /openral/safe_action out."""
+    require_ros()
     from openral_nodes.rskill_runner import RskillRunnerNode, runner_parameters
     from openral_nodes.runtime import Spinner, ros_session
 
