@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -221,3 +222,16 @@ def test_sim_run_drives_the_robosuite_scene(tmp_path: Path) -> None:
     assert len(sorted(tmp_path.glob("wrist_*.png"))) == 3
     last = json.loads((tmp_path / "joint_states.jsonl").read_text().splitlines()[-1])
     assert set(last["positions"]) == {f"joint{i}" for i in range(1, 8)} | {"finger_joint1"}
+
+
+def test_a_welded_base_is_refused(tmp_path: Path) -> None:
+    path = write_scene(tmp_path, "franka_panda", "id: lift")
+    path.write_text(path.read_text() + "base_pose: {weld: true}\n")
+    with pytest.raises(RobosuiteError, match="base_pose: robosuite environments place"):
+        build_robosuite_rollout(load_scene(path))
+
+
+def test_scene_file_errors_name_the_file(tmp_path: Path) -> None:
+    path = write_scene(tmp_path, "so100", "id: lift")
+    with pytest.raises(RobosuiteError, match=rf"^{re.escape(str(path))}: robot_id 'so100'"):
+        build_sim_env_from_yaml(path)

@@ -272,7 +272,7 @@ def build_robosuite_rollout(scene: DeployScene) -> RobosuiteRollout:
                 f"scene.options: {', '.join(foreign)} apply to the native backend only"
             )
     pose = scene.base_pose
-    if pose is not None and (any(pose.position_m) or pose.yaw_deg):
+    if pose is not None and (any(pose.position_m) or pose.yaw_deg or pose.weld):
         raise RobosuiteError("base_pose: robosuite environments place the robot themselves")
     return RobosuiteRollout(
         env_name=robosuite_env_name(scene),

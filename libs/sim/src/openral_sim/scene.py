@@ -39,9 +39,12 @@ def build_sim_env_from_yaml(path: str | Path, robot_id_fallback: str | None = No
             raise OpenralError(
                 f"{file}: scene.backend: the robosuite backend is unavailable ({error})"
             ) from None
-        rollout: SimRollout = backend.build_robosuite_rollout(
-            scene.model_copy(update={"robot_id": robot_id})
-        )
+        try:
+            rollout: SimRollout = backend.build_robosuite_rollout(
+                scene.model_copy(update={"robot_id": robot_id})
+            )
+        except OpenralError as error:  # name the file, as the native backend does
+            raise type(error)(f"{file}: {error}") from None
         return rollout
     from openral_sim.native_scene import NativeScene
 
