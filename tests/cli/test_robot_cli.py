@@ -83,3 +83,14 @@ def test_an_error_with_brackets_is_printed_verbatim(
         main.run()
     assert exit_.value.code == 1
     assert "expected slots [camera1, camera2], saw [camera1]" in capsys.readouterr().err
+
+
+def test_check_names_the_manifest_once_when_it_cannot_load(write_manifest: ManifestWriter) -> None:
+    invalid = write_manifest(("base: fixed", "base: fixed\nbase: mobile"), folder="invalid")
+    broken = write_manifest(folder="mock_arm")
+    (broken.parent / "mock_arm.xml").write_text("<mujoco><worldbody><body></mujoco>")
+    result = runner.invoke(app, ["robot", "check", str(invalid), str(broken)])
+    assert result.exit_code == 1
+    assert f"✗ {invalid}: INVALID" in result.output
+    assert f"{invalid}: {invalid}" not in result.output
+    assert f"✗ {broken}: {broken.parent / 'mock_arm.xml'} does not load: " in result.output

@@ -29,6 +29,7 @@ from openral_core.errors import OpenralError
 from openral_core.models import LimitedJoint
 from openral_core.registry import MANIFEST_NAME
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 app = typer.Typer(help="Inspect and validate robot manifests.", no_args_is_help=True)
@@ -228,10 +229,13 @@ def check(
             if robot.sim is None:
                 raise OpenralError(f"{file}: no sim block; nothing to check")
             path = resolve_mjcf_uri(robot.sim.mjcf_uri, file.parent)
-            model = mujoco.MjModel.from_xml_path(str(path))
-        except (OpenralError, ValueError) as error:
+            try:
+                model = mujoco.MjModel.from_xml_path(str(path))
+            except ValueError as error:  # MuJoCo's compiler does not know the manifest
+                raise OpenralError(f"{file}: {path} does not load: {error}") from None
+        except OpenralError as error:  # each names its manifest file already
             failed_robots += 1
-            err.print(f"[red]✗[/] {file}: {error}", highlight=False)
+            err.print(f"[red]✗[/] {escape(str(error))}", highlight=False)
             summary.add_row(file.parent.name, "-", "-", "[red]cannot load[/]")
             continue
         rows = check_robot(robot, model)
