@@ -45,11 +45,17 @@ def test_non_finite_numbers_are_rejected(tmp_path: Path, value: str) -> None:
     assert "expected a finite number" in issue.message
 
 
-def test_custom_tags_and_dates_are_rejected(tmp_path: Path) -> None:
-    error = _load_error(tmp_path, "a: !python/object:os.system ls\nb: 2024-01-01\n")
+def test_tags_are_refused_before_anything_is_built(tmp_path: Path) -> None:
+    error = _load_error(tmp_path, "a: !python/object:os.system ls\nb: !!str 3\n")
     fields = {issue.field: issue.message for issue in error.issues}
-    assert "custom YAML tag" in fields["a"]
-    assert "unsupported YAML value" in fields["b"]
+    assert "YAML tags (!python/object:os.system) are not allowed" in fields["a"]
+    assert "YAML tags (tag:yaml.org,2002:str) are not allowed" in fields["b"]
+
+
+def test_dates_are_rejected_where_they_stand(tmp_path: Path) -> None:
+    (issue,) = _load_error(tmp_path, "a: 1\nb: 2024-01-01\n").issues
+    assert (issue.line, issue.field) == (2, "b")
+    assert "unsupported YAML value" in issue.message
 
 
 def test_syntax_error_is_located(tmp_path: Path) -> None:

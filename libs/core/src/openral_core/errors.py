@@ -10,6 +10,17 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+PathKey = tuple[str | int, ...]
+"""Where a value sits in a document: keys and list indices from the root."""
+
+
+def format_field(path: PathKey) -> str:
+    """Render a path such as ``("sim", "grippers", 0, "joint")`` as ``sim.grippers[0].joint``."""
+    text = ""
+    for part in path:
+        text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else part)
+    return text
+
 
 class OpenralError(Exception):
     """Root of every error openral raises on purpose."""

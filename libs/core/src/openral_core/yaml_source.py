@@ -1,8 +1,10 @@
 """Safe YAML loading that remembers where every value came from.
 
-The loader is ruamel's round-trip loader (which never builds arbitrary Python objects).
-It turns the document into plain ``dict``/``list``/scalars and records the line and
-column of every key and item, so later checks can point at the exact spot in the file.
+The text first passes :mod:`openral_core.yaml_guard` (size, encoding, control characters,
+nesting, aliases, tags, merge and duplicate keys, long integers). Only then does ruamel's
+round-trip loader (which never builds arbitrary Python objects) parse it; the document is
+turned into plain ``dict``/``list``/scalars with the line and column of every key and item,
+so later checks can point at the exact spot in the file.
 """
 
 from __future__ import annotations
@@ -15,21 +17,12 @@ from typing import Any
 
 from ruamel.yaml import YAML
 from ruamel.yaml.comments import CommentedMap, CommentedSeq
-from ruamel.yaml.constructor import DuplicateKeyError
-from ruamel.yaml.error import MarkedYAMLError
-from ruamel.yaml.nodes import MappingNode, Node, SequenceNode
+from ruamel.yaml.error import YAMLError
 
-from openral_core.errors import Issue, ManifestError
+from openral_core.errors import Issue, ManifestError, PathKey, format_field
+from openral_core.yaml_guard import read_text, scan_events
 
-PathKey = tuple[str | int, ...]
-
-
-def format_field(path: PathKey) -> str:
-    """Render a path such as ``("sim", "grippers", 0, "joint")`` as ``sim.grippers[0].joint``."""
-    text = ""
-    for part in path:
-        text += f"[{part}]" if isinstance(part, int) else (f".{part}" if text else part)
-    return text
+__all__ = ["LocatedDocument", "PathKey", "format_field", "load_located"]
 
 
 @dataclass
@@ -58,24 +51,16 @@ def load_located(file: Path) -> LocatedDocument:
     """Parse ``file`` into a :class:`LocatedDocument`.
 
     Raises:
-        ManifestError: The file cannot be read, is not valid YAML, has a duplicate key,
-            or holds a non-finite number or a custom tag.
+        ManifestError: The file cannot be read, breaks a limit of
+            :mod:`openral_core.yaml_guard`, is not valid YAML, or holds a non-finite number
+            or a value of a type the contract has no use for (dates, ...).
     """
+    text = read_text(file)
+    scan_events(file, text)
     try:
-        text = file.read_text(encoding="utf-8")
-    except OSError as exc:
-        issue = Issue(file, 0, 0, "", f"cannot read file: {exc.strerror}")
-        raise ManifestError(file, [issue]) from None
-    yaml = YAML(typ="rt")
-    try:
-        raw = yaml.load(text)
-    except DuplicateKeyError:
-        raise ManifestError(file, _duplicate_key_issues(file, yaml, text)) from None
-    except MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        line, col = (mark.line + 1, mark.column + 1) if mark else (0, 0)
-        problem = exc.problem or exc.context or "invalid YAML"
-        issue = Issue(file, line, col, "", f"invalid YAML: {problem}")
+        raw = YAML(typ="rt").load(text)
+    except (YAMLError, ValueError, RecursionError) as error:  # the scan should prevent these
+        issue = Issue(file, 1, 1, "", f"cannot be read as YAML ({type(error).__name__})")
         raise ManifestError(file, [issue]) from None
     document = LocatedDocument(file, None)
     issues: list[Issue] = []
@@ -85,42 +70,8 @@ def load_located(file: Path) -> LocatedDocument:
     return document
 
 
-def _duplicate_key_issues(file: Path, yaml: YAML, text: str) -> list[Issue]:
-    """Every repeated key in the document, naming the line of its first occurrence."""
-    issues: list[Issue] = []
-    pending: list[tuple[Node, PathKey]] = [(yaml.compose(text), ())]
-    while pending:
-        node, path = pending.pop()
-        if isinstance(node, MappingNode):
-            first_line: dict[str, int] = {}
-            for key_node, value_node in node.value:
-                key = str(key_node.value)
-                mark = key_node.start_mark
-                if key in first_line:
-                    issues.append(
-                        Issue(
-                            file,
-                            mark.line + 1,
-                            mark.column + 1,
-                            format_field((*path, key)),
-                            f"duplicate key {key!r}: also defined on line {first_line[key]}; "
-                            "each key may appear once",
-                        )
-                    )
-                else:
-                    first_line[key] = mark.line + 1
-                pending.append((value_node, (*path, key)))
-        elif isinstance(node, SequenceNode):
-            pending.extend((item, (*path, i)) for i, item in enumerate(node.value))
-    return sorted(issues, key=lambda issue: (issue.line, issue.column))
-
-
 def _plain(node: Any, path: PathKey, doc: LocatedDocument, issues: list[Issue]) -> Any:
     """Convert ruamel nodes to plain Python, recording positions and rejecting oddities."""
-    tag = getattr(getattr(node, "tag", None), "value", None)
-    if tag is not None and tag.startswith("!") and not tag.startswith("!!"):
-        issues.append(doc.issue(path, f"custom YAML tag {tag} is not allowed"))
-        return None
     if isinstance(node, CommentedMap):
         result: dict[str, Any] = {}
         for key, (line, col) in _key_positions(node):
