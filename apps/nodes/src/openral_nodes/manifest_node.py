@@ -5,8 +5,9 @@ Parameters (all read at configure):
 - ``robot_id`` (str) or ``manifest_path`` (str): which robot; with neither, the robot the
   ``sim_env_yaml`` scene names;
 - ``hal_mode`` (``sim`` | ``real``), ``sim_env_yaml`` (a deploy-scene file, ``""`` for none);
-- ``viewer_enabled`` (bool), ``camera_publish_rate_hz`` (float), ``joint_state_rate_hz``
-  (float), ``idle_hold_ms`` (float).
+- ``viewer_enabled`` (bool), ``camera_publish_rate_hz`` (float) and ``joint_state_rate_hz``
+  (float) within :data:`RATE_RANGE_HZ`, ``idle_hold_ms`` (float) within
+  :data:`IDLE_HOLD_RANGE_MS`.
 
 Transitions:
 
@@ -15,7 +16,12 @@ Transitions:
   ``/openral/action_spec``, subscribe ``/openral/safe_action``, offer the E-stop services and
   start the :class:`~openral_bridge.SimSensorBridge`;
 - deactivate → stop all of that (the HAL stays connected and holds still);
-- cleanup / shutdown / error → also disconnect and drop the HAL.
+- cleanup / shutdown / error → also disconnect and drop the HAL; shutdown also sets the
+  ``shutdown_event`` the owner passed, so a process can end when told to over ROS.
+
+A ChangeState request for a transition the current state does not allow (by id or label)
+is answered ``success=false`` with a throttled warning, never raised into the executor
+(:mod:`openral_nodes.lifecycle_guard`).
 
 The command on ``/openral/safe_action`` (``std_msgs/Float64MultiArray``) is ``data`` = one
 value per HAL action slot, in the order and meaning ``/openral/action_spec`` announces
@@ -27,6 +33,7 @@ warning and changes nothing. Run it on a single-threaded executor only.
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -55,6 +62,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 
+from openral_nodes.lifecycle_guard import guard_change_state
 from openral_nodes.runtime import LATCHED
 
 NODE_NAME = "openral_manifest_node"
@@ -73,6 +81,17 @@ PARAMETERS: dict[str, Any] = {
 }
 """Every parameter and its default."""
 
+RATE_RANGE_HZ = (0.1, 1000.0)
+"""Accepted ``camera_publish_rate_hz`` and ``joint_state_rate_hz``, inclusive [Hz]."""
+IDLE_HOLD_RANGE_MS = (0.0, 60_000.0)
+"""Accepted ``idle_hold_ms``, inclusive [ms]."""
+BOUNDS: dict[str, tuple[tuple[float, float], str]] = {
+    "camera_publish_rate_hz": (RATE_RANGE_HZ, "Hz"),
+    "joint_state_rate_hz": (RATE_RANGE_HZ, "Hz"),
+    "idle_hold_ms": (IDLE_HOLD_RANGE_MS, "ms"),
+}
+"""Range and unit of each bounded parameter, checked at configure."""
+
 Result = TransitionCallbackReturn
 """Transition outcome (a pybind enum, typed Any; hence the ``-> Any`` of the callbacks)."""
 
@@ -86,6 +105,7 @@ class ManifestLifecycleNode(LifecycleNode):
         node_name: str = NODE_NAME,
         parameter_overrides: dict[str, Any] | None = None,
         log_boot_errors: bool = True,
+        shutdown_event: threading.Event | None = None,
         **kwargs: Any,
     ) -> None:
         """Declare the parameters; ``parameter_overrides`` replaces their defaults.
@@ -95,6 +115,8 @@ class ManifestLifecycleNode(LifecycleNode):
             parameter_overrides: Parameter values by name (see :data:`PARAMETERS`).
             log_boot_errors: Log why configure failed; off when the caller reports
                 :attr:`boot_error` itself (the CLI), so the reason is printed once.
+            shutdown_event: Set by the shutdown transition (from any state, also one
+                requested over ROS), for an owner that should then end its process.
             kwargs: Passed to :class:`rclpy.lifecycle.LifecycleNode` (e.g. ``context``).
 
         Raises:
@@ -120,6 +142,8 @@ class ManifestLifecycleNode(LifecycleNode):
         self.actions_refused = 0
         self._entities: list[tuple[str, Any]] = []
         self._state_rate_hz = 0.0
+        self._shutdown_event = shutdown_event
+        guard_change_state(self)
 
     # -- transitions -----------------------------------------------------------------------
 
@@ -181,8 +205,10 @@ class ManifestLifecycleNode(LifecycleNode):
         return Result.SUCCESS
 
     def on_shutdown(self, state: LifecycleState) -> Any:
-        """Stop everything and disconnect."""
+        """Stop everything, disconnect and set the owner's ``shutdown_event``."""
         self._release()
+        if self._shutdown_event is not None:
+            self._shutdown_event.set()
         return Result.SUCCESS
 
     def on_error(self, state: LifecycleState) -> Any:
@@ -229,10 +255,12 @@ class ManifestLifecycleNode(LifecycleNode):
         return self.get_parameter(name).value
 
     def _check_rates(self) -> None:
-        for name in ("camera_publish_rate_hz", "joint_state_rate_hz"):
+        for name, ((low, high), unit) in BOUNDS.items():
             value = float(self._param(name))
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"parameter {name} must be a positive rate in Hz, got {value}")
+            if not (math.isfinite(value) and low <= value <= high):
+                raise ValueError(
+                    f"parameter {name} must be within {low:g}-{high:g} {unit}, got {value:g}"
+                )
 
     def _load_description(self) -> RobotDescription:
         robot_id, manifest = self._param("robot_id"), self._param("manifest_path")

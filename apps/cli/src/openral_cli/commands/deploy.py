@@ -7,7 +7,8 @@ Example::
 The scene's robot comes up as one :class:`~openral_nodes.manifest_node.ManifestLifecycleNode`
 in this process, driven through configure and activate here (there is no ``ros2 launch``).
 It runs until Ctrl-C or SIGTERM (or ``--duration``), then deactivates, cleans up and
-exits 0. ``openral ros topics`` in a second terminal lists what it publishes.
+exits 0; a ``shutdown`` transition requested over ROS ends it with exit 0 too.
+``openral ros topics`` in a second terminal lists what it publishes.
 """
 
 from __future__ import annotations
@@ -39,10 +40,12 @@ def sim(
         bool, typer.Option("--no-viewer", help="Never open the MuJoCo viewer.")
     ] = False,
     camera_rate: Annotated[
-        float, typer.Option("--camera-rate", min=0.1, help="Camera and idle-step rate [Hz].")
+        float,
+        typer.Option("--camera-rate", min=0.1, max=1000.0, help="Camera and idle-step rate [Hz]."),
     ] = 10.0,
     joint_state_rate: Annotated[
-        float, typer.Option("--joint-state-rate", min=0.1, help="/joint_states rate [Hz].")
+        float,
+        typer.Option("--joint-state-rate", min=0.1, max=1000.0, help="/joint_states rate [Hz]."),
     ] = 50.0,
     duration: Annotated[
         float | None,
@@ -73,7 +76,10 @@ def sim(
     stop = threading.Event()
     with ros_session(domain_id=domain_id) as context:
         node = ManifestLifecycleNode(
-            context=context, parameter_overrides=parameters, log_boot_errors=False
+            context=context,
+            parameter_overrides=parameters,
+            log_boot_errors=False,
+            shutdown_event=stop,
         )
         executor = SingleThreadedExecutor(context=context)
         executor.add_node(node)
@@ -85,12 +91,14 @@ def sim(
             _print_interfaces(node, config)
             spin_until(executor, stop, timeout_s=duration)
         finally:
-            _shut_down(node)
+            shut_down_over_ros = _shut_down(node)
             executor.shutdown()
             node.destroy_node()  # type: ignore[no-untyped-call]
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
     reason = "signal" if stop.is_set() else "--duration"
+    if shut_down_over_ros:
+        reason = "shutdown transition requested over ROS"
     out.print(f"stopped ({reason}) after {time.monotonic() - started:.1f} s; clean shutdown")
 
 
@@ -118,14 +126,21 @@ def _transition(node: Any, name: str) -> None:
         raise OpenralError(f"{name} failed: {node.boot_error or result}")
 
 
-def _shut_down(node: Any) -> None:
-    """Deactivate and clean up from whatever state the node reached."""
+def _shut_down(node: Any) -> bool:
+    """Deactivate and clean up from whatever state the node reached.
+
+    Returns:
+        True when the node was already finalized (a shutdown transition came over ROS).
+    """
     state = node.lifecycle_state
+    if state == "finalized":
+        return True
     if state == "active":
         node.trigger_deactivate()
         state = "inactive"
     if state == "inactive":
         node.trigger_cleanup()
+    return False
 
 
 def _print_interfaces(node: Any, config: Path) -> None:
