@@ -90,8 +90,8 @@ def sensor_lists(draw: st.DrawFn) -> list[Sensor]:
         entry: dict[str, Any] = {
             "name": name,
             "kind": kind,
-            "width": 8,
-            "height": 8,
+            "width": 16,
+            "height": 16,
             "rate_hz": 10.0,
             "frame_id": "f",
         }

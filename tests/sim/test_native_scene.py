@@ -13,7 +13,6 @@ import pytest
 from openral_cli.main import app
 from openral_core import ManifestError, robot_ids
 from openral_core.errors import OpenralError
-from openral_sim.native_scene import SceneError
 from openral_sim.rollout import SimRollout
 from openral_sim.scene import build_sim_env_from_yaml
 from typer.testing import CliRunner
@@ -65,8 +64,12 @@ def test_a_camera_the_robot_does_not_have_is_an_error(tmp_path: Path) -> None:
     text = (ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml").read_text()
     bad = tmp_path / "scene.yaml"
     bad.write_text(text.replace("cameras: [agentview, wrist]", "cameras: [agentview, belly]"))
-    with pytest.raises(SceneError, match="'belly' is not a camera sensor"):
+    with pytest.raises(ManifestError) as info:
         build_sim_env_from_yaml(bad)
+    (issue,) = info.value.issues
+    assert (issue.file, issue.field) == (bad, "scene.cameras[1]")
+    assert issue.line > 1 and issue.column > 1
+    assert "'belly' is not a camera sensor of robot 'franka_panda'" in issue.message
 
 
 def test_an_invalid_scene_file_reports_file_line_and_field(tmp_path: Path) -> None:
@@ -126,7 +129,7 @@ def test_a_welded_floating_base_stays_where_the_scene_puts_it(tmp_path: Path) ->
 def test_welding_a_fixed_base_is_an_error(tmp_path: Path) -> None:
     path = _humanoid_scene(tmp_path, True, robot="ur5e")
     path.write_text(path.read_text().replace("cameras: [head]", "cameras: [agentview]"))
-    with pytest.raises(SceneError, match=r"base_pose\.weld: .* has a fixed base"):
+    with pytest.raises(ManifestError, match=r":\d+:\d+: base_pose\.weld: .* has a fixed base"):
         build_sim_env_from_yaml(path)
 
 
@@ -134,15 +137,15 @@ def test_a_scene_for_an_unknown_robot_names_the_file(tmp_path: Path) -> None:
     text = (ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml").read_text()
     bad = tmp_path / "scene.yaml"
     bad.write_text(text.replace("robot_id: franka_panda", "robot_id: nobot"))
-    with pytest.raises(OpenralError, match=r"scene\.yaml: robot_id: unknown robot 'nobot'"):
+    with pytest.raises(OpenralError, match=r"scene\.yaml:\d+:\d+: robot_id: unknown robot 'nobot'"):
         build_sim_env_from_yaml(bad)
 
 
 @pytest.mark.parametrize("axis", ["+x", "-x", "+y", "-y", "+z", "-z"])
 def test_a_mounted_camera_looks_along_its_mount_axis(axis: str) -> None:
-    from openral_sim.native_scene import _looking_along
+    from openral_sim.scene_cameras import looking_along
 
-    position, xyaxes = _looking_along(axis)
+    position, xyaxes = looking_along(axis)
     right, up = np.array(xyaxes[:3]), np.array(xyaxes[3:])
     look = -np.cross(right, up)  # a MuJoCo camera looks along its -z
     expected = np.zeros(3)

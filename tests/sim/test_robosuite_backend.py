@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from openral_cli.main import app as cli
 from openral_core import load_robot_by_id
-from openral_core.errors import OpenralError
+from openral_core.errors import ManifestError, OpenralError
 from openral_core.loader import load_scene
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_sim.robosuite_backend import (
@@ -171,15 +171,15 @@ def test_unknown_robot_names_the_supported_ones(tmp_path: Path) -> None:
     ("scene", "options", "message"),
     [
         ("id: tabletop", "horizon: 5", "names no robosuite environment"),
-        ("id: lift", "table_height_m: 0.7", "table_height_m apply to the native backend"),
+        ("id: lift", "table_height_m: 0.7", "table_height_m: applies to the native backend"),
         ("id: lift\n  assets: Lfit", "horizon: 5", "unknown robosuite environment 'Lfit'"),
         ("id: lift", "controller: NOPE", "unknown robosuite composite controller 'NOPE'"),
     ],
 )
 def test_scene_errors(tmp_path: Path, scene: str, options: str, message: str) -> None:
-    loaded = load_scene(write_scene(tmp_path, "franka_panda", scene, options))
-    with pytest.raises(RobosuiteError, match=message):
-        build_robosuite_rollout(loaded)
+    path = write_scene(tmp_path, "franka_panda", scene, options)
+    with pytest.raises(ManifestError, match=rf"^{re.escape(str(path))}:\d+:\d+: .*{message}"):
+        build_robosuite_rollout(load_scene(path))
 
 
 def test_wrong_action_width_is_refused(rollouts: dict[str, RobosuiteRollout]) -> None:
@@ -227,11 +227,11 @@ def test_sim_run_drives_the_robosuite_scene(tmp_path: Path) -> None:
 def test_a_welded_base_is_refused(tmp_path: Path) -> None:
     path = write_scene(tmp_path, "franka_panda", "id: lift")
     path.write_text(path.read_text() + "base_pose: {weld: true}\n")
-    with pytest.raises(RobosuiteError, match="base_pose: robosuite environments place"):
+    with pytest.raises(ManifestError, match=r":\d+:\d+: base_pose: robosuite environments place"):
         build_robosuite_rollout(load_scene(path))
 
 
 def test_scene_file_errors_name_the_file(tmp_path: Path) -> None:
     path = write_scene(tmp_path, "so100", "id: lift")
-    with pytest.raises(RobosuiteError, match=rf"^{re.escape(str(path))}: robot_id 'so100'"):
+    with pytest.raises(ManifestError, match=rf"^{re.escape(str(path))}:\d+:\d+: robot_id: 'so100'"):
         build_sim_env_from_yaml(path)

@@ -21,9 +21,10 @@ import numpy.typing as npt
 import pytest
 from openral_bridge.idle import should_idle_step
 from openral_core import load_robot_by_id
+from openral_core.errors import ManifestError
 from openral_core.loader import load_robot
 from openral_core.models import RobotDescription
-from openral_hal.errors import ActionRejected, ConfigurationError, EStopLatched, HalError
+from openral_hal.errors import ActionRejected, ConfigurationError, EStopLatched
 from openral_hal.factory import REAL_DRIVERS, build_hal, can_idle_step, register_real_driver
 from openral_hal.mujoco_arm import MujocoArmHAL
 from openral_hal.sim_attached import SimAttachedHAL
@@ -240,9 +241,11 @@ def test_a_joint_missing_from_the_scene_fails_at_connect(
 ) -> None:
     env = arm_env()
     hal = SimAttachedHAL(env, load_robot_by_id("franka_panda"))
-    with pytest.raises(HalError) as error:
+    with pytest.raises(ManifestError) as error:
         hal.connect()
-    message = str(error.value)
+    (issue,) = error.value.issues
+    assert issue.field == "joints" and issue.file.name == "robot.yaml" and issue.line > 1
+    message = issue.message
     for missing in ("joint3", "joint7", "finger_joint1"):
         assert missing in message
     assert "robot0_joint1" in message  # a few available names are listed
@@ -428,7 +431,7 @@ def test_build_hal_refuses_a_scene_for_another_robot(
         'schema_version: "0.1"\nrobot_id: ur5e\n'
         "scene: {id: t, backend: native, observation: {width: 32, height: 32}, cameras: []}\n"
     )
-    with pytest.raises(ConfigurationError, match="ur5e"):
+    with pytest.raises(ManifestError, match=r"scene\.yaml:2:1: robot_id: the scene is for ur5e"):
         build_hal(
             fake_arm, mode="sim", sim_env_yaml=scene, env_builder=lambda p: NonMujocoRollout()
         )

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, model_validator
+from pydantic import BaseModel, ConfigDict, PrivateAttr, model_validator
 
 __all__ = ["OpenralModel"]
 
@@ -22,6 +22,10 @@ class OpenralModel(BaseModel):
     """Strict contract model: unknown fields and explicit nulls are rejected."""
 
     model_config = ConfigDict(extra="forbid")
+
+    _source: object | None = PrivateAttr(default=None)
+    """Where a document loaded from a file came from (set by ``openral_core``'s loader;
+    read through ``openral_core.located``), so later stages can point into the file."""
 
     @model_validator(mode="before")
     @classmethod

@@ -22,6 +22,17 @@ def format_field(path: PathKey) -> str:
     return text
 
 
+def parse_field(text: str) -> PathKey:
+    """The inverse of :func:`format_field`: ``sim.grippers[0].joint`` → its path."""
+    path: list[str | int] = []
+    for part in text.split("."):
+        name, *indices = part.split("[")
+        if name:
+            path.append(name)
+        path.extend(int(index.rstrip("]")) for index in indices)
+    return tuple(path)
+
+
 class OpenralError(Exception):
     """Root of every error openral raises on purpose."""
 
@@ -57,7 +68,10 @@ class ManifestError(OpenralError):
         self.file = file
         self.issues = tuple(issues)
         lines = "\n".join(issue.format() for issue in self.issues)
-        super().__init__(f"{file}: INVALID ({len(self.issues)} problem(s))\n{lines}")
+        if len(self.issues) == 1:  # one problem: its located line says it all
+            super().__init__(lines)
+        else:
+            super().__init__(f"{file}: INVALID ({len(self.issues)} problem(s))\n{lines}")
 
 
 class UnknownRobot(OpenralError):

@@ -11,16 +11,18 @@ import json
 from pathlib import Path
 from typing import TypeVar
 
-from pydantic import BaseModel, ValidationError
+from openral_base import OpenralModel
+from pydantic import ValidationError
 
 from openral_core.errors import Issue, ManifestError
+from openral_core.located import remember_source
 from openral_core.models import DeployScene, RobotDescription
-from openral_core.rules import robot_findings
+from openral_core.rules import robot_findings, scene_findings
 from openral_core.schemas import SchemaName
 from openral_core.validation import schema_issues
 from openral_core.yaml_source import LocatedDocument, load_located
 
-ModelT = TypeVar("ModelT", bound=BaseModel)
+ModelT = TypeVar("ModelT", bound=OpenralModel)
 
 
 def load_robot(file: Path, *, check_folder_name: bool = True) -> RobotDescription:
@@ -48,7 +50,12 @@ def load_scene(file: Path) -> DeployScene:
     Raises:
         ManifestError: With every problem found in the file.
     """
-    return _build(load_located(file), SchemaName.SCENE, DeployScene)
+    document = load_located(file)
+    scene = _build(document, SchemaName.SCENE, DeployScene)
+    findings = scene_findings(scene)
+    if findings:
+        raise ManifestError(file, [document.issue(path, msg) for path, msg in findings])
+    return scene
 
 
 def validate_robot_file(file: Path, *, check_folder_name: bool = True) -> list[Issue]:
@@ -65,7 +72,7 @@ def _build(document: LocatedDocument, name: SchemaName, model: type[ModelT]) -> 
     if issues:
         raise ManifestError(document.file, issues)
     try:
-        return model.model_validate_json(json.dumps(document.data), strict=True)
+        built = model.model_validate_json(json.dumps(document.data), strict=True)
     except ValidationError as error:
         # The schema and the models are generated to agree (a property test guards it);
         # should they ever disagree, report the model's verdict the same way.
@@ -73,3 +80,5 @@ def _build(document: LocatedDocument, name: SchemaName, model: type[ModelT]) -> 
             document.file,
             [document.issue(tuple(e["loc"]), e["msg"]) for e in error.errors()],
         ) from None
+    remember_source(built, document)
+    return built

@@ -9,7 +9,13 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
 
-from openral_core.models import LimitedJoint, RgbSensor, RobotDescription, TorquePdControl
+from openral_core.models import (
+    DeployScene,
+    LimitedJoint,
+    RgbSensor,
+    RobotDescription,
+    TorquePdControl,
+)
 from openral_core.tables import vla_slot
 from openral_core.yaml_source import PathKey, format_field
 
@@ -44,6 +50,18 @@ def robot_findings(robot: RobotDescription, folder_name: str | None) -> list[Fin
         *_limits_ordered(robot),
         *_sim_findings(robot),
     ]
+
+
+def scene_findings(scene: DeployScene) -> list[Finding]:
+    """Every cross-field rule violation of a deploy scene that needs no robot manifest.
+
+    Args:
+        scene: A scene that already passed schema validation.
+    """
+    options = scene.scene.options
+    objects = options.objects if options is not None and options.objects else []
+    located = [(("scene", "options", "objects", i, "name"), o.name) for i, o in enumerate(objects)]
+    return list(_unique(located, "object name"))
 
 
 def _name_matches_folder(robot: RobotDescription, folder_name: str | None) -> Iterator[Finding]:

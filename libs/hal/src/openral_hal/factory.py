@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from openral_core.loader import load_scene
+from openral_core.located import error_at
 from openral_core.models import RobotDescription
 from openral_sim.rollout import SimRollout
 
@@ -58,8 +59,8 @@ def build_hal(
 
     Raises:
         ConfigurationError: Unknown mode, a real robot with a scene, no real driver for the
-            robot, a driver whose HAL could idle-step, or a scene for another robot.
-        ManifestError: The scene file exists but is invalid.
+            robot, or a driver whose HAL could idle-step.
+        ManifestError: The scene file is invalid or is for another robot (located).
     """
     if mode not in MODES:
         raise ConfigurationError(f"unknown HAL mode {mode!r}; expected one of {MODES}")
@@ -100,7 +101,8 @@ def _scene_seed(path: Path, robot: str) -> int:
         return 0
     scene = load_scene(path)
     if scene.robot_id is not None and scene.robot_id != robot:
-        raise ConfigurationError(f"{path}: the scene is for {scene.robot_id}, not {robot}")
+        message = f"the scene is for {scene.robot_id}, not {robot}"
+        raise error_at(scene, ("robot_id",), message)
     return scene.seed
 
 

@@ -4,8 +4,11 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
+from pathlib import Path
 
 import mujoco
+from openral_core.errors import ManifestError, parse_field
+from openral_core.located import error_at, issue_at
 from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
 from openral_core.tables import HalWiring, hal_wiring
 
@@ -33,6 +36,52 @@ def check_robot(description: RobotDescription, model: mujoco.MjModel) -> list[Ch
         *_keyframe_and_base_rows(wiring, model),
         *_sensor_rows(description, model),
     ]
+
+
+def manifest_mismatch(description: RobotDescription, model: mujoco.MjModel) -> ManifestError | None:
+    """A located error listing every check ``description`` fails against ``model``, or None.
+
+    The HAL and the native scene call this before they use a model: a manifest whose
+    addresses, actuators, base or cameras disagree with its model would drive the wrong
+    joint or crash later, so it is refused at the fields that are wrong.
+    """
+    failed = [row for row in check_robot(description, model) if not row.ok]
+    if not failed:
+        return None
+    issues = [
+        issue_at(
+            description,
+            parse_field(row.field),
+            f"the manifest says {row.expected}, the model has {row.actual}; "
+            "`openral robot check` lists every check",
+        )
+        for row in failed
+    ]
+    return ManifestError(issues[0].file, issues)
+
+
+def load_checked_model(description: RobotDescription, path: Path) -> mujoco.MjModel:
+    """Compile the robot's MJCF at ``path`` and check the manifest against it.
+
+    Raises:
+        ManifestError: At ``sim.mjcf_uri`` when MuJoCo cannot load the file, or at every
+            field that disagrees with the model (:func:`manifest_mismatch`).
+    """
+    try:
+        model = mujoco.MjModel.from_xml_path(str(path))
+    except ValueError as error:  # MuJoCo's parser and compiler report this way
+        raise unloadable_model(description, path, error) from None
+    mismatch = manifest_mismatch(description, model)
+    if mismatch is not None:
+        raise mismatch
+    return model
+
+
+def unloadable_model(description: RobotDescription, path: Path, error: Exception) -> ManifestError:
+    """The located error for an MJCF file MuJoCo refuses (one line of its message)."""
+    first_line = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
+    message = f"{path} does not load in MuJoCo: {first_line}"
+    return error_at(description, ("sim", "mjcf_uri"), message)
 
 
 def _joint_rows(

@@ -21,10 +21,12 @@ from openral_core.registry import manifest_path
 from openral_core.tables import GripperWiring, HalWiring, hal_wiring
 
 from openral_hal.action import validated_action
+from openral_hal.control_law import pd_torque, seed_position_servos
 from openral_hal.errors import EStopLatched, HalError, NotConnected, SimulationDiverged
 from openral_hal.gripper import gripper_ctrl, read_gripper
-from openral_hal.mjcf_model import ctrl_limits, is_position_servo, is_scalar_joint
+from openral_hal.mjcf_model import ctrl_limits
 from openral_hal.mjcf_uri import resolve_mjcf_uri
+from openral_hal.model_check import load_checked_model
 from openral_hal.state import FloatArray, JointStateSample
 
 CONTROL_MODES = ("position", "torque_pd")
@@ -129,6 +131,9 @@ class MujocoArmHAL:
         self._reach: dict[int, FloatArray] = {}
         self._estopped = False
         self._last_step_ns = 0
+        self.description: RobotDescription | None = None
+        """The manifest this HAL was wired from (``from_description``); connect checks the
+        model against it and reports a disagreement at the manifest's fields."""
 
     @classmethod
     def from_description(
@@ -163,12 +168,14 @@ class MujocoArmHAL:
         kwargs = hal_kwargs(wiring)
         if settle_steps is not None:
             kwargs["settle_steps"] = settle_steps
-        return cls(
+        hal = cls(
             mjcf_path=path,
             gravity_enabled=gravity_enabled,
             staleness_limit_s=staleness_limit_s,
             **kwargs,
         )
+        hal.description = description
+        return hal
 
     # -- lifecycle -------------------------------------------------------------------------
 
@@ -179,7 +186,10 @@ class MujocoArmHAL:
 
     def connect(self) -> None:
         """Load the model, reset (keyframe), seed the actuators, forward and settle."""
-        model = mujoco.MjModel.from_xml_path(str(self.mjcf_path))
+        if self.description is not None:
+            model = load_checked_model(self.description, self.mjcf_path)
+        else:
+            model = mujoco.MjModel.from_xml_path(str(self.mjcf_path))
         self._check_wiring(model)
         if not self.gravity_enabled:
             model.opt.gravity[:] = 0.0
@@ -365,34 +375,3 @@ def hal_kwargs(wiring: HalWiring) -> dict[str, Any]:
     del kwargs["mjcf_uri"]
     kwargs["settle_steps"] = kwargs.pop("settle_steps_default")
     return kwargs
-
-
-def pd_torque(
-    kp: FloatArray,
-    kd: FloatArray,
-    target: FloatArray,
-    q: FloatArray,
-    qdot: FloatArray,
-    low: FloatArray,
-    high: FloatArray,
-) -> FloatArray:
-    """The ``torque_pd`` control law: ``kp * (target - q) - kd * qdot``, clipped to [low, high]."""
-    torque: FloatArray = np.minimum(np.maximum(kp * (target - q) - kd * qdot, low), high)
-    return torque
-
-
-def seed_position_servos(model: mujoco.MjModel, data: mujoco.MjData) -> None:
-    """ctrl ← qpos of the joint for every position-servo actuator on a hinge or slide joint."""
-    for actuator in range(model.nu):
-        if model.actuator_trntype[actuator] != mujoco.mjtTrn.mjTRN_JOINT:
-            continue
-        if not is_position_servo(model, actuator):
-            continue
-        joint = model.actuator_trnid[actuator, 0]
-        if not is_scalar_joint(model, joint):
-            continue
-        low, high = model.actuator_ctrlrange[actuator]
-        value = float(data.qpos[model.jnt_qposadr[joint]])
-        data.ctrl[actuator] = (
-            min(max(value, low), high) if model.actuator_ctrllimited[actuator] else value
-        )

@@ -17,6 +17,7 @@ from typing import Any
 import mujoco
 import numpy as np
 import numpy.typing as npt
+from openral_core.located import error_at
 from openral_core.models import RgbSensor, RobotDescription
 from openral_core.tables import joint_name_map
 from openral_sim.rollout import HoldingRollout, Observation, SimRollout, StepResult
@@ -291,7 +292,10 @@ class SimAttachedHAL:
     def _resolve_addresses(self, model: mujoco.MjModel) -> None:
         joint = mujoco.mjtObj.mjOBJ_JOINT
         available = [mujoco.mj_id2name(model, joint, i) for i in range(model.njnt)]
-        resolved = resolve_joint_names(self._mjcf_names, [n for n in available if n])
+        try:
+            resolved = resolve_joint_names(self._mjcf_names, [n for n in available if n])
+        except HalError as error:  # the manifest's joints: say so at its joints list
+            raise error_at(self.description, ("joints",), str(error)) from None
         ids = [mujoco.mj_name2id(model, joint, resolved[n]) for n in self._mjcf_names]
         bad = [
             resolved[n]
@@ -299,10 +303,11 @@ class SimAttachedHAL:
             if not is_scalar_joint(model, i)
         ]
         if bad:
-            raise HalError(
+            message = (
                 f"scene joints {', '.join(bad)} are not hinge or slide joints; a manifest "
                 "joint must map to a one-value joint"
             )
+            raise error_at(self.description, ("joints",), message)
         self._qpos = np.array([model.jnt_qposadr[i] for i in ids], dtype=np.intp)
         self._dof = np.array([model.jnt_dofadr[i] for i in ids], dtype=np.intp)
         self._addr_model = model

@@ -1,12 +1,10 @@
 """The native scene backend: any manifest's robot composed into a tabletop with MjSpec.
 
 The scene adds a floor, lights, optionally a table and a pedestal, the objects the scene file
-lists, and a camera for every manifest camera sensor the scene file names:
-
-- a sensor with ``camera`` renders that camera of the robot's own model;
-- a sensor with ``mount_body`` gets a camera fixed to that body, looking forward (+x) on a
-  torso, head, pelvis or base body and along the body's +z (the tool axis) on any other;
-- any other sensor is a fixed camera in front of the robot, framed by the robot's reach.
+lists, and a camera for every manifest camera sensor the scene file names (placed as
+:mod:`openral_sim.scene_cameras` says). Before composing, the manifest is checked against
+the robot's own model (:func:`~openral_hal.model_check.manifest_mismatch`); every fault of
+the scene file or the manifest is reported at its field's line and column.
 
 The action is one control value per actuator of the robot model. For a ``torque_pd`` robot
 the values are position targets, turned into torques by the manifest's PD law every step.
@@ -17,28 +15,35 @@ robot stays where it was last sent.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from pathlib import Path
 from typing import Any
 
 import mujoco
 import numpy as np
 import numpy.typing as npt
 from openral_core.errors import OpenralError
+from openral_core.located import error_at
 from openral_core.models import DeployScene, DepthSensor, RgbSensor, RobotDescription
 from openral_core.registry import manifest_path
 from openral_core.tables import hal_wiring, joint_name_map
+from openral_hal.control_law import pd_torque, seed_position_servos
 from openral_hal.mjcf_model import ctrl_limits
 from openral_hal.mjcf_uri import resolve_mjcf_uri
-from openral_hal.mujoco_arm import pd_torque, seed_position_servos
+from openral_hal.model_check import manifest_mismatch, unloadable_model
 
 from openral_sim.rollout import Observation, StepResult
+from openral_sim.scene_cameras import (
+    add_fixed_camera,
+    add_mounted_cameras,
+    camera_sensors,
+    rotate_about_z,
+)
+from openral_sim.scene_checks import check_object_names, physics_steps_per_control
+from openral_sim.scene_geometry import lowest_static_point, robot_extent, root_body
 
 ASSETS = ("tabletop", "floor")
 """``scene.assets`` values: a table in front of the robot, or only floor and lights (for
 models that bring their own table)."""
 DEFAULT_TABLE_HEIGHT_M = 0.75
-FORWARD_LOOKING = ("torso", "head", "pelvis", "base")
 BASE_WELD = "scene_base_weld"
 """Name of the equality constraint that holds a welded floating base."""
 
@@ -50,31 +55,35 @@ class SceneError(OpenralError):
 class NativeScene:
     """A MuJoCo scene composed from a manifest and a deploy-scene file (a SimRollout)."""
 
-    def __init__(self, scene: DeployScene, robot: RobotDescription, source: Path | None = None):
+    def __init__(self, scene: DeployScene, robot: RobotDescription):
+        """Compose ``scene`` around ``robot`` (both as loaded, so errors point into them).
+
+        Raises:
+            ManifestError: At the field of the scene file or manifest that cannot be built:
+                an unknown asset or camera, a manifest that disagrees with its model, an
+                object name the model already uses, a weld on a fixed base, a control rate
+                the model's physics step cannot serve.
+        """
         self.scene = scene
         self.robot = robot
-        where = f"{source}: " if source else ""
         if scene.scene.assets not in ASSETS:
-            raise SceneError(
-                f"{where}scene.assets {scene.scene.assets!r}; expected one of {ASSETS}"
-            )
-        sim = robot.sim
-        if sim is None:
-            raise SceneError(f"{where}robot {robot.name!r} has no sim block")
-        self._sensors = _camera_sensors(robot, scene.scene.cameras, where)
+            message = f"{scene.scene.assets!r} is not a native scene; expected one of {ASSETS}"
+            raise error_at(scene, ("scene", "assets"), message)
+        if robot.sim is None:
+            raise error_at(scene, ("robot_id",), f"robot {robot.name!r} has no sim block")
+        self._sensors = camera_sensors(scene, robot)
         self.model = _compose(scene, robot, self._sensors)
         self.data = mujoco.MjData(self.model)
         wiring = hal_wiring(robot)
         assert wiring is not None
         self._keyframe = wiring.keyframe_index
         self._floating = wiring.floating_base
-        self._root_body = _root_body(self.model, robot)
+        self._root_body = root_body(self.model, robot)
         self._root_qpos = int(self.model.jnt_qposadr[self.model.body_jntadr[self._root_body]])
         self._width = scene.scene.observation.width
         self._height = scene.scene.observation.height
         options = scene.scene.options
-        control_hz = options.control_freq_hz if options and options.control_freq_hz else 20.0
-        self.substeps = max(1, round(1.0 / (control_hz * self.model.opt.timestep)))
+        self.substeps = physics_steps_per_control(scene, self.model.opt.timestep)
         self.horizon = options.horizon if options and options.horizon else None
         self._ctrl_low, self._ctrl_high = ctrl_limits(self.model)
         self._pd = _pd_law(robot, self.model) if wiring.control_mode == "torque_pd" else None
@@ -202,28 +211,21 @@ class NativeScene:
         self.data.qpos[free + 3 : free + 7] = quat
 
 
-def _camera_sensors(robot: RobotDescription, wanted: Sequence[str], where: str) -> dict[str, str]:
-    """Scene camera list → {sensor name: MJCF camera name}, in the scene file's order."""
-    by_name = {s.name: s for s in robot.sensors if isinstance(s, RgbSensor | DepthSensor)}
-    cameras: dict[str, str] = {}
-    for name in wanted:
-        sensor = by_name.get(name)
-        if sensor is None:
-            known = ", ".join(by_name) or "(none)"
-            raise SceneError(
-                f"{where}scene.cameras: {name!r} is not a camera sensor of robot "
-                f"{robot.name!r}; its camera sensors are: {known}"
-            )
-        cameras[name] = sensor.camera or f"openral_{name}"
-    return cameras
-
-
 def _compose(
     scene: DeployScene, robot: RobotDescription, cameras: dict[str, str]
 ) -> mujoco.MjModel:
     assert robot.sim is not None
     folder = manifest_path(robot.name).parent
-    child = mujoco.MjSpec.from_file(str(resolve_mjcf_uri(robot.sim.mjcf_uri, folder)))
+    path = resolve_mjcf_uri(robot.sim.mjcf_uri, folder)
+    try:
+        child = mujoco.MjSpec.from_file(str(path))
+        child_model = child.copy().compile()  # before attach: no compile after it
+    except ValueError as error:
+        raise unloadable_model(robot, path, error) from None
+    mismatch = manifest_mismatch(robot, child_model)
+    if mismatch is not None:
+        raise mismatch
+    check_object_names(scene, child_model)
     spec = mujoco.MjSpec()
     spec.modelname = f"{scene.scene.id}_{robot.name}"
     for key in ("timestep", "integrator", "cone", "impratio", "noslip_iterations"):
@@ -238,11 +240,10 @@ def _compose(
     base = np.asarray(pose.position_m if pose and pose.position_m else [0.0, 0.0, 0.0])
     yaw = math.radians(pose.yaw_deg if pose and pose.yaw_deg else 0.0)
     options = scene.scene.options
-    child_model = child.copy().compile()  # before attach: no compile after it
     own_floor = any(g.type == mujoco.mjtGeom.mjGEOM_PLANE for g in child.geoms)  # no 2nd
     floor_z = 0.0
     if scene.scene.assets == "floor":  # the model brings a table: the floor goes under it
-        floor_z = min(0.0, base[2] + _lowest_static_point(child_model) - 0.001)
+        floor_z = min(0.0, base[2] + lowest_static_point(child_model) - 0.001)
     own_sky = any(t.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX for t in child.textures)
     _add_world(spec, floor_z=None if own_floor else floor_z, sky=not own_sky)
     if scene.scene.assets == "tabletop":
@@ -264,36 +265,37 @@ def _compose(
     for obj in options.objects if options and options.objects else []:
         _add_object(spec, obj)
     frame = spec.worldbody.add_frame(pos=base.tolist(), quat=_yaw_quat(yaw).tolist())
-    center, radius = _robot_extent(child_model, robot)
-    _add_mounted_cameras(child, robot, cameras)
+    center, radius = robot_extent(child_model, robot)
+    add_mounted_cameras(child, robot, cameras)
     spec.attach(child, frame=frame, prefix="")
     if pose is not None and pose.weld:
+        if not robot.sim.floating_base:
+            message = (
+                f"robot {robot.name!r} has a fixed base; only a floating base can be welded "
+                "in place"
+            )
+            raise error_at(scene, ("base_pose", "weld"), message)
         _add_base_weld(spec, child_model, robot)
     for sensor in robot.sensors:  # neither a model camera nor mounted: a fixed camera
         if not isinstance(sensor, RgbSensor | DepthSensor) or sensor.name not in cameras:
             continue
         if sensor.camera is None and sensor.mount_body is None:
             fovy = sensor.fovy_deg or 45.0
-            target = base + _rotate(yaw, center)
-            _add_fixed_camera(spec, cameras[sensor.name], target, yaw, radius, fovy)
+            target = base + rotate_about_z(yaw, center)
+            add_fixed_camera(spec, cameras[sensor.name], target, yaw, radius, fovy)
     try:
         return spec.compile()
     except ValueError as error:
-        problem = f"scene {scene.scene.id!r} for {robot.name!r} does not compile: {error}"
-        raise SceneError(problem) from None
+        message = f"scene {scene.scene.id!r} for {robot.name!r} does not compile: {error}"
+        raise error_at(scene, ("scene",), message) from None
 
 
 def _add_base_weld(
     spec: mujoco.MjSpec, child_model: mujoco.MjModel, robot: RobotDescription
 ) -> None:
     """A weld holding the floating root body; its pose is set at every reset."""
-    assert robot.sim is not None
-    if not robot.sim.floating_base:
-        raise SceneError(
-            f"base_pose.weld: robot {robot.name!r} has a fixed base; only a floating base "
-            "can be welded in place"
-        )
-    root = _root_body(child_model, robot)
+    assert robot.sim is not None and robot.sim.floating_base, "_compose checks the base"
+    root = root_body(child_model, robot)
     timestep = spec.option.timestep
     spec.add_equality(
         name=BASE_WELD,
@@ -329,7 +331,7 @@ def _add_world(spec: mujoco.MjSpec, *, floor_z: float | None, sky: bool) -> None
 
 
 def _add_table(spec: mujoco.MjSpec, base: np.ndarray, yaw: float, height: float) -> None:
-    centre = base + _rotate(yaw, np.array([0.55, 0.0, 0.0]))
+    centre = base + rotate_about_z(yaw, np.array([0.55, 0.0, 0.0]))
     spec.worldbody.add_geom(
         name="scene_table",
         type=mujoco.mjtGeom.mjGEOM_BOX,
@@ -358,106 +360,6 @@ def _add_object(spec: mujoco.MjSpec, obj: Any) -> None:
     )
 
 
-def _add_mounted_cameras(
-    child: mujoco.MjSpec, robot: RobotDescription, cameras: dict[str, str]
-) -> None:
-    for sensor in robot.sensors:
-        if not isinstance(sensor, RgbSensor | DepthSensor) or sensor.name not in cameras:
-            continue
-        if sensor.camera is not None or sensor.mount_body is None:
-            continue
-        body = child.body(sensor.mount_body)
-        if body is None:
-            raise SceneError(f"sensor {sensor.name!r}: no body {sensor.mount_body!r} in the model")
-        forward = any(word in sensor.mount_body.lower() for word in FORWARD_LOOKING)
-        axis = sensor.mount_axis.value if sensor.mount_axis is not None else None
-        # A MuJoCo camera looks along its -z axis with +y up.
-        if axis is None and forward:  # along body +x, slightly down, from above the origin
-            pos, xyaxes = [0.1, 0.0, 0.35], [0, -1, 0, 0.45, 0, 1]
-        else:
-            pos, xyaxes = _looking_along(axis or "+z")
-        body.add_camera(
-            name=cameras[sensor.name], pos=pos, xyaxes=xyaxes, fovy=sensor.fovy_deg or 60.0
-        )
-
-
-def _looking_along(axis: str) -> tuple[list[float], list[float]]:
-    """Camera position and xyaxes in a body's frame that look along body ``axis`` (e.g.
-    ``+y``) from 7 cm beside it, image up pointing to that side (for ``+z``: from -y)."""
-    index = "xyz".index(axis[1])
-    look = np.zeros(3)
-    look[index] = 1.0 if axis[0] == "+" else -1.0
-    up = np.zeros(3)
-    up[(index - 1) % 3] = -1.0  # z -> -y, y -> -x, x -> -z
-    right = np.cross(up, -look)
-    return (0.07 * up).tolist(), [*right.tolist(), *up.tolist()]
-
-
-def _add_fixed_camera(
-    spec: mujoco.MjSpec, name: str, target: np.ndarray, yaw: float, radius: float, fovy: float
-) -> None:
-    """A world camera in front of the robot, above and to one side, that fits a sphere of
-    ``radius`` around ``target`` into its field of view."""
-    direction = _rotate(yaw, np.array([1.0, 0.3, 0.55]))
-    direction /= np.linalg.norm(direction)
-    distance = 1.1 * radius / math.sin(math.radians(fovy) / 2)
-    eye = target + distance * direction
-    forward = -direction
-    right = np.cross(forward, [0.0, 0.0, 1.0])
-    right /= np.linalg.norm(right)
-    up = np.cross(right, forward)
-    spec.worldbody.add_camera(name=name, pos=eye.tolist(), xyaxes=[*right, *up], fovy=fovy)
-
-
-def _lowest_static_point(model: mujoco.MjModel) -> float:
-    """Lowest z (at most 0) of the geoms welded to the world in ``model``, e.g. the underside
-    of a table that comes with the robot's file."""
-    data = mujoco.MjData(model)
-    mujoco.mj_kinematics(model, data)
-    lowest = 0.0
-    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
-    for geom in np.flatnonzero(model.body_weldid[model.geom_bodyid] == 0):
-        if model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_PLANE:
-            continue
-        center, half = model.geom_aabb[geom, :3], model.geom_aabb[geom, 3:]
-        local = center + corners * half
-        world = data.geom_xpos[geom] + local @ data.geom_xmat[geom].reshape(3, 3).T
-        lowest = min(lowest, float(world[:, 2].min()))
-    return lowest
-
-
-def _root_body(model: mujoco.MjModel, robot: RobotDescription) -> int:
-    """The robot's root body (the world's child that carries its first manifest joint)."""
-    first = next(iter(joint_name_map(robot).values()))
-    joint = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, first)
-    return int(model.body_rootid[model.jnt_bodyid[joint]])
-
-
-def _robot_extent(model: mujoco.MjModel, robot: RobotDescription) -> tuple[np.ndarray, float]:
-    """Centre and radius (at least 0.2 m) of the robot's links in its start pose, in the
-    model's frame; only bodies moved by the manifest's joints and their bases count, so a
-    table or a prop in the robot's file does not widen the view. A floating base's
-    horizontal offset is removed (the scene puts the base at ``base_pose``)."""
-    data = mujoco.MjData(model)
-    if model.nkey:
-        mujoco.mj_resetDataKeyframe(model, data, 0)
-    mujoco.mj_kinematics(model, data)
-    joint = mujoco.mjtObj.mjOBJ_JOINT
-    mjcf_names = joint_name_map(robot).values()
-    bodies = {
-        int(model.jnt_bodyid[i])
-        for i in range(model.njnt)
-        if mujoco.mj_id2name(model, joint, i) in mjcf_names
-    }
-    bodies |= {int(model.body_parentid[b]) for b in bodies}
-    bodies.discard(0)
-    points = data.xpos[sorted(bodies)] if bodies else data.xpos[1:]
-    if robot.sim is not None and robot.sim.floating_base:
-        points = points - data.xpos[_root_body(model, robot)] * np.array([1, 1, 0])
-    low, high = points.min(axis=0), points.max(axis=0)
-    return (low + high) / 2, max(0.2, float(np.linalg.norm(high - low)) / 2)
-
-
 def _pd_law(robot: RobotDescription, model: mujoco.MjModel) -> Any:
     """The manifest's PD law (:func:`pd_torque`) for every actuator, as a function of the
     data and the per-actuator position targets."""
@@ -483,8 +385,3 @@ def _pd_law(robot: RobotDescription, model: mujoco.MjModel) -> Any:
 
 def _yaw_quat(yaw: float) -> npt.NDArray[np.float64]:
     return np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
-
-
-def _rotate(yaw: float, vector: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([c * vector[0] - s * vector[1], s * vector[0] + c * vector[1], vector[2]])

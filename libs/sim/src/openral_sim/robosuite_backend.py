@@ -35,6 +35,7 @@ import numpy as np
 import numpy.typing as npt
 import robosuite
 from openral_core.errors import OpenralError
+from openral_core.located import error_at
 from openral_core.models import DeployScene
 
 from openral_sim.rollout import Observation, StepResult
@@ -234,54 +235,82 @@ class RobosuiteRollout:
 
 
 def robosuite_env_name(scene: DeployScene) -> str:
-    """The robosuite environment a scene names (see the module docstring)."""
+    """The robosuite environment a scene names (see the module docstring).
+
+    Raises:
+        ManifestError: At ``scene.assets`` (or ``scene.id``) when it names no environment.
+    """
     spec = scene.scene
+    available = ", ".join(sorted(robosuite.ALL_ENVIRONMENTS))
     if "assets" in spec.model_fields_set:
+        if spec.assets not in robosuite.ALL_ENVIRONMENTS:
+            message = f"unknown robosuite environment {spec.assets!r}; available: {available}"
+            raise error_at(scene, ("scene", "assets"), message)
         return spec.assets
     wanted = spec.id.replace("_", "").lower()
     for name in robosuite.ALL_ENVIRONMENTS:
         if name.lower() == wanted:
             return str(name)
-    raise RobosuiteError(
-        f"scene.id {spec.id!r} names no robosuite environment and scene.assets is not set; "
-        f"set scene.assets to one of: {', '.join(sorted(robosuite.ALL_ENVIRONMENTS))}"
+    message = (
+        f"{spec.id!r} names no robosuite environment and scene.assets is not set; set "
+        f"scene.assets to one of: {available}"
     )
+    raise error_at(scene, ("scene", "id"), message)
 
 
 def build_robosuite_rollout(scene: DeployScene) -> RobosuiteRollout:
     """The robosuite environment a deploy scene describes.
 
     Raises:
-        RobosuiteError: No or unsupported robot, unknown environment, or an option that
-            belongs to another backend.
+        ManifestError: At the scene file's field that robosuite cannot serve: no or an
+            unsupported robot, an unknown environment or controller, an option or a base
+            pose that belongs to the native backend, or an environment robosuite fails to
+            build (e.g. a camera it does not have).
     """
-    robot_id = scene.robot_id
-    if robot_id is None:
-        raise RobosuiteError("robot_id: the scene names no robot")
-    robot = ROBOSUITE_ROBOTS.get(robot_id)
-    if robot is None:
-        raise RobosuiteError(
-            f"robot_id {robot_id!r} has no robosuite model; the robosuite backend supports: "
-            f"{', '.join(sorted(ROBOSUITE_ROBOTS))}"
-        )
+    robot = _robosuite_robot(scene)
     options = scene.scene.options
     if options is not None:
-        foreign = [key for key in _NATIVE_ONLY_OPTIONS if getattr(options, key) is not None]
-        if foreign:
-            raise RobosuiteError(
-                f"scene.options: {', '.join(foreign)} apply to the native backend only"
+        for key in _NATIVE_ONLY_OPTIONS:
+            if getattr(options, key) is not None:
+                message = "applies to the native backend only"
+                raise error_at(scene, ("scene", "options", key), message)
+        controller = options.controller
+        if controller is not None and controller not in robosuite.ALL_COMPOSITE_CONTROLLERS:
+            message = (
+                f"unknown robosuite composite controller {controller!r}; available: "
+                f"{', '.join(sorted(robosuite.ALL_COMPOSITE_CONTROLLERS))}"
             )
+            raise error_at(scene, ("scene", "options", "controller"), message)
     pose = scene.base_pose
-    if pose is not None and (any(pose.position_m) or pose.yaw_deg or pose.weld):
-        raise RobosuiteError("base_pose: robosuite environments place the robot themselves")
-    return RobosuiteRollout(
-        env_name=robosuite_env_name(scene),
-        robot=robot,
-        camera_names=scene.scene.cameras,
-        width=scene.scene.observation.width,
-        height=scene.scene.observation.height,
-        control_freq_hz=options.control_freq_hz if options else 20.0,
-        horizon=options.horizon if options else None,
-        controller=options.controller if options else None,
-        seed=scene.seed,
-    )
+    if pose is not None and (any(pose.position_m or []) or pose.yaw_deg or pose.weld):
+        raise error_at(scene, ("base_pose",), "robosuite environments place the robot themselves")
+    env_name = robosuite_env_name(scene)
+    try:
+        return RobosuiteRollout(
+            env_name=env_name,
+            robot=robot,
+            camera_names=scene.scene.cameras,
+            width=scene.scene.observation.width,
+            height=scene.scene.observation.height,
+            control_freq_hz=options.control_freq_hz if options else 20.0,
+            horizon=options.horizon if options else None,
+            controller=options.controller if options else None,
+            seed=scene.seed,
+        )
+    except RobosuiteError as error:
+        raise error_at(scene, ("scene",), str(error)) from None
+
+
+def _robosuite_robot(scene: DeployScene) -> str:
+    """The robosuite robot model of the scene's robot (located error when there is none)."""
+    robot_id = scene.robot_id
+    if robot_id is None:
+        raise error_at(scene, (), "the scene names no robot; add robot_id")
+    robot = ROBOSUITE_ROBOTS.get(robot_id)
+    if robot is None:
+        message = (
+            f"{robot_id!r} has no robosuite model; the robosuite backend supports: "
+            f"{', '.join(sorted(ROBOSUITE_ROBOTS))}"
+        )
+        raise error_at(scene, ("robot_id",), message)
+    return robot

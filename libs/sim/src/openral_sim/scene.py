@@ -5,8 +5,9 @@ from __future__ import annotations
 import importlib
 from pathlib import Path
 
-from openral_core.errors import OpenralError, UnknownRobot
+from openral_core.errors import UnknownRobot
 from openral_core.loader import load_scene
+from openral_core.located import error_at
 from openral_core.registry import load_robot_by_id
 
 from openral_sim.rollout import SimRollout
@@ -27,25 +28,21 @@ def build_sim_env_from_yaml(path: str | Path, robot_id_fallback: str | None = No
     scene = load_scene(file)
     robot_id = scene.robot_id or robot_id_fallback
     if robot_id is None:
-        raise OpenralError(f"{file}: robot_id: the scene names no robot and none was given")
+        raise error_at(scene, (), "the scene names no robot and none was given; add robot_id")
     try:
         robot = load_robot_by_id(robot_id)
     except UnknownRobot as error:
-        raise OpenralError(f"{file}: robot_id: {error}") from None
+        raise error_at(scene, ("robot_id",), str(error)) from None
     if scene.scene.backend.value == "robosuite":
         try:
             backend = importlib.import_module("openral_sim.robosuite_backend")
         except ModuleNotFoundError as error:
-            raise OpenralError(
-                f"{file}: scene.backend: the robosuite backend is unavailable ({error})"
-            ) from None
-        try:
-            rollout: SimRollout = backend.build_robosuite_rollout(
-                scene.model_copy(update={"robot_id": robot_id})
-            )
-        except OpenralError as error:  # name the file, as the native backend does
-            raise type(error)(f"{file}: {error}") from None
+            message = f"the robosuite backend is unavailable ({error})"
+            raise error_at(scene, ("scene", "backend"), message) from None
+        rollout: SimRollout = backend.build_robosuite_rollout(
+            scene.model_copy(update={"robot_id": robot_id})
+        )
         return rollout
     from openral_sim.native_scene import NativeScene
 
-    return NativeScene(scene, robot, source=file)
+    return NativeScene(scene, robot)

@@ -1,0 +1,57 @@
+"""Checks a native scene makes against the robot's model before it composes anything.
+
+Each refuses one field of the scene file, at its line and column (what needs only the file,
+such as unique object names, the loader already checked).
+"""
+
+from __future__ import annotations
+
+import mujoco
+from openral_core.located import error_at
+from openral_core.models import DeployScene
+
+MAX_PHYSICS_STEPS_PER_CONTROL = 10_000
+"""Most physics steps one control period may take (a 1 Hz control period of a 0.1 ms
+model): beyond it one step of the scene would block the graph for seconds."""
+
+
+def physics_steps_per_control(scene: DeployScene, timestep_s: float) -> int:
+    """Physics steps of ``timestep_s`` [s] per control period of ``scene``.
+
+    Raises:
+        ManifestError: At ``scene.options.control_freq_hz`` when the rate is faster than the
+            physics step or needs more than :data:`MAX_PHYSICS_STEPS_PER_CONTROL` steps.
+    """
+    options = scene.scene.options
+    control_hz = options.control_freq_hz if options and options.control_freq_hz else 20.0
+    steps = round(1.0 / (control_hz * timestep_s))
+    field = ("scene", "options", "control_freq_hz")
+    physics_hz = 1.0 / timestep_s
+    if steps < 1:
+        message = (
+            f"{control_hz:g} Hz is faster than the model's physics ({physics_hz:g} Hz, a "
+            f"{timestep_s:g} s step); use at most {physics_hz:g} Hz"
+        )
+        raise error_at(scene, field, message)
+    if steps > MAX_PHYSICS_STEPS_PER_CONTROL:
+        message = (
+            f"{control_hz:g} Hz needs {steps} physics steps of {timestep_s:g} s per control "
+            f"period; at most {MAX_PHYSICS_STEPS_PER_CONTROL} are allowed (use at least "
+            f"{physics_hz / MAX_PHYSICS_STEPS_PER_CONTROL:g} Hz)"
+        )
+        raise error_at(scene, field, message)
+    return int(steps)
+
+
+def check_object_names(scene: DeployScene, model: mujoco.MjModel) -> None:
+    """Refuse a scene object whose body or joint name the robot's model already uses."""
+    options = scene.scene.options
+    for index, obj in enumerate(options.objects or [] if options else []):
+        for kind, name in (
+            (mujoco.mjtObj.mjOBJ_BODY, f"scene_{obj.name}"),
+            (mujoco.mjtObj.mjOBJ_JOINT, f"scene_{obj.name}_joint"),
+            (mujoco.mjtObj.mjOBJ_GEOM, f"scene_{obj.name}_geom"),
+        ):
+            if mujoco.mj_name2id(model, kind, name) >= 0:
+                message = f"the robot's model already has an element named {name!r}; rename it"
+                raise error_at(scene, ("scene", "options", "objects", index, "name"), message)
