@@ -91,6 +91,6 @@ def test_check_names_the_manifest_once_when_it_cannot_load(write_manifest: Manif
     (broken.parent / "mock_arm.xml").write_text("<mujoco><worldbody><body></mujoco>")
     result = runner.invoke(app, ["robot", "check", str(invalid), str(broken)])
     assert result.exit_code == 1
-    assert f"✗ {invalid}: INVALID" in result.output
+    assert f"✗ {invalid}:7:1: base: duplicate key 'base'" in result.output  # one located line
     assert f"{invalid}: {invalid}" not in result.output
     assert f"✗ {broken}: {broken.parent / 'mock_arm.xml'} does not load: " in result.output
