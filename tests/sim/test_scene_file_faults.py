@@ -135,9 +135,21 @@ def test_an_object_named_like_a_model_element_is_refused(tmp_path: Path) -> None
 @pytest.mark.parametrize(
     ("old", "new", "expected"),
     [
-        ("control_freq_hz: 20.0", "control_freq_hz: 0.002", "expected a value >= 1, got 0.002"),
-        ("control_freq_hz: 20.0", "control_freq_hz: 5000", "expected a value <= 2000, got 5000"),
-        ("{width: 128, height: 128}", "{width: 8, height: 128}", "expected a value >= 16, got 8"),
+        (
+            "control_freq_hz: 20.0",
+            "control_freq_hz: 0.002",
+            "expected a value >= 1 and <= 2000, got 0.002",
+        ),
+        (
+            "control_freq_hz: 20.0",
+            "control_freq_hz: 5000",
+            "expected a value >= 1 and <= 2000, got 5000",
+        ),
+        (
+            "{width: 128, height: 128}",
+            "{width: 8, height: 128}",
+            "expected a value >= 16 and <= 4096, got 8",
+        ),
     ],
     ids=["rate-too-low", "rate-too-high", "image-too-small"],
 )

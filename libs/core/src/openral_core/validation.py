@@ -118,6 +118,14 @@ def _allowed(sub: ValidationError, key: str) -> list[Any]:
     return [value] if sub.validator == "const" else list(value) if sub.validator == "enum" else []
 
 
+_BOUNDS = {"minimum": ">=", "exclusiveMinimum": ">", "maximum": "<=", "exclusiveMaximum": "<"}
+
+
+def _range(schema: Any) -> str:
+    """Every bound ``schema`` sets on a number, e.g. ``>= 1 and <= 2000``."""
+    return " and ".join(f"{op} {schema[key]}" for key, op in _BOUNDS.items() if key in schema)
+
+
 def _message(error: ValidationError) -> str:
     instance: Any = error.instance
     value: Any = error.validator_value
@@ -132,14 +140,8 @@ def _message(error: ValidationError) -> str:
         return f"expected {value!r}, got {got}"
     if kind == "pattern":
         return f"{instance!r} does not match the required form {value}"
-    bounds = {
-        "minimum": ">=",
-        "maximum": "<=",
-        "exclusiveMinimum": ">",
-        "exclusiveMaximum": "<",
-    }
-    if kind in bounds:
-        return f"expected a value {bounds[str(kind)]} {value}, got {instance}"
+    if kind in _BOUNDS:
+        return f"expected a value {_range(error.schema)}, got {instance}"
     if kind in ("minItems", "maxItems"):
         word = "at least" if kind == "minItems" else "at most"
         return f"expected {word} {value} item(s), got {len(instance)}"
