@@ -1,15 +1,19 @@
-"""An outside client of a lifecycle node's services, for the hostile-peer tests.
+"""Outside peers for the hostile-peer tests: a lifecycle client and a deploy-sim process.
 
-It lives on a context of its own (its own DDS participant), as another process would, and
-calls the node's services the way ``ros2 lifecycle set`` does. Every call waits for its
-response with a generous timeout and fails the test when none comes.
+The client lives on a context of its own (its own DDS participant), as another process
+would, and calls the node's services the way ``ros2 lifecycle set`` does. Every call waits
+for its response with a generous timeout and fails the test when none comes.
 """
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -71,11 +75,21 @@ TRANSITION_WAIT_S = 60.0
 """Longest wait for a transition that builds a HAL and its scene on a loaded machine [s]."""
 
 
+OPENRAL = Path(sys.executable).parent / "openral"
+DEPLOY_ENV = {**os.environ, "MUJOCO_GL": "egl", "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+DEPLOY_NODE = "openral_manifest_node"
+"""Name of the node ``openral deploy sim`` runs."""
+STOP_WAIT_S = 30.0
+"""Longest wait for a deploy process to end after SIGTERM before it is killed [s]."""
+
+
 class LifecycleClient:
     """ChangeState / GetState (and any Trigger service) calls from a node of its own."""
 
-    def __init__(self, node: Node, target: str) -> None:
+    def __init__(self, node: Node, target: str, spinner: Spinner) -> None:
         self.node = node
+        self.spinner = spinner
+        """The spinner of the client's context (add probe nodes to it)."""
         self.target = target
         self._change = node.create_client(ChangeState, f"/{target}/change_state")
         self._get = node.create_client(GetState, f"/{target}/get_state")
@@ -129,10 +143,39 @@ class LifecycleClient:
 def outside_client(domain_id: int, target: str, name: str) -> Iterator[LifecycleClient]:
     """A :class:`LifecycleClient` on its own context and spinner in ``domain_id``."""
     with ros_session(domain_id=domain_id) as context, Spinner(context) as spinner:
-        client = LifecycleClient(Node(name, context=context), target)
+        client = LifecycleClient(Node(name, context=context), target, spinner)
         spinner.add_node(client.node)
         try:
             yield client
         finally:
             spinner.stop()
             client.node.destroy_node()
+
+
+@contextmanager
+def deploy_sim(config: Path, domain_id: int, logs: Path) -> Iterator[subprocess.Popen[str]]:
+    """``openral deploy sim --config CONFIG --no-viewer`` in ``domain_id`` as a subprocess.
+
+    Its stdout and stderr go to ``logs/deploy.out`` and ``logs/deploy.err`` (files, not
+    pipes, so a chatty process never blocks on a full pipe). Still alive on exit, it gets
+    SIGTERM, then SIGKILL after :data:`STOP_WAIT_S`.
+    """
+    command = [str(OPENRAL), "deploy", "sim", "--config", str(config), "--no-viewer"]
+    command += ["--domain-id", str(domain_id)]
+    with (logs / "deploy.out").open("w") as out, (logs / "deploy.err").open("w") as err:
+        process = subprocess.Popen(command, stdout=out, stderr=err, text=True, env=DEPLOY_ENV)
+        try:
+            yield process
+        finally:
+            if process.poll() is None:
+                process.terminate()
+            try:
+                process.wait(STOP_WAIT_S)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait()
+
+
+def deploy_output(logs: Path) -> tuple[str, str]:
+    """What a :func:`deploy_sim` process wrote so far: (stdout, stderr)."""
+    return (logs / "deploy.out").read_text(), (logs / "deploy.err").read_text()
