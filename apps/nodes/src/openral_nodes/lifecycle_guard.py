@@ -24,6 +24,9 @@ from rclpy.lifecycle import LifecycleNode
 WARN_EVERY_S = 2.0
 """At most one refused-transition warning per this many seconds per node [s]."""
 
+LABEL_SHOWN = 40
+"""Characters of a requested label quoted in the warning (a hostile label can be long)."""
+
 ServiceCallback = Callable[[Any, Any], Any]
 
 
@@ -55,7 +58,8 @@ def _checked(
         # (id, label, start id, start label, goal id, goal label) of each allowed transition
         allowed: dict[str, int] = {row[1]: row[0] for row in machine.available_transitions}
         label, transition_id = request.transition.label, request.transition.id
-        asked = f"transition label {label!r}" if label else f"transition id {transition_id}"
+        shown = label if len(label) <= LABEL_SHOWN else f"{label[:LABEL_SHOWN]}…"
+        asked = f"transition label {shown!r}" if label else f"transition id {transition_id}"
         valid = label in allowed if label else transition_id in allowed.values()
         if not valid:
             listed = ", ".join(f"{name} (id {tid})" for name, tid in allowed.items()) or "none"
