@@ -61,7 +61,6 @@ def sim(
     """Bring SCENE's robot up as a ROS 2 graph: joint states, cameras, actions, E-stop."""
     robot_id = _scene_robot(config)
     require_ros()
-    from openral_nodes.manifest_node import ManifestLifecycleNode
     from openral_nodes.runtime import ros_session, spin_until
     from rclpy.executors import SingleThreadedExecutor
 
@@ -75,12 +74,7 @@ def sim(
     }
     stop = threading.Event()
     with ros_session(domain_id=domain_id) as context:
-        node = ManifestLifecycleNode(
-            context=context,
-            parameter_overrides=parameters,
-            log_boot_errors=False,
-            shutdown_event=stop,
-        )
+        node = _make_node(context, parameters, stop)
         executor = SingleThreadedExecutor(context=context)
         executor.add_node(node)
         previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in STOP_SIGNALS}
@@ -91,14 +85,11 @@ def sim(
             _print_interfaces(node, config)
             spin_until(executor, stop, timeout_s=duration)
         finally:
-            shut_down_over_ros = _shut_down(node)
+            reason = _shut_down(node, stop)
             executor.shutdown()
-            node.destroy_node()  # type: ignore[no-untyped-call]
+            node.destroy_node()
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
-    reason = "signal" if stop.is_set() else "--duration"
-    if shut_down_over_ros:
-        reason = "shutdown transition requested over ROS"
     out.print(f"stopped ({reason}) after {time.monotonic() - started:.1f} s; clean shutdown")
 
 
@@ -117,6 +108,16 @@ def _scene_robot(config: Path) -> str:
     return scene.robot_id
 
 
+def _make_node(context: Any, parameters: dict[str, Any], stop: threading.Event) -> Any:
+    """The manifest node as deploy runs it: boot errors reported by the caller, ``stop``
+    set by a shutdown transition (also one requested over ROS)."""
+    from openral_nodes.manifest_node import ManifestLifecycleNode
+
+    return ManifestLifecycleNode(
+        context=context, parameter_overrides=parameters, log_boot_errors=False, shutdown_event=stop
+    )
+
+
 def _transition(node: Any, name: str) -> None:
     """Run one lifecycle transition; a failure becomes one clear error."""
     from rclpy.lifecycle import TransitionCallbackReturn
@@ -126,21 +127,22 @@ def _transition(node: Any, name: str) -> None:
         raise OpenralError(f"{name} failed: {node.boot_error or result}")
 
 
-def _shut_down(node: Any) -> bool:
+def _shut_down(node: Any, stop: threading.Event) -> str:
     """Deactivate and clean up from whatever state the node reached.
 
     Returns:
-        True when the node was already finalized (a shutdown transition came over ROS).
+        Why the graph stopped: a shutdown transition (the node is finalized), a signal
+        (``stop`` is set) or the end of ``--duration``.
     """
     state = node.lifecycle_state
     if state == "finalized":
-        return True
+        return "shutdown transition requested over ROS"
     if state == "active":
         node.trigger_deactivate()
         state = "inactive"
     if state == "inactive":
         node.trigger_cleanup()
-    return False
+    return "signal" if stop.is_set() else "--duration"
 
 
 def _print_interfaces(node: Any, config: Path) -> None:
