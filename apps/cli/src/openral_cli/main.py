@@ -2,7 +2,8 @@
 
 Every command lives in ``openral_cli.commands.<noun>``; this module only assembles them.
 An :class:`~openral_core.OpenralError` becomes one message on stderr and exit code 1;
-usage errors exit 2 (typer's convention).
+usage errors exit 2 (typer's convention). All printing goes through
+:mod:`openral_cli.console`, which never reads data as rich markup.
 """
 
 from __future__ import annotations
@@ -12,8 +13,8 @@ import sys
 import typer
 from openral_core.errors import OpenralError
 from openral_sim.display import render_offscreen_when_headless
-from rich.console import Console
-from rich.markup import escape
+
+from openral_cli.console import error as print_error
 
 render_offscreen_when_headless()  # before any command module imports mujoco
 
@@ -37,10 +38,7 @@ def run() -> None:
     try:
         app()
     except OpenralError as error:
-        message = escape(str(error))  # a message may contain [brackets]: not rich markup
-        Console(stderr=True).print(
-            f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True
-        )
+        print_error(str(error))  # verbatim: a message may contain [brackets]
         sys.exit(1)
 
 

@@ -28,13 +28,11 @@ from openral_core import (
 from openral_core.errors import OpenralError
 from openral_core.models import LimitedJoint
 from openral_core.registry import MANIFEST_NAME
-from rich.console import Console
-from rich.markup import escape
 from rich.table import Table
 
+from openral_cli.console import err, highlighted, line, out, styled
+
 app = typer.Typer(help="Inspect and validate robot manifests.", no_args_is_help=True)
-out = Console(soft_wrap=True)
-err = Console(stderr=True, soft_wrap=True)
 
 
 @app.command("list")
@@ -54,7 +52,7 @@ def list_robots() -> None:
         except ManifestError as error:
             invalid += 1
             problems = f"INVALID ({len(error.issues)} problem(s)); run `openral robot validate`"
-            table.add_row(robot_id, f"[red]{problems}[/]", "", "", "", "")
+            table.add_row(robot_id, styled(problems, "red"), "", "", "", "")
             continue
         sim = robot.sim
         cameras = [s.name for s in robot.sensors if s.kind == "rgb"]
@@ -85,7 +83,8 @@ def show(robot_id: Annotated[str, typer.Argument(help="Robot id (folder under ro
     """The resolved HAL wiring, VLA slot table and joint-name map of one robot."""
     robot = load_robot_by_id(robot_id)
     tables = robot_tables(robot)
-    out.print(f"[bold]{robot.display_name}[/] ({robot.name}) — {manifest_path(robot_id)}")
+    header = line((robot.display_name, "bold"), f" ({robot.name}) — {manifest_path(robot_id)}")
+    out.print(highlighted(header))
     wiring = tables.hal_wiring
     joints = Table(title="joints and HAL wiring")
     for column in ("joint", "type", "limits", "MJCF name", "qpos", "qvel", "actuator"):
@@ -118,7 +117,8 @@ def _print_sim_summary(mjcf_uri: str, robot: RobotDescription) -> None:
     out.print(
         f"model: {mjcf_uri}  floating base: {wiring.floating_base}  "
         f"keyframe: {wiring.keyframe_index}  seed ctrl from qpos: {wiring.seed_ctrl_from_qpos}  "
-        f"control: {wiring.control_mode}  settle steps: {wiring.settle_steps_default}"
+        f"control: {wiring.control_mode}  settle steps: {wiring.settle_steps_default}",
+        highlight=True,
     )
     if not wiring.grippers:
         return
@@ -167,13 +167,13 @@ def validate(
             load_robot(file, check_folder_name=file.name == MANIFEST_NAME)
         except ManifestError as error:
             failures += 1
-            err.print(f"{file}: [red]INVALID[/]", highlight=False)
+            err.print(line(f"{file}: ", ("INVALID", "red")))
             for issue in error.issues:
-                err.print(f"  {issue.format()}", highlight=False, markup=False)
+                err.print(f"  {issue.format()}")
             continue
-        out.print(f"{file}: [green]OK[/]", highlight=False)
+        out.print(line(f"{file}: ", ("OK", "green")))
     if failures:
-        err.print(f"{failures} of {len(files)} file(s) invalid")
+        err.print(f"{failures} of {len(files)} file(s) invalid", highlight=True)
         raise typer.Exit(1)
 
 
@@ -183,7 +183,7 @@ def _named_manifests(targets: list[str] | None, all_robots: bool, verb: str) -> 
     if all_robots:
         files += [manifest_path(robot_id) for robot_id in robot_ids()]
     if not files:
-        err.print(f"name robot ids or files to {verb}, or pass --all")
+        err.print(f"name robot ids or files to {verb}, or pass --all", highlight=True)
         raise typer.Exit(2)
     return files
 
@@ -235,8 +235,8 @@ def check(
                 raise OpenralError(f"{file}: {path} does not load: {error}") from None
         except OpenralError as error:  # each names its manifest file already
             failed_robots += 1
-            err.print(f"[red]✗[/] {escape(str(error))}", highlight=False)
-            summary.add_row(file.parent.name, "-", "-", "[red]cannot load[/]")
+            err.print(line(("✗", "red"), f" {error}"))
+            summary.add_row(file.parent.name, "-", "-", styled("cannot load", "red"))
             continue
         rows = check_robot(robot, model)
         failures = [row for row in rows if not row.ok]
@@ -246,15 +246,17 @@ def check(
             for column in ("field", "manifest", "model", ""):
                 table.add_column(column)
             for row in shown:
-                mark = "[green]ok[/]" if row.ok else "[red]MISMATCH[/]"
+                mark = styled("ok", "green") if row.ok else styled("MISMATCH", "red")
                 table.add_row(row.field, row.expected, row.actual, mark)
             out.print(table)
         failed_robots += bool(failures)
-        status = f"[red]{len(failures)}[/]" if failures else "[green]0[/]"
+        status = styled(str(len(failures)), "red" if failures else "green")
         summary.add_row(robot.name, path.name, str(len(rows)), status)
     out.print(summary)
     if failed_robots:
-        err.print(f"{failed_robots} of {len(files)} robot(s) do not match their model")
+        err.print(
+            f"{failed_robots} of {len(files)} robot(s) do not match their model", highlight=True
+        )
         raise typer.Exit(1)
 
 
@@ -264,9 +266,19 @@ def scaffold(
     name: Annotated[str, typer.Option("--name", help="Robot id (folder under robots/).")],
     out_dir: Annotated[
         Path | None,
-        typer.Option("--out", help="Folder to write robot.yaml into [default: robots/<name>]"),
+        typer.Option(
+            "--out", help="Folder to write robot.yaml into.", show_default="robots/<name>"
+        ),
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Overwrite an existing file.")] = False,
+    allow_outside: Annotated[
+        bool,
+        typer.Option(
+            "--allow-outside",
+            help="Accept a model (or files it loads) outside the robot folder or package; "
+            "checking the draft later then needs OPENRAL_ALLOW_OUTSIDE=1.",
+        ),
+    ] = False,
 ) -> None:
     """Draft a robot.yaml from an MJCF model; lines marked `# REVIEW:` need a human."""
     from openral_core.paths import repo_root
@@ -275,12 +287,13 @@ def scaffold(
     folder = out_dir or repo_root() / "robots" / name
     target = folder / MANIFEST_NAME
     if target.exists() and not force:
-        err.print(f"{target} exists; pass --force to overwrite it")
+        err.print(f"{target} exists; pass --force to overwrite it", highlight=True)
         raise typer.Exit(1)
-    text = scaffold_manifest(mjcf, name, folder)
+    text = scaffold_manifest(mjcf, name, folder, allow_outside=allow_outside)
     folder.mkdir(parents=True, exist_ok=True)
     target.write_text(text, encoding="utf-8")
     out.print(
         f"wrote {target}; review the lines marked REVIEW, then run "
-        f"`openral robot validate {target}` and `openral robot check {target}`"
+        f"`openral robot validate {target}` and `openral robot check {target}`",
+        highlight=True,
     )

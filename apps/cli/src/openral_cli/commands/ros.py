@@ -20,9 +20,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
+from openral_cli.console import err, out
 from openral_cli.ros_available import require_ros
 
 if TYPE_CHECKING:
@@ -32,12 +32,12 @@ if TYPE_CHECKING:
 app = typer.Typer(
     help="Inspect the ROS 2 graph: topics, messages, camera frames.", no_args_is_help=True
 )
-out = Console(soft_wrap=True)
-err = Console(stderr=True, soft_wrap=True)
 
 DomainId = Annotated[
     int | None,
-    typer.Option("--domain-id", min=0, max=232, help="ROS domain [default: $ROS_DOMAIN_ID or 0]"),
+    typer.Option(
+        "--domain-id", min=0, max=232, help="ROS domain.", show_default="$ROS_DOMAIN_ID or 0"
+    ),
 ]
 Timeout = Annotated[
     float,
@@ -100,7 +100,7 @@ def topics(
         rates = measure_rates(node, infos, window) if rate else {}
         domain = node.context.get_domain_id()
     if not infos:
-        err.print(f"no topics on ROS_DOMAIN_ID={domain} after {wait:g} s")
+        err.print(f"no topics on ROS_DOMAIN_ID={domain} after {wait:g} s", highlight=True)
         return
     table = Table(title=f"ROS_DOMAIN_ID={domain}")
     table.add_column("topic", no_wrap=True)
@@ -135,7 +135,7 @@ def echo(
         with subscribe(node, info) as inbox:
             msg = inbox.get(timeout)
             while True:
-                out.print(format_message(msg), highlight=False, markup=False)
+                out.print(format_message(msg))
                 if once:
                     return
                 out.print("---")
@@ -181,6 +181,5 @@ def snapshot(
     write_png(out_file, rgb)
     out.print(
         f"wrote {out_file} ({rgb.shape[1]}x{rgb.shape[0]} {msg.encoding}, "
-        f"frame {msg.header.frame_id or '-'}) from {info.name}",
-        highlight=False,
+        f"frame {msg.header.frame_id or '-'}) from {info.name}"
     )

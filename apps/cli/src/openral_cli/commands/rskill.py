@@ -22,15 +22,14 @@ from types import FrameType
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.console import Console
 
+from openral_cli.console import line, out, status
 from openral_cli.ros_available import require_ros
 
 if TYPE_CHECKING:
     from openral_nodes.rskill_runner import RskillRunnerNode
 
 app = typer.Typer(help="Run robot skills (policies) on the ROS graph.", no_args_is_help=True)
-out = Console(soft_wrap=True)
 
 STATUS_PERIOD_S = 0.2
 """How often the status line refreshes [s]."""
@@ -54,7 +53,9 @@ def run(
     ] = 5.0,
     domain_id: Annotated[
         int | None,
-        typer.Option("--domain-id", min=0, max=232, help="ROS domain [default: $ROS_DOMAIN_ID]"),
+        typer.Option(
+            "--domain-id", min=0, max=232, help="ROS domain.", show_default="$ROS_DOMAIN_ID"
+        ),
     ] = None,
 ) -> None:
     """Run POLICY for ROBOT: camera frames by VLA slot in, /openral/safe_action out."""
@@ -83,8 +84,7 @@ def run(
     routes = ", ".join(f"{e.slot} <- {e.sensor}" for e in node.slot_table)
     out.print(
         f"{policy} on {node.robot}: {node.status.actions} action(s) on /openral/safe_action "
-        f"in {elapsed:.1f} s ({routes or 'no cameras'})",
-        highlight=False,
+        f"in {elapsed:.1f} s ({routes or 'no cameras'})"
     )
 
 
@@ -92,15 +92,17 @@ def _watch(node: RskillRunnerNode, policy: str, duration: float | None) -> float
     """Show the runner's status until it aborts, ``duration`` passes or Ctrl-C; the seconds run."""
     start = time.monotonic()
     try:
-        with out.status("starting") as status:
+        with status("starting") as shown:
             while node.abort_error is None:
                 elapsed = time.monotonic() - start
                 if duration is not None and elapsed >= duration:
                     break
                 state = node.status
-                status.update(
-                    f"{policy} on {node.robot}: {state.state} · slots "
-                    f"({', '.join(state.seen_slots)}) · {state.actions} action(s)",
+                shown.update(
+                    line(
+                        f"{policy} on {node.robot}: {state.state} · slots "
+                        f"({', '.join(state.seen_slots)}) · {state.actions} action(s)"
+                    )
                 )
                 time.sleep(STATUS_PERIOD_S)
     except KeyboardInterrupt:

@@ -13,12 +13,11 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
-from rich.progress import Progress
 from rich.table import Table
 
+from openral_cli.console import out, progress
+
 app = typer.Typer(help="Run simulated scenes.", no_args_is_help=True)
-out = Console()
 
 SWAY_RAD = 0.15
 """Amplitude of the demo motion around the start pose."""
@@ -66,8 +65,8 @@ def run(
         hold = hal.hold_action()
         if out_dir:
             out_dir.mkdir(parents=True, exist_ok=True)
-        with Progress(console=out, transient=True) as progress:
-            task = progress.add_task(f"{scene.scene.id} · {robot_id}", total=steps)
+        with progress() as bar:
+            task = bar.add_task(f"{scene.scene.id} · {robot_id}", total=steps)
             for step in range(steps):
                 phase = math.sin(2 * math.pi * step / max(steps, 20))
                 hal.send_action(hold + (SWAY_RAD * phase if motion == "sway" else 0.0))
@@ -87,7 +86,7 @@ def run(
                 if out_dir:
                     for camera, image in images.items():
                         write_png(out_dir / f"{camera}_{step:04d}.png", image)
-                progress.advance(task)
+                bar.advance(task)
     finally:
         hal.disconnect()
     if out_dir:
@@ -98,4 +97,4 @@ def run(
     table.add_row(
         robot_id, scene.scene.backend.value, str(steps), ", ".join(cameras), str(out_dir or "-")
     )
-    out.print(table)
+    out.print(table, soft_wrap=False)  # centred title, as this command always printed it
