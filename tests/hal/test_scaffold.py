@@ -18,7 +18,8 @@ IDS = robot_ids()
 
 
 def _source_uri(robot_id: str) -> str:
-    """The robot's own ``sim.mjcf_uri``, with ``file:`` made absolute."""
+    """The robot's own ``sim.mjcf_uri``, with ``file:`` made absolute (outside the draft's
+    folder, so drafting and loading it need ``allow_outside``)."""
     robot = load_robot_by_id(robot_id)
     assert robot.sim is not None
     uri = robot.sim.mjcf_uri
@@ -30,7 +31,7 @@ def _source_uri(robot_id: str) -> str:
 def _write_draft(uri: str, name: str, tmp_path: Path) -> tuple[Path, str]:
     folder = tmp_path / name
     folder.mkdir(parents=True, exist_ok=True)
-    text = scaffold_manifest(uri, name, folder)
+    text = scaffold_manifest(uri, name, folder, allow_outside=True)
     file = folder / "robot.yaml"
     file.write_text(text, encoding="utf-8")
     return file, text
@@ -42,7 +43,8 @@ def _load_draft(
     file, text = _write_draft(uri, name, tmp_path)
     draft = load_robot(file)
     assert draft.sim is not None
-    model = mujoco.MjModel.from_xml_path(str(resolve_mjcf_uri(draft.sim.mjcf_uri, file.parent)))
+    path = resolve_mjcf_uri(draft.sim.mjcf_uri, file.parent, allow_outside=True)
+    model = mujoco.MjModel.from_xml_path(str(path))
     return draft, model, text
 
 
@@ -232,6 +234,15 @@ def test_relative_file_uri_resolves_from_the_manifest_folder(tmp_path: Path) -> 
     (folder / "arm.xml").write_text(SYNTHETIC, encoding="utf-8")
     text = scaffold_manifest("file:arm.xml", "relative_arm", folder)
     assert "  mjcf_uri: file:arm.xml" in text.splitlines()
+
+
+def test_a_model_outside_the_draft_folder_needs_allow_outside(tmp_path: Path) -> None:
+    (tmp_path / "arm.xml").write_text(SYNTHETIC, encoding="utf-8")
+    folder = tmp_path / "outside_arm"
+    with pytest.raises(MjcfUriError, match="outside the robot folder"):
+        scaffold_manifest("file:../arm.xml", "outside_arm", folder)
+    text = scaffold_manifest("file:../arm.xml", "outside_arm", folder, allow_outside=True)
+    assert "  mjcf_uri: file:../arm.xml" in text.splitlines()
 
 
 def test_unknown_scheme_raises(tmp_path: Path) -> None:

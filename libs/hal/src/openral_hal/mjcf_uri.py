@@ -1,8 +1,8 @@
-"""Resolve a manifest's ``sim.mjcf_uri`` to an MJCF file on disk, offline.
+"""Resolve a manifest's ``sim.mjcf_uri`` to an MJCF file on disk, offline and confined.
 
 Schemes:
 
-- ``file:<path>``: relative to the manifest's folder, or absolute.
+- ``file:<path>``: relative to the manifest's folder, and inside it.
 - ``pkg:<distribution>/<path>``: a file shipped inside an installed distribution, found
   through its installed-files record (``importlib.metadata``); ``<path>`` is matched against
   the end of each recorded path, so data files installed outside site-packages resolve too.
@@ -10,23 +10,34 @@ Schemes:
 - ``gym_aloha:<scene>``: ``gym_aloha/assets/<scene>.xml`` of the installed gym-aloha.
 - ``openarm_v2:<variant>``: ``openarm_mujoco/v2/openarm_<variant>.xml`` installed by
   openarm-mujoco.
-- ``robot_descriptions:<module>``: the ``MJCF_PATH`` of ``robot_descriptions.<module>``;
-  kept for compatibility only, since that package downloads its models on first use.
 
-Nothing is ever downloaded. Every failure is one :class:`MjcfUriError` that names the
-manifest, the URI and what to install.
+Each resolution has a confinement root (:class:`~openral_hal.mjcf_confinement.Confinement`):
+the robot's folder for ``file:``, the folder holding the distribution's files next to the
+model for the others. The model, and every file it includes or loads, must lie inside it
+(symlinks resolved) unless ``OPENRAL_ALLOW_OUTSIDE=1`` or the caller's ``allow_outside``
+allows otherwise; :func:`resolve_mjcf_uri` returns only files that passed
+:func:`~openral_hal.mjcf_confinement.check_mjcf_files`. Nothing is ever downloaded or imported.
+Every failure is one :class:`MjcfUriError` that names the manifest, the URI and what to do.
 """
 
 from __future__ import annotations
 
-import importlib
 import importlib.metadata as metadata
+import os
 import re
 from pathlib import Path, PurePosixPath
 
 from openral_core.errors import OpenralError
 
-SCHEMES = ("file", "pkg", "robosuite", "gym_aloha", "openarm_v2", "robot_descriptions")
+from openral_hal.mjcf_confinement import (
+    ALLOW_OUTSIDE_ENV,
+    Confinement,
+    MjcfConfinementError,
+    check_mjcf_files,
+    outside_allowed,
+)
+
+SCHEMES = ("file", "pkg", "robosuite", "gym_aloha", "openarm_v2")
 """Every scheme :func:`resolve_mjcf_uri` understands."""
 
 DISTRIBUTION = "openral"
@@ -34,7 +45,7 @@ DISTRIBUTION = "openral"
 
 
 class MjcfUriError(OpenralError):
-    """An ``mjcf_uri`` that cannot be turned into a readable MJCF file."""
+    """An ``mjcf_uri`` that cannot be turned into a readable, confined MJCF file."""
 
     def __init__(self, uri: str, problem: str, manifest_dir: Path | None = None) -> None:
         self.uri = uri
@@ -42,62 +53,104 @@ class MjcfUriError(OpenralError):
         super().__init__(f"{where}sim.mjcf_uri {uri!r}: {problem}")
 
 
-def resolve_mjcf_uri(uri: str, manifest_dir: Path | None = None) -> Path:
-    """The MJCF file ``uri`` names.
+def resolve_mjcf_uri(
+    uri: str, manifest_dir: Path | None = None, *, allow_outside: bool = False
+) -> Path:
+    """The MJCF file ``uri`` names, checked to stay (with its includes and assets) confined.
 
     Args:
         uri: A ``<scheme>:<rest>`` string (see the module docstring).
-        manifest_dir: Folder of the manifest, for relative ``file:`` paths and messages.
+        manifest_dir: Folder of the manifest, for ``file:`` paths and messages.
+        allow_outside: Let the model and its files lie anywhere, for this call (as
+            ``OPENRAL_ALLOW_OUTSIDE=1`` does for every call).
 
     Raises:
-        MjcfUriError: Unknown scheme, package not installed, or file missing.
+        MjcfUriError: Unknown scheme, package not installed, file missing, a file outside
+            the confinement root, or XML that cannot be read safely.
     """
+    path, confinement = locate_mjcf_uri(uri, manifest_dir)
+    allowed = outside_allowed(allow_outside)
+    if not allowed and (confinement is None or not confinement.contains(path)):
+        where = f"outside {confinement}" if confinement else "and there is no robot folder"
+        raise MjcfUriError(
+            uri,
+            f"resolves to {os.path.realpath(path)}, {where}; set {ALLOW_OUTSIDE_ENV}=1 to "
+            "allow a model outside it",
+            manifest_dir,
+        )
+    if not path.is_file():
+        raise MjcfUriError(uri, f"resolved to {path}, which is not a file", manifest_dir)
+    if not allowed and confinement is not None:
+        try:
+            check_mjcf_files(path, confinement)
+        except MjcfConfinementError as error:
+            raise MjcfUriError(uri, str(error), manifest_dir) from None
+    return path
+
+
+def locate_mjcf_uri(uri: str, manifest_dir: Path | None = None) -> tuple[Path, Confinement | None]:
+    """The file ``uri`` names and the root it must stay in, unchecked (None: no root known)."""
     scheme, sep, rest = uri.partition(":")
     if not sep or not rest:
         raise MjcfUriError(uri, f"expected '<scheme>:<path>' with scheme one of {SCHEMES}")
     if scheme == "file":
-        path = _file_path(rest, uri, manifest_dir)
-    elif scheme == "pkg":
+        return _file_path(rest, uri, manifest_dir)
+    if scheme == "pkg":
         distribution, slash, inner = rest.partition("/")
         if not slash or not inner:
             raise MjcfUriError(uri, "expected 'pkg:<distribution>/<path inside it>'", manifest_dir)
-        path = distribution_file(distribution, inner, uri, manifest_dir)
     elif scheme == "robosuite":
-        path = distribution_file("robosuite", f"robosuite/models/assets/{rest}", uri, manifest_dir)
+        distribution, inner = "robosuite", f"robosuite/models/assets/{rest}"
     elif scheme == "gym_aloha":
-        path = distribution_file("gym-aloha", f"gym_aloha/assets/{rest}.xml", uri, manifest_dir)
+        distribution, inner = "gym-aloha", f"gym_aloha/assets/{rest}.xml"
     elif scheme == "openarm_v2":
-        inner = f"openarm_mujoco/v2/openarm_{rest}.xml"
-        path = distribution_file("openarm-mujoco", inner, uri, manifest_dir)
-    elif scheme == "robot_descriptions":
-        path = _robot_descriptions_path(rest, uri, manifest_dir)
+        distribution, inner = "openarm-mujoco", f"openarm_mujoco/v2/openarm_{rest}.xml"
     else:
         raise MjcfUriError(
             uri, f"unknown scheme {scheme!r}; expected one of {SCHEMES}", manifest_dir
         )
-    if not path.is_file():
-        raise MjcfUriError(uri, f"resolved to {path}, which is not a file", manifest_dir)
-    return path
+    return distribution_file(distribution, inner, uri, manifest_dir)
 
 
 def distribution_file(
     distribution: str, inner: str, uri: str, manifest_dir: Path | None = None
-) -> Path:
-    """The installed file of ``distribution`` whose recorded path ends with ``inner``."""
+) -> tuple[Path, Confinement]:
+    """The installed file of ``distribution`` whose recorded path ends with ``inner``, and
+    its confinement: the deepest folder holding every file of the distribution that sits
+    in the same top-level folder as the model (``site-packages/<package>``, or
+    ``share/<name>`` for data files)."""
     try:
         dist = metadata.distribution(distribution)
     except metadata.PackageNotFoundError:
         raise MjcfUriError(uri, _not_installed(distribution), manifest_dir) from None
     wanted = PurePosixPath(inner).parts
-    for record in dist.files or ():
-        parts = PurePosixPath(str(record)).parts
-        if parts[-len(wanted) :] == wanted:
-            return Path(str(dist.locate_file(record))).resolve()
+    records = [PurePosixPath(str(record)) for record in dist.files or ()]
+    for record in records:
+        if record.parts[-len(wanted) :] == wanted:
+            path = Path(str(dist.locate_file(record))).resolve()
+            root = _common_folder(record, records)
+            label = f"the files of {distribution} {dist.version}"
+            return path, Confinement.of(Path(str(dist.locate_file(root))), label)
     raise MjcfUriError(
         uri,
         f"{distribution} {dist.version} is installed but ships no file {inner!r}",
         manifest_dir,
     )
+
+
+def _common_folder(model: PurePosixPath, records: list[PurePosixPath]) -> PurePosixPath:
+    """Deepest folder holding every record that shares ``model``'s top-level folder."""
+    ups = next(i for i, part in enumerate(model.parts) if part != "..")
+    top = model.parts[: ups + 1]
+    common = model.parent.parts
+    for record in records:
+        if record.parts[: ups + 1] == top:
+            folder = record.parent.parts
+            depth = next(
+                (i for i, (a, b) in enumerate(zip(common, folder, strict=False)) if a != b), None
+            )
+            common = common[: min(len(common), len(folder)) if depth is None else depth]
+    return PurePosixPath(*common)
 
 
 def extras_providing(distribution: str) -> list[str]:
@@ -128,32 +181,14 @@ def _not_installed(distribution: str) -> str:
     )
 
 
-def _file_path(rest: str, uri: str, manifest_dir: Path | None) -> Path:
+def _file_path(rest: str, uri: str, manifest_dir: Path | None) -> tuple[Path, Confinement | None]:
     path = Path(rest)
-    if path.is_absolute():
-        return path
     if manifest_dir is None:
-        raise MjcfUriError(uri, "a relative file: path needs the manifest's folder")
-    return (manifest_dir / path).resolve()
-
-
-def _robot_descriptions_path(module: str, uri: str, manifest_dir: Path | None) -> Path:
-    offline = (
-        "robot_descriptions fetches models from the internet on first use; point mjcf_uri at "
-        "a file inside an installed wheel instead (pkg:<distribution>/<path>), or file:"
-    )
-    try:
-        metadata.distribution("robot_descriptions")
-    except metadata.PackageNotFoundError:
-        problem = f"robot_descriptions is not installed. {offline}"
-        raise MjcfUriError(uri, problem, manifest_dir) from None
-    try:
-        loaded = importlib.import_module(f"robot_descriptions.{module}")
-        mjcf_path = loaded.MJCF_PATH
-    except Exception as exc:
-        problem = f"robot_descriptions.{module} is not available ({type(exc).__name__}: {exc})"
-        raise MjcfUriError(uri, f"{problem}. {offline}", manifest_dir) from None
-    return Path(str(mjcf_path))
+        if not path.is_absolute():
+            raise MjcfUriError(uri, "a relative file: path needs the manifest's folder")
+        return Path(os.path.realpath(path)), None
+    confinement = Confinement.of(manifest_dir, "the robot folder")
+    return Path(os.path.realpath(manifest_dir / path)), confinement
 
 
 def _normalise(name: str) -> str:

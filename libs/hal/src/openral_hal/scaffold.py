@@ -88,18 +88,22 @@ class _Driven:
     """Joints of the fixed tendon the actuator drives (this joint first), or () for a joint."""
 
 
-def scaffold_manifest(mjcf_uri: str, name: str, manifest_dir: Path) -> str:
+def scaffold_manifest(
+    mjcf_uri: str, name: str, manifest_dir: Path, *, allow_outside: bool = False
+) -> str:
     """Draft robot.yaml text for the MJCF model `mjcf_uri` names.
 
     Args:
         mjcf_uri: A ``sim.mjcf_uri`` (see :mod:`openral_hal.mjcf_uri`), written into the draft
             as given.
         name: Robot id; the draft belongs in ``robots/<name>/robot.yaml``.
-        manifest_dir: Folder the draft will be written to (relative ``file:`` URIs start
-            there).
+        manifest_dir: Folder the draft will be written to (``file:`` URIs start there and
+            must stay inside it).
+        allow_outside: Accept a model, or files it loads, outside its confinement root
+            (see :func:`openral_hal.mjcf_uri.resolve_mjcf_uri`).
 
     Raises:
-        MjcfUriError: The URI cannot be resolved to an MJCF file.
+        MjcfUriError: The URI cannot be resolved to a confined MJCF file.
         HalError: Invalid robot id, a model MuJoCo cannot load, or no actuator that drives
             a joint.
     """
@@ -108,7 +112,7 @@ def scaffold_manifest(mjcf_uri: str, name: str, manifest_dir: Path) -> str:
             f"robot name {name!r} must be lower-case snake case, 2 to 63 characters "
             "(^[a-z][a-z0-9_]{1,62}$)"
         )
-    path = resolve_mjcf_uri(mjcf_uri, manifest_dir)
+    path = resolve_mjcf_uri(mjcf_uri, manifest_dir, allow_outside=allow_outside)
     try:
         model = mujoco.MjModel.from_xml_path(str(path))
     except ValueError as error:
