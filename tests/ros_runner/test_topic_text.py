@@ -68,8 +68,8 @@ def test_short_sequences_print_inline_and_message_lists_as_items() -> None:
 
 
 def test_message_types_resolve_from_graph_names() -> None:
-    assert message_class("sensor_msgs/msg/JointState") is JointState
+    assert message_class("sensor_msgs/msg/JointState", "/j") is JointState
     with pytest.raises(MessageTypeError, match="not a message type"):
-        message_class("std_srvs/srv/Trigger")
-    with pytest.raises(MessageTypeError, match="install the ros-nope-msgs wheel"):
-        message_class("nope_msgs/msg/Thing")
+        message_class("std_srvs/srv/Trigger", "/t")
+    with pytest.raises(MessageTypeError, match="nope_msgs/msg/Thing, which openral does not"):
+        message_class("nope_msgs/msg/Thing", "/n")

@@ -2,22 +2,41 @@
 
 Graph queries read rmw's discovery cache, which DDS threads fill in the background, so
 they need no executor; waiting is polling that cache every ``POLL_S`` seconds.
+
+A topic's type name comes from whichever peer advertises it, so it never names a module
+to import: only the packages in ``DECODABLE_PACKAGES`` are decoded.
 """
 
 from __future__ import annotations
 
 import importlib
+import re
 import time
 from dataclasses import dataclass
 from typing import Any
 
 from openral_core.errors import OpenralError
+from rclpy.exceptions import InvalidTopicNameException
 from rclpy.node import Node
+from rclpy.validate_full_topic_name import validate_full_topic_name
 
 HIDDEN_TOPICS = frozenset({"/rosout", "/parameter_events"})
 """Topics every node creates; listed only on request."""
 POLL_S = 0.05
 """Interval between discovery-cache reads while waiting (s)."""
+DECODABLE_PACKAGES = (
+    "builtin_interfaces",
+    "geometry_msgs",
+    "lifecycle_msgs",
+    "nav_msgs",
+    "rcl_interfaces",
+    "rosgraph_msgs",
+    "sensor_msgs",
+    "std_msgs",
+)
+"""ROS message packages whose types are decoded (the ``ros`` extra and rclpy's own)."""
+MESSAGE_NAME = re.compile(r"[A-Z][A-Za-z0-9]*")
+"""A ROS message name: CamelCase, letters and digits."""
 
 
 @dataclass(frozen=True)
@@ -43,12 +62,26 @@ class TopicNotFound(OpenralError):
 
 
 class MessageTypeError(OpenralError):
-    """A message type name that cannot be imported in this environment."""
+    """A topic type this process does not decode: not a message, not allowed or not installed."""
+
+
+class TopicNameError(OpenralError):
+    """A topic name that ROS would reject."""
 
 
 def topic_name(name: str) -> str:
-    """Absolute form of a topic name (``joint_states`` → ``/joint_states``)."""
-    return name if name.startswith("/") else f"/{name}"
+    """Absolute form of a valid topic name (``joint_states`` → ``/joint_states``).
+
+    Raises:
+        TopicNameError: ROS does not accept the name (e.g. ``/a[b]``, ``/1x``, ``/a//b``).
+    """
+    full = name if name.startswith("/") else f"/{name}"
+    try:
+        validate_full_topic_name(full)
+    except InvalidTopicNameException as error:
+        reason = str(error).splitlines()[0].removeprefix("Invalid topic name: ").rstrip(":")
+        raise TopicNameError(f"{_shown(name)} is not a valid ROS topic name: {reason}") from None
+    return full
 
 
 def graph_topics(node: Node, *, include_hidden: bool = False) -> list[TopicInfo]:
@@ -75,17 +108,43 @@ def wait_for_topic(node: Node, topic: str, timeout_s: float) -> TopicInfo:
         time.sleep(POLL_S)
 
 
-def message_class(type_name: str) -> type[Any]:
-    """The Python class of a ROS message type such as ``sensor_msgs/msg/Image``."""
+def message_class(type_name: str, topic: str) -> type[Any]:
+    """The class of ``topic``'s type, e.g. ``sensor_msgs/msg/Image``, from an allowed package.
+
+    ``type_name`` is whatever a peer advertised: the package must be one of
+    ``DECODABLE_PACKAGES`` and the name a ROS message name before anything is imported.
+
+    Raises:
+        MessageTypeError: not ``pkg/msg/Name``, a package outside the allow-list, or a
+            name that package does not define as a message.
+    """
+    shown = _shown(type_name)
     parts = type_name.split("/")
-    if len(parts) != 3 or parts[1] != "msg" or not parts[0] or not parts[2]:
-        raise MessageTypeError(f"{type_name!r} is not a message type (expected pkg/msg/Name)")
-    package, _, name = parts
-    try:
-        cls: type[Any] = getattr(importlib.import_module(f"{package}.msg"), name)
-    except (ImportError, AttributeError) as error:
+    if len(parts) != 3 or parts[1] != "msg":
         raise MessageTypeError(
-            f"message type {type_name} is not installed in this Python environment ({error}); "
+            f"topic {topic} has type {shown}, which is not a message type (expected pkg/msg/Name)"
+        )
+    package, _, name = parts
+    if package not in DECODABLE_PACKAGES:
+        raise MessageTypeError(
+            f"topic {topic} has type {shown}, which openral does not decode; "
+            f"decodable packages: {', '.join(DECODABLE_PACKAGES)}"
+        )
+    if not MESSAGE_NAME.fullmatch(name):
+        raise MessageTypeError(f"topic {topic} has type {shown}: {name!r} is not a message name")
+    try:
+        module = importlib.import_module(f"{package}.msg")
+    except ImportError as error:
+        raise MessageTypeError(
+            f"topic {topic} has type {shown}, but {package} is not installed ({error}); "
             f"install the ros-{package.replace('_', '-')} wheel"
-        ) from error
+        ) from None
+    cls = getattr(module, name, None)
+    if not isinstance(cls, type) or not hasattr(cls, "get_fields_and_field_types"):
+        raise MessageTypeError(f"topic {topic} has type {shown}, which {package} does not define")
     return cls
+
+
+def _shown(text: str) -> str:
+    """``text`` as is when printable, else its repr (no terminal escapes from a peer)."""
+    return text if text.isprintable() else repr(text)

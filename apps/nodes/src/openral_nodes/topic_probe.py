@@ -62,7 +62,7 @@ def subscribe(node: Node, info: TopicInfo) -> Iterator[Inbox]:
     """Subscribe ``node`` to ``info`` (first advertised type) for the ``with`` block."""
     inbox = Inbox(info)
     subscription = node.create_subscription(
-        message_class(info.types[0]), info.name, inbox.put, qos_profile_best_available
+        message_class(info.types[0], info.name), info.name, inbox.put, qos_profile_best_available
     )
     try:
         yield inbox
@@ -81,7 +81,7 @@ def measure_rates(
     subscriptions = []
     for info in topics:
         try:
-            cls = message_class(info.types[0])
+            cls = message_class(info.types[0], info.name)
         except OpenralError:
             continue
         callback = _stamper(arrivals[info.name])
