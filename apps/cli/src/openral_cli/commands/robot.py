@@ -12,6 +12,7 @@ Examples::
 
 from __future__ import annotations
 
+import shlex
 from pathlib import Path
 from typing import Annotated
 
@@ -292,8 +293,9 @@ def scaffold(
     text = scaffold_manifest(mjcf, name, folder, allow_outside=allow_outside)
     folder.mkdir(parents=True, exist_ok=True)
     target.write_text(text, encoding="utf-8")
+    typed = shlex.quote(str(target))  # the commands below paste into a shell as they are
     out.print(
         f"wrote {target}; review the lines marked REVIEW, then run "
-        f"`openral robot validate {target}` and `openral robot check {target}`",
+        f"`openral robot validate {typed}` and `openral robot check {typed}`",
         highlight=True,
     )
