@@ -47,6 +47,10 @@ docs-serve:
 docs-images *IDS:
     python -m openral_codegen images {{IDS}}
 
+# Fuzz manifests and scenes through load, robot check and the HAL: N cases, counts by outcome, reproducers in fuzz-findings/.
+fuzz N *ARGS:
+    python -m tests.fuzz.campaign {{N}} {{ARGS}}
+
 # The static checks CI runs after the tests: lint, types, generated-tree drift.
 check: lint typecheck schema-check
 
