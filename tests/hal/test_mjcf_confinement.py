@@ -255,6 +255,16 @@ def test_xml_that_cannot_be_read_safely_is_refused(
     assert f"{folder / 'mjcf' / 'rizon4.xml'}{expected}" in message
 
 
+def test_a_fifo_is_never_opened(tmp_path: Path) -> None:
+    folder = _robot(tmp_path, _top('<include file="pipe.xml"/>'))
+    os.mkfifo(folder / "mjcf" / "pipe.xml")
+    message = _refusal(folder, outside=False)
+    assert "<include file='pipe.xml'> resolves to " in message
+    assert "which is not a regular file" in message
+    with pytest.raises(MjcfUriError, match="which is not a file"):
+        resolve_mjcf_uri("file:mjcf/pipe.xml", folder)
+
+
 def test_an_include_cycle_ends(tmp_path: Path) -> None:
     folder = _robot(tmp_path, _top('<include file="a.xml"/>'))
     (folder / "mjcf" / "a.xml").write_text('<mujoco><include file="a.xml"/></mujoco>')

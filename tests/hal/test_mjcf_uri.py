@@ -35,7 +35,9 @@ def test_file_uri_is_relative_to_the_manifest_folder(tmp_path: Path) -> None:
 def test_an_absolute_file_uri_without_a_folder_needs_permission(tmp_path: Path) -> None:
     model = tmp_path / "arm.xml"
     model.write_text("<mujoco/>")
-    with pytest.raises(MjcfUriError, match="there is no robot folder; set OPENRAL_ALLOW_OUTSIDE"):
+    with pytest.raises(
+        MjcfUriError, match="with no robot folder to keep it in; set OPENRAL_ALLOW_OUTSIDE=1"
+    ):
         resolve_mjcf_uri(f"file:{model}", None)
     assert resolve_mjcf_uri(f"file:{model}", None, allow_outside=True) == model.resolve()
 

@@ -31,6 +31,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NoReturn
 from xml.parsers import expat
 
 from openral_core.errors import OpenralError
@@ -188,7 +189,7 @@ def _check_model(main: Path, confinement: Confinement, seen: set[str]) -> None:
     base = main.parent
     for refs in found.dirs.values():
         for ref in refs:
-            _check_ref(ref, ref.value, [base], confinement)
+            _check_ref(ref, ref.value, [base], confinement, directory=True)
     mesh_dirs = _dir_values(found, "meshdir")
     texture_dirs = _dir_values(found, "texturedir")
     for ref in found.refs:
@@ -229,16 +230,20 @@ def _strip(value: str) -> str:
     return value.replace("\\", "/").rsplit("/", 1)[-1]
 
 
-def _check_ref(ref: _Ref, value: str, folders: list[Path], confinement: Confinement) -> list[Path]:
-    """Every place MuJoCo may open for ``value``, refusing the first outside the confinement.
+def _check_ref(
+    ref: _Ref, value: str, folders: list[Path], confinement: Confinement, *, directory: bool = False
+) -> list[Path]:
+    """Every place MuJoCo may open for ``value``, refusing any outside the confinement, or
+    (unless ``directory``) one that exists but is not a regular file (a FIFO would block).
 
     MuJoCo treats a backslash as a separator and ``<x>:/`` as an absolute path (a drive or
     a resource provider), so both spellings are checked and the latter is refused.
     """
+    outside = f"outside {confinement}; set {ALLOW_OUTSIDE_ENV}=1 to allow files outside it"
     places: list[Path] = []
     for form in dict.fromkeys([value, value.replace("\\", "/")]):
         if ":/" in form:
-            _refuse(ref, "is read by MuJoCo as a drive or resource path", confinement)
+            _refuse(ref, f"is read by MuJoCo as a drive or resource path, {outside}")
         if Path(form).is_absolute():
             places.append(Path(form))
         else:
@@ -246,14 +251,15 @@ def _check_ref(ref: _Ref, value: str, folders: list[Path], confinement: Confinem
     places = list(dict.fromkeys(places))
     for place in places:
         if not confinement.contains(place):
-            _refuse(ref, f"resolves to {os.path.realpath(place)}", confinement)
+            _refuse(ref, f"resolves to {os.path.realpath(place)}, {outside}")
+        if not directory and place.exists() and not place.is_file():
+            _refuse(ref, f"resolves to {os.path.realpath(place)}, which is not a regular file")
     return places
 
 
-def _refuse(ref: _Ref, problem: str, confinement: Confinement) -> None:
+def _refuse(ref: _Ref, problem: str) -> NoReturn:
     raise MjcfConfinementError(
-        f"{ref.xml}:{ref.line}: <{ref.tag} {ref.attribute}={ref.value!r}> {problem}, outside "
-        f"{confinement}; set {ALLOW_OUTSIDE_ENV}=1 to allow files outside it"
+        f"{ref.xml}:{ref.line}: <{ref.tag} {ref.attribute}={ref.value!r}> {problem}"
     )
 
 

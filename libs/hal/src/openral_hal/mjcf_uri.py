@@ -71,11 +71,10 @@ def resolve_mjcf_uri(
     path, confinement = locate_mjcf_uri(uri, manifest_dir)
     allowed = outside_allowed(allow_outside)
     if not allowed and (confinement is None or not confinement.contains(path)):
-        where = f"outside {confinement}" if confinement else "and there is no robot folder"
+        where = f"outside {confinement}" if confinement else "with no robot folder to keep it in"
         raise MjcfUriError(
             uri,
-            f"resolves to {os.path.realpath(path)}, {where}; set {ALLOW_OUTSIDE_ENV}=1 to "
-            "allow a model outside it",
+            f"resolves to {os.path.realpath(path)}, {where}; set {ALLOW_OUTSIDE_ENV}=1 to allow it",
             manifest_dir,
         )
     if not path.is_file():
@@ -140,7 +139,7 @@ def distribution_file(
 
 def _common_folder(model: PurePosixPath, records: list[PurePosixPath]) -> PurePosixPath:
     """Deepest folder holding every record that shares ``model``'s top-level folder."""
-    ups = next(i for i, part in enumerate(model.parts) if part != "..")
+    ups = next((i for i, part in enumerate(model.parts) if part != ".."), len(model.parts) - 1)
     top = model.parts[: ups + 1]
     common = model.parent.parts
     for record in records:
