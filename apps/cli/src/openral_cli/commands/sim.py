@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
+from openral_core.tables import joint_name_map
 from rich.table import Table
 
 from openral_cli.console import out, progress
@@ -45,9 +47,7 @@ def run(
     from openral_core.errors import OpenralError
     from openral_core.loader import load_scene
     from openral_core.registry import load_robot_by_id
-    from openral_core.tables import joint_name_map
     from openral_hal.factory import build_hal
-    from openral_sim.png import write_png
 
     if motion not in ("sway", "hold"):
         raise typer.BadParameter("expected 'sway' or 'hold'", param_hint="--motion")
@@ -56,37 +56,16 @@ def run(
     if robot_id is None:
         raise OpenralError(f"{config}: robot_id: the scene names no robot and none was given")
     description = load_robot_by_id(robot_id)
-    mjcf_name = joint_name_map(description)
     hal = build_hal(description, mode="sim", sim_env_yaml=config)
-    records: list[dict[str, object]] = []
-    cameras: list[str] = []
     hal.connect()
     try:
-        hold = hal.hold_action()
         if out_dir:
             out_dir.mkdir(parents=True, exist_ok=True)
         with progress() as bar:
             task = bar.add_task(f"{scene.scene.id} · {robot_id}", total=steps)
-            for step in range(steps):
-                phase = math.sin(2 * math.pi * step / max(steps, 20))
-                hal.send_action(hold + (SWAY_RAD * phase if motion == "sway" else 0.0))
-                state = hal.read_state()
-                records.append(
-                    {
-                        "step": step,
-                        "time": state.sim_time_s,
-                        "positions": {
-                            mjcf_name[name]: float(value)
-                            for name, value in zip(state.names, state.positions, strict=True)
-                        },
-                    }
-                )
-                images = hal.read_images()
-                cameras = list(images)
-                if out_dir:
-                    for camera, image in images.items():
-                        write_png(out_dir / f"{camera}_{step:04d}.png", image)
-                bar.advance(task)
+            records, cameras = _drive(
+                hal, joint_name_map(description), steps, motion, out_dir, lambda: bar.advance(task)
+            )
     finally:
         hal.disconnect()
     if out_dir:
@@ -98,3 +77,38 @@ def run(
         robot_id, scene.scene.backend.value, str(steps), ", ".join(cameras), str(out_dir or "-")
     )
     out.print(table, soft_wrap=False)  # centred title, as this command always printed it
+
+
+def _drive(
+    hal: Any,
+    mjcf_name: dict[str, str],
+    steps: int,
+    motion: str,
+    out_dir: Path | None,
+    advance: Callable[[], None],
+) -> tuple[list[dict[str, object]], list[str]]:
+    """Step a connected HAL from its hold action; the joint records and the camera names."""
+    from openral_sim.png import write_png
+
+    hold = hal.hold_action()
+    records: list[dict[str, object]] = []
+    cameras: list[str] = []
+    for step in range(steps):
+        phase = math.sin(2 * math.pi * step / max(steps, 20))
+        hal.send_action(hold + (SWAY_RAD * phase if motion == "sway" else 0.0))
+        state = hal.read_state()
+        positions = zip(state.names, state.positions, strict=True)
+        records.append(
+            {
+                "step": step,
+                "time": state.sim_time_s,
+                "positions": {mjcf_name[name]: float(value) for name, value in positions},
+            }
+        )
+        images = hal.read_images()
+        cameras = list(images)
+        if out_dir:
+            for camera, image in images.items():
+                write_png(out_dir / f"{camera}_{step:04d}.png", image)
+        advance()
+    return records, cameras
