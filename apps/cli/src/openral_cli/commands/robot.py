@@ -217,7 +217,7 @@ def check(
     """
     import mujoco
     from openral_hal.mjcf_uri import resolve_mjcf_uri
-    from openral_hal.model_check import check_robot
+    from openral_hal.model_check import check_robot, unloadable_model
 
     files = _named_manifests(targets, all_robots, "check")
     summary = Table(title="robot check")
@@ -233,7 +233,7 @@ def check(
             try:
                 model = mujoco.MjModel.from_xml_path(str(path))
             except ValueError as error:  # MuJoCo's compiler does not know the manifest
-                raise OpenralError(f"{file}: {path} does not load: {error}") from None
+                raise unloadable_model(robot, path, error) from None
         except OpenralError as error:  # each names its manifest file already
             failed_robots += 1
             err.print(line(("✗", "red"), f" {error}"))
