@@ -181,7 +181,7 @@ class SceneSpec(OpenralModel):
     """
     assets: Annotated[str, Field(pattern="^[A-Za-z0-9_:./-]{1,255}$")] = "tabletop"
     """
-    What the backend builds the scene from: for `native` a built-in layout (`tabletop`) or a `file:` MJCF relative to the scene file; for `robosuite` the environment name (`Lift`).
+    What the backend builds the scene from: for `native` a built-in layout (`tabletop`: floor, lights and a table; `floor`: floor and lights only, for models that bring their own table); for `robosuite` the environment name (`Lift`).
     """
     observation: Observation
     """
