@@ -136,6 +136,18 @@ def test_deploy_sim_names_a_missing_bracketed_scene_verbatim(
     assert_clean(run, 1, f"error: {missing}: no such scene file")
 
 
+def test_deploy_sim_runs_a_bracketed_scene_and_prints_its_name_verbatim(hostile: Path) -> None:
+    """A valid scene under a bracketed path, run as a user runs it (a subprocess: rclpy)."""
+    scene = hostile / "t[red]:smile:.yaml"
+    shutil.copy(hostile / "tabletop.yaml", scene)
+    env = {**os.environ, "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "COLUMNS": "1000"}
+    command = [str(CLI), "deploy", "sim", "--config", str(scene), "--no-viewer"]
+    domain = ["--domain-id", str(claim_domain_id()), "--duration", "1"]
+    done = subprocess.run(command + domain, env=env, capture_output=True, text=True, timeout=120)
+    assert_clean(Run(done.returncode, done.stdout + done.stderr), 0, "ur5e in t[red]:smile:.yaml")
+    assert "clean shutdown" in done.stdout
+
+
 @pytest.mark.parametrize(
     ("args", "shown"),
     [

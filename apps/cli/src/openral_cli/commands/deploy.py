@@ -22,14 +22,12 @@ from typing import Annotated, Any
 import typer
 from openral_core.errors import OpenralError
 from rich import box
-from rich.console import Console
 from rich.table import Table
 
+from openral_cli.console import out
 from openral_cli.ros_available import require_ros
 
 app = typer.Typer(help="Run robots as ROS 2 graphs.", no_args_is_help=True)
-out = Console()
-
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
@@ -90,7 +88,11 @@ def sim(
             node.destroy_node()
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
-    out.print(f"stopped ({reason}) after {time.monotonic() - started:.1f} s; clean shutdown")
+    out.print(
+        f"stopped ({reason}) after {time.monotonic() - started:.1f} s; clean shutdown",
+        soft_wrap=False,
+        highlight=True,
+    )
 
 
 def _scene_robot(config: Path) -> str:
@@ -160,11 +162,13 @@ def _print_interfaces(node: Any, config: Path) -> None:
     for topic in node.topics():
         rate = "latched" if topic.rate_hz is None else f"{topic.rate_hz:g} Hz"
         table.add_row(topic.name, topic.type, rate)
-    out.print(table)
+    out.print(table, soft_wrap=False)
     out.print(
         f"actions:  {SAFE_ACTION} (std_msgs/msg/Float64MultiArray, {len(names)} values: "
         f"{', '.join(names)})",
-        highlight=False,
+        soft_wrap=False,
     )
-    out.print(f"E-stop:   {ESTOP}, {RELEASE_ESTOP} (std_srvs/srv/Trigger)", highlight=False)
-    out.print("running; stop with Ctrl-C. In a second terminal: openral ros topics")
+    out.print(f"E-stop:   {ESTOP}, {RELEASE_ESTOP} (std_srvs/srv/Trigger)", soft_wrap=False)
+    out.print(
+        "running; stop with Ctrl-C. In a second terminal: openral ros topics", soft_wrap=False
+    )
