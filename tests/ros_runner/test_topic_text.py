@@ -73,3 +73,11 @@ def test_message_types_resolve_from_graph_names() -> None:
         message_class("std_srvs/srv/Trigger", "/t")
     with pytest.raises(MessageTypeError, match="nope_msgs/msg/Thing, which openral does not"):
         message_class("nope_msgs/msg/Thing", "/n")
+
+
+def test_a_peers_control_characters_are_shown_escaped_never_sent_to_the_terminal() -> None:
+    from openral_nodes.topic_format import format_value, printable
+
+    hostile = "ok\x1b[2J\x07"  # clear screen and bell
+    assert format_value(hostile) == repr(hostile) and "\x1b" not in format_value(hostile)
+    assert printable("sensor_msgs/msg/Image") == "sensor_msgs/msg/Image"

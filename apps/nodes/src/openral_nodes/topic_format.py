@@ -51,10 +51,16 @@ def _is_sequence(value: object) -> bool:
     return isinstance(value, list | tuple | array.array | np.ndarray | bytes)
 
 
+def printable(text: str) -> str:
+    """``text`` as is when printable, else its repr: a peer's string never reaches the
+    terminal as escape codes or control characters."""
+    return text if text.isprintable() else repr(text)
+
+
 def format_value(value: object, max_items: int = MAX_ITEMS) -> str:
     """One-line text of a scalar or a sequence of scalars."""
     if isinstance(value, str):
-        return value if value else "''"
+        return printable(value) if value else "''"
     if isinstance(value, bool):
         return str(value).lower()
     if isinstance(value, float | np.floating):

@@ -20,6 +20,8 @@ from rclpy.exceptions import InvalidTopicNameException
 from rclpy.node import Node
 from rclpy.validate_full_topic_name import validate_full_topic_name
 
+from openral_nodes.topic_format import printable
+
 HIDDEN_TOPICS = frozenset({"/rosout", "/parameter_events"})
 """Topics every node creates; listed only on request."""
 POLL_S = 0.05
@@ -80,7 +82,7 @@ def topic_name(name: str) -> str:
         validate_full_topic_name(full)
     except InvalidTopicNameException as error:
         reason = str(error).splitlines()[0].removeprefix("Invalid topic name: ").rstrip(":")
-        raise TopicNameError(f"{_shown(name)} is not a valid ROS topic name: {reason}") from None
+        raise TopicNameError(f"{printable(name)} is not a valid ROS topic name: {reason}") from None
     return full
 
 
@@ -118,7 +120,7 @@ def message_class(type_name: str, topic: str) -> type[Any]:
         MessageTypeError: not ``pkg/msg/Name``, a package outside the allow-list, or a
             name that package does not define as a message.
     """
-    shown = _shown(type_name)
+    shown = printable(type_name)
     parts = type_name.split("/")
     if len(parts) != 3 or parts[1] != "msg":
         raise MessageTypeError(
@@ -143,8 +145,3 @@ def message_class(type_name: str, topic: str) -> type[Any]:
     if not isinstance(cls, type) or not hasattr(cls, "get_fields_and_field_types"):
         raise MessageTypeError(f"topic {topic} has type {shown}, which {package} does not define")
     return cls
-
-
-def _shown(text: str) -> str:
-    """``text`` as is when printable, else its repr (no terminal escapes from a peer)."""
-    return text if text.isprintable() else repr(text)
