@@ -96,7 +96,8 @@ def main(argv: list[str] | None = None) -> int:
     minutes = (time.monotonic() - start) / 60
     console.print(report.outcome_table())
     if report.failed:
-        console.print(report.findings_table())
+        console.print("\n[bold]findings[/] (one reproducer each; the lowest case index)")
+        console.print(report.findings_text(), markup=False, highlight=False)
     summary = report.write_summary()
     kinds = ", ".join(sorted(o.value for o in FINDINGS))
     verdict = "[red]findings[/]" if report.failed else "[green]no findings[/]"

@@ -8,13 +8,17 @@ once; text mutations then run on those bytes. So no mutator ever parses hostile 
 
 from __future__ import annotations
 
+import copy
+import io
 import json
 import random
 from collections.abc import Sequence
 from functools import cache
+from typing import Any
 
-import yaml
 from openral_core.paths import repo_root
+from ruamel.yaml import YAML
+from ruamel.yaml.scalarbool import ScalarBoolean
 
 from tests.fuzz.text_mutators import TEXT_MUTATORS
 from tests.fuzz.tree_mutators import TREE_MUTATORS
@@ -70,12 +74,44 @@ def apply_mutations(seed: bytes, mutations: Sequence[Mutation], donors: Sequence
     text_ops = [m for m in mutations if m[0] not in TREE_MUTATORS]
     data = seed
     if tree_ops:
-        tree = yaml.safe_load(seed.decode("utf-8"))
+        tree = copy.deepcopy(_parsed(seed))
         for name, subseed in tree_ops:
             tree = TREE_MUTATORS[name](tree, random.Random(subseed), vocabulary())
-        style = random.Random(tree_ops[0][1]).random() < 0.2  # sometimes all flow style
-        dumped = yaml.safe_dump(tree, sort_keys=False, allow_unicode=True, default_flow_style=style)
-        data = dumped.encode("utf-8")
+        data = _dump(tree, flow=random.Random(tree_ops[0][1]).random() < 0.2)
     for name, subseed in text_ops:
         data = TEXT_MUTATORS[name](data, random.Random(subseed), donors)
     return data
+
+
+@cache
+def _parsed(seed: bytes) -> Any:
+    """The round-trip tree of a seed (parsed once; each case mutates a deep copy)."""
+    return YAML(typ="rt").load(seed.decode("utf-8"))
+
+
+def _dump(tree: Any, *, flow: bool) -> bytes:
+    """Write ``tree`` back: round-trip (the seed's comments and layout kept), or sometimes
+    as plain data in flow style (``{a: [1, 2]}``, keys sorted)."""
+    yaml = YAML(typ="rt")
+    if flow:
+        yaml = YAML(typ="safe", pure=True)
+        yaml.default_flow_style = True
+        tree = _plain(tree)
+    yaml.allow_unicode = True
+    stream = io.StringIO()
+    yaml.dump(tree, stream)
+    return stream.getvalue().encode("utf-8")
+
+
+def _plain(node: Any) -> Any:
+    """``node`` with ruamel's round-trip types turned into plain Python ones."""
+    if isinstance(node, dict):
+        return {str(key): _plain(value) for key, value in node.items()}
+    if isinstance(node, list):
+        return [_plain(item) for item in node]
+    if isinstance(node, bool | ScalarBoolean):
+        return bool(node)
+    for kind in (int, float, str):
+        if isinstance(node, kind):
+            return kind(node)
+    return node

@@ -69,11 +69,27 @@ def _line_pattern(file: Path) -> re.Pattern[str]:
     return re.compile(rf"^(?:{located}|{summary})")
 
 
-def unlocated_lines(message: str, file: Path) -> list[str]:
-    """The lines of ``message`` that do not point into ``file`` (all of them when empty)."""
-    lines = message.splitlines() or [""]
+def unlocated_lines(message: str, file: Path, *, unicode_breaks: bool = True) -> list[str]:
+    """The lines of ``message`` that do not point into ``file`` (all of them when empty).
+
+    Lines end at every line break Python knows (``str.splitlines``: also U+2028, U+0085,
+    form feed, ...), as any reader that honours Unicode would split them; with
+    ``unicode_breaks=False`` only at ``\n``.
+    """
+    lines = (message.splitlines() if unicode_breaks else message.split("\n")) or [""]
     pattern = _line_pattern(file)
     return [line for line in lines if not pattern.match(line)]
+
+
+def _unlocated_signature(kind: str, where: str, message: str, file: Path) -> str | None:
+    """The signature of an unlocated ``message``, or None when every line is located."""
+    bad = unlocated_lines(message, file)
+    if not bad:
+        return None
+    if not unlocated_lines(message, file, unicode_breaks=False):
+        breaks = sorted({f"U+{ord(c):04X}" for c in message if c != "\n" and c.splitlines() != [c]})
+        return f"{kind} @ {where}: a located line holds a line break ({', '.join(breaks)})"
+    return f"{kind} @ {where}: {normalise(bad[0], file)}"
 
 
 def normalise(text: str, file: Path) -> str:
@@ -105,10 +121,9 @@ def classify(error: BaseException, stage: str, file: Path) -> Result:
     kind = type(error).__name__
     if isinstance(error, OpenralError):
         message = str(error)
-        bad = unlocated_lines(message, file)
-        if not bad:
+        signature = _unlocated_signature(kind, where, message, file)
+        if signature is None:
             return Result(Outcome.REFUSED, stage, kind, message)
-        signature = f"{kind} @ {where}: {normalise(bad[0], file)}"
         return Result(Outcome.UNLOCATED, stage, signature, message)
     detail = "".join(traceback.format_exception(error))
     return Result(Outcome.TRACEBACK, stage, f"{kind} @ {where}", detail)
@@ -117,10 +132,10 @@ def classify(error: BaseException, stage: str, file: Path) -> Result:
 def classify_lines(lines: list[str], stage: str, file: Path) -> Result:
     """The :class:`Result` of an error seen only as printed lines (the ``robot check`` CLI)."""
     message = "\n".join(lines)
-    bad = unlocated_lines(message, file)
-    if not bad:
+    signature = _unlocated_signature("printed", "robot check", message, file)
+    if signature is None:
         return Result(Outcome.REFUSED, stage, "printed", message)
-    return Result(Outcome.UNLOCATED, stage, f"printed: {normalise(bad[0], file)}", message)
+    return Result(Outcome.UNLOCATED, stage, signature, message)
 
 
 _DUMP_FRAME = re.compile(r'^\s*File "([^"]+)", line (\d+) in (\S+)')

@@ -100,8 +100,8 @@ class _Worker:
     def send(self, ticket: Any, case: Case) -> None:
         """Start ``case``; ``ticket`` comes back with its result."""
         assert self.process.stdin is not None
-        request = {"file": str(case.file), "kind": case.kind, "robot": case.robot}
-        request["load_only"] = case.load_only
+        request: dict[str, Any] = {"file": str(case.file), "kind": case.kind}
+        request.update(robot=case.robot, load_only=case.load_only)
         self.process.stdin.write((json.dumps(request) + "\n").encode())
         self.process.stdin.flush()
         self.ticket, self.stage, self.sent_at = ticket, "load", time.monotonic()

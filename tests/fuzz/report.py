@@ -103,21 +103,20 @@ class Report:
         table.add_row("all", *map(str, totals), str(sum(totals)), style="bold")
         return table
 
-    def findings_table(self) -> Table:
-        """Every distinct finding with its count and reproducer."""
-        table = Table(title="findings (reproduce: python -m tests.fuzz.replay <reproducer>)")
-        for column in ("outcome", "stage", "signature", "count", "reproducer"):
-            table.add_column(column, overflow="fold")
+    def findings_text(self) -> str:
+        """Every distinct finding: outcome, stage, count, signature, reproducer, replay."""
+        blocks: list[str] = []
         ordered = sorted(self.findings.values(), key=lambda f: (f.outcome, f.stage, -f.count))
         for finding in ordered:
-            table.add_row(
-                finding.outcome.value,
-                finding.stage,
-                finding.signature,
-                str(finding.count),
-                str(finding.reproducer),
+            where = _shown(finding.reproducer)
+            folder = _shown(_case_folder(finding.reproducer))
+            blocks.append(
+                f"{finding.outcome.value} in {finding.stage}, {finding.count}x: "
+                f"{finding.signature}\n"
+                f"  reproducer: {where}\n"
+                f"  replay:     python -m tests.fuzz.replay {folder}"
             )
-        return table
+        return "\n".join(blocks)
 
     def write_summary(self) -> Path:
         """Write ``summary.json`` (counts and findings) under ``out``; return its path."""
@@ -141,3 +140,20 @@ class Report:
         path = self.out / "summary.json"
         path.write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
         return path
+
+
+def _case_folder(reproducer: Path | None) -> Path | None:
+    """The reproducer's folder (the one holding ``case.json``)."""
+    if reproducer is None:
+        return None
+    return next((p for p in reproducer.parents if (p / "case.json").is_file()), reproducer)
+
+
+def _shown(path: Path | None) -> str:
+    """``path`` relative to the working folder when it is inside it."""
+    if path is None:
+        return "-"
+    try:
+        return str(path.relative_to(Path.cwd()))
+    except ValueError:
+        return str(path)

@@ -14,9 +14,9 @@ from functools import cache
 from pathlib import Path
 from typing import Literal
 
-import yaml
 from openral_core.paths import repo_root
 from openral_core.registry import MANIFEST_NAME
+from ruamel.yaml import YAML
 
 Kind = Literal["manifest", "scene"]
 
@@ -81,7 +81,7 @@ def donors() -> tuple[bytes, ...]:
 
 
 def _is_robosuite(scene: Path) -> bool:
-    data = yaml.safe_load(scene.read_text(encoding="utf-8"))
+    data = YAML(typ="safe", pure=True).load(scene.read_text(encoding="utf-8"))
     return bool(data["scene"]["backend"] == "robosuite")
 
 

@@ -213,6 +213,32 @@ def scale_number(tree: Any, rng: random.Random, vocabulary: Sequence[str]) -> An
     return _set(tree, path, int(scaled) if isinstance(value, int) else float(scaled))
 
 
+def perturb_number(tree: Any, rng: random.Random, vocabulary: Sequence[str]) -> Any:
+    """Nudge one number to a plausible wrong value (x0.5, x1.1, x2, +1, -1, ...).
+
+    Unlike :func:`boundary_number` the result usually passes the schema, so the case reaches
+    robot check, the model and the scene.
+    """
+    path = _pick(tree, rng, _is_number)
+    if path is None:
+        return tree
+    value = _get(tree, path)
+    if isinstance(value, int):
+        return _set(tree, path, value + rng.choice((-2, -1, 1, 2, 7)))
+    return _set(tree, path, float(value) * rng.choice((0.0, 0.5, 0.9, 1.1, 2.0, 10.0, -1.0)))
+
+
+def swap_strings(tree: Any, rng: random.Random, vocabulary: Sequence[str]) -> Any:
+    """Exchange two strings of the document (two joint, camera or body names, ...)."""
+    paths = [p for p in _paths(tree) if isinstance(_get(tree, p), str)]
+    if len(paths) < 2:
+        return tree
+    a, b = rng.sample(paths, 2)
+    first, second = _get(tree, a), _get(tree, b)
+    _set(tree, a, second)
+    return _set(tree, b, first)
+
+
 def duplicate_item(tree: Any, rng: random.Random, vocabulary: Sequence[str]) -> Any:
     """Repeat one list item (two joints, cameras or objects with the same name)."""
     lists = [p for p in _containers(tree, list) if _get(tree, p)]
@@ -282,6 +308,8 @@ TREE_MUTATORS: dict[str, TreeMutator] = {
     "swap_type": swap_type,
     "boundary_number": boundary_number,
     "scale_number": scale_number,
+    "perturb_number": perturb_number,
+    "swap_strings": swap_strings,
     "duplicate_item": duplicate_item,
     "drop_item": drop_item,
     "change_reference": change_reference,
