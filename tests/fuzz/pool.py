@@ -180,6 +180,9 @@ def run_pool(
                     if job is None:
                         exhausted = True
                     else:
+                        if worker.process.poll() is not None:  # died while idle
+                            worker.stop()
+                            worker.start()
                         worker.send(*job)
             busy = [w for w in workers if w.ticket is not None]
             if not busy:
