@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 from openral_core import ManifestError, load_robot
 
-from tests.conftest import ManifestWriter
+from tests.conftest import REPO, ManifestWriter
 
 
 def _findings(path: object) -> dict[str, str]:
@@ -131,3 +133,23 @@ def test_torque_pd_needs_gains_and_position_forbids_them(write_manifest: Manifes
     assert _findings(position) == {
         "sim.control.kp": "unknown field 'kp'; expected one of: mode (because mode is 'position')"
     }
+
+
+def test_scene_object_sizes_must_fit_their_shape(tmp_path: Path) -> None:
+    from openral_core.loader import load_scene
+
+    scene = REPO / "robots" / "franka_panda" / "scenes" / "tabletop.yaml"
+    bad = tmp_path / "scene.yaml"
+    bad.write_text(scene.read_text().replace("size_m: [0.02, 0.02, 0.02]", "size_m: [0.02]", 1))
+    with pytest.raises(ManifestError) as error:
+        load_scene(bad)
+    (issue,) = error.value.issues
+    assert issue.field == "scene.options.objects[1].size_m"
+    assert issue.message == "a box takes 3 size value(s), got 1"
+
+
+def test_an_issue_is_always_one_printable_line() -> None:
+    from openral_core.errors import Issue
+
+    issue = Issue(Path("f.yaml"), 3, 4, "a\u2028b", "does not compile: Error: x\nElement 'y'")
+    assert issue.format() == "f.yaml:3:4: a\\u2028b: does not compile: Error: x; Element 'y'"

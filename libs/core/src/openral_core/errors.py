@@ -56,9 +56,23 @@ class Issue:
     message: str
 
     def format(self) -> str:
-        """Render as ``file:line:col: field.path: message``."""
-        where = f"{self.file}:{self.line}:{self.column}"
-        return f"{where}: {self.field or '<document>'}: {self.message}"
+        """Render as ``file:line:col: field.path: message``, always one printable line."""
+        where = escaped(f"{self.file}:{self.line}:{self.column}: {self.field or '<document>'}")
+        return f"{where}: {one_line(self.message)}"
+
+
+def one_line(text: str) -> str:
+    """A message of several lines (MuJoCo's compiler writes two) joined with ``; ``, then
+    :func:`escaped`, so a terminal shows exactly one line."""
+    return escaped("; ".join(part.strip() for part in text.splitlines() if part.strip()))
+
+
+def escaped(text: str) -> str:
+    """``text`` with every unprintable character (a U+2028 in a key, an escape code)
+    written as its Python escape."""
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 class ManifestError(OpenralError):

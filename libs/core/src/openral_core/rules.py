@@ -14,6 +14,7 @@ from openral_core.models import (
     LimitedJoint,
     RgbSensor,
     RobotDescription,
+    SceneObject,
     TorquePdControl,
 )
 from openral_core.tables import vla_slot
@@ -61,7 +62,22 @@ def scene_findings(scene: DeployScene) -> list[Finding]:
     options = scene.scene.options
     objects = options.objects if options is not None and options.objects else []
     located = [(("scene", "options", "objects", i, "name"), o.name) for i, o in enumerate(objects)]
-    return list(_unique(located, "object name"))
+    return [*_unique(located, "object name"), *_object_sizes(objects)]
+
+
+SIZE_VALUES = {"box": 3, "sphere": 1, "cylinder": 2}
+"""How many ``size_m`` values each object shape takes (half-extents; radius; radius and
+half-height)."""
+
+
+def _object_sizes(objects: Sequence[SceneObject]) -> Iterator[Finding]:
+    for index, obj in enumerate(objects):
+        wanted = SIZE_VALUES[obj.shape.value]
+        if len(obj.size_m) != wanted:
+            yield (
+                ("scene", "options", "objects", index, "size_m"),
+                f"a {obj.shape.value} takes {wanted} size value(s), got {len(obj.size_m)}",
+            )
 
 
 def _name_matches_folder(robot: RobotDescription, folder_name: str | None) -> Iterator[Finding]:

@@ -28,6 +28,9 @@ import re
 from pathlib import Path, PurePosixPath
 
 from openral_core.errors import OpenralError
+from openral_core.located import error_at, source_file
+from openral_core.models import RobotDescription
+from openral_core.registry import manifest_path
 
 from openral_hal.mjcf_confinement import (
     ALLOW_OUTSIDE_ENV,
@@ -49,6 +52,7 @@ class MjcfUriError(OpenralError):
 
     def __init__(self, uri: str, problem: str, manifest_dir: Path | None = None) -> None:
         self.uri = uri
+        self.problem = problem
         where = f"{manifest_dir / 'robot.yaml'}: " if manifest_dir is not None else ""
         super().__init__(f"{where}sim.mjcf_uri {uri!r}: {problem}")
 
@@ -85,6 +89,28 @@ def resolve_mjcf_uri(
         except MjcfConfinementError as error:
             raise MjcfUriError(uri, str(error), manifest_dir) from None
     return path
+
+
+def robot_model_file(robot: RobotDescription, manifest_dir: Path | None = None) -> Path:
+    """The checked MJCF file of ``robot``'s ``sim.mjcf_uri``.
+
+    Args:
+        robot: A manifest with a ``sim`` block.
+        manifest_dir: Its folder; defaults to the folder of the file it was loaded from,
+            else ``robots/<name>/``.
+
+    Raises:
+        ManifestError: At ``sim.mjcf_uri`` of the manifest, saying why the URI does not
+            give a usable file (see :func:`resolve_mjcf_uri`).
+    """
+    if robot.sim is None:
+        raise error_at(robot, ("sim",), "the robot has no sim block; it has no model")
+    source = source_file(robot)
+    folder = manifest_dir or (source.parent if source else manifest_path(robot.name).parent)
+    try:
+        return resolve_mjcf_uri(robot.sim.mjcf_uri, folder)
+    except MjcfUriError as error:
+        raise error_at(robot, ("sim", "mjcf_uri"), f"{error.uri!r}: {error.problem}") from None
 
 
 def locate_mjcf_uri(uri: str, manifest_dir: Path | None = None) -> tuple[Path, Confinement | None]:

@@ -17,7 +17,6 @@ from typing import Any
 import mujoco
 import numpy as np
 from openral_core.models import RobotDescription
-from openral_core.registry import manifest_path
 from openral_core.tables import GripperWiring, HalWiring, hal_wiring
 
 from openral_hal.action import validated_action
@@ -25,7 +24,7 @@ from openral_hal.control_law import pd_torque, seed_position_servos
 from openral_hal.errors import EStopLatched, HalError, NotConnected, SimulationDiverged
 from openral_hal.gripper import gripper_ctrl, read_gripper
 from openral_hal.mjcf_model import ctrl_limits
-from openral_hal.mjcf_uri import resolve_mjcf_uri
+from openral_hal.mjcf_uri import robot_model_file
 from openral_hal.model_check import load_checked_model
 from openral_hal.state import FloatArray, JointStateSample
 
@@ -143,7 +142,6 @@ class MujocoArmHAL:
         settle_steps: int | None = None,
         gravity_enabled: bool = True,
         staleness_limit_s: float = 0.5,
-        mjcf_path_override: str | Path | None = None,
         manifest_dir: Path | None = None,
     ) -> MujocoArmHAL:
         """A HAL wired from ``description.sim``.
@@ -153,18 +151,13 @@ class MujocoArmHAL:
             settle_steps: Overrides ``sim.settle_steps_default``.
             gravity_enabled: See :meth:`__init__`.
             staleness_limit_s: See :meth:`__init__`.
-            mjcf_path_override: Use this MJCF file instead of resolving ``sim.mjcf_uri``.
-            manifest_dir: Folder of the manifest (for ``file:`` URIs); defaults to
-                ``robots/<name>/``.
+            manifest_dir: Folder of the manifest (for ``file:`` URIs); defaults to the
+                folder of the file it was loaded from, else ``robots/<name>/``.
         """
         wiring = hal_wiring(description)
         if wiring is None:
             raise HalError(f"robot {description.name!r} has no sim block; cannot simulate it")
-        if mjcf_path_override is not None:
-            path = Path(mjcf_path_override)
-        else:
-            folder = manifest_dir or manifest_path(description.name).parent
-            path = resolve_mjcf_uri(wiring.mjcf_uri, folder)
+        path = robot_model_file(description, manifest_dir)
         kwargs = hal_kwargs(wiring)
         if settle_steps is not None:
             kwargs["settle_steps"] = settle_steps

@@ -23,11 +23,10 @@ import numpy.typing as npt
 from openral_core.errors import OpenralError
 from openral_core.located import error_at
 from openral_core.models import DeployScene, DepthSensor, RgbSensor, RobotDescription
-from openral_core.registry import manifest_path
 from openral_core.tables import hal_wiring, joint_name_map
 from openral_hal.control_law import pd_torque, seed_position_servos
 from openral_hal.mjcf_model import ctrl_limits
-from openral_hal.mjcf_uri import resolve_mjcf_uri
+from openral_hal.mjcf_uri import robot_model_file
 from openral_hal.model_check import manifest_mismatch, unloadable_model
 
 from openral_sim.rollout import Observation, StepResult
@@ -215,8 +214,7 @@ def _compose(
     scene: DeployScene, robot: RobotDescription, cameras: dict[str, str]
 ) -> mujoco.MjModel:
     assert robot.sim is not None
-    folder = manifest_path(robot.name).parent
-    path = resolve_mjcf_uri(robot.sim.mjcf_uri, folder)
+    path = robot_model_file(robot)  # next to the manifest it was loaded from
     try:
         child = mujoco.MjSpec.from_file(str(path))
         child_model = child.copy().compile()  # before attach: no compile after it

@@ -216,7 +216,7 @@ def check(
     Exits 1 on any mismatch, 2 when nothing was named.
     """
     import mujoco
-    from openral_hal.mjcf_uri import resolve_mjcf_uri
+    from openral_hal.mjcf_uri import robot_model_file
     from openral_hal.model_check import check_robot, unloadable_model
 
     files = _named_manifests(targets, all_robots, "check")
@@ -227,9 +227,7 @@ def check(
     for file in files:
         try:
             robot = load_robot(file, check_folder_name=file.name == MANIFEST_NAME)
-            if robot.sim is None:
-                raise OpenralError(f"{file}: no sim block; nothing to check")
-            path = resolve_mjcf_uri(robot.sim.mjcf_uri, file.parent)
+            path = robot_model_file(robot, file.parent)  # located error without a sim block
             try:
                 model = mujoco.MjModel.from_xml_path(str(path))
             except ValueError as error:  # MuJoCo's compiler does not know the manifest
