@@ -101,9 +101,10 @@ def main(argv: list[str] | None = None) -> int:
     summary = report.write_summary()
     kinds = ", ".join(sorted(o.value for o in FINDINGS))
     verdict = "[red]findings[/]" if report.failed else "[green]no findings[/]"
+    seconds, index = report.slowest
     console.print(
-        f"{args.cases} cases, seed {args.seed}, {args.workers} workers, {minutes:.1f} min: "
-        f"{verdict} ({kinds}); summary in {summary}"
+        f"{args.cases} cases, seed {args.seed}, {args.workers} workers, {minutes:.1f} min, "
+        f"slowest case {seconds:.1f} s (#{index}): {verdict} ({kinds}); summary in {summary}"
     )
     return 1 if report.failed else 0
 

@@ -48,6 +48,8 @@ class Report:
     campaign_seed: int
     counts: Counter[tuple[Outcome, str]] = field(default_factory=Counter)
     findings: dict[tuple[Outcome, str, str], Finding] = field(default_factory=dict)
+    slowest: tuple[float, int] = (0.0, -1)
+    """Seconds and index of the slowest case that finished (a killed one is a hang)."""
 
     def clear(self) -> None:
         """Remove the reproducers an earlier campaign saved under ``out``."""
@@ -57,6 +59,7 @@ class Report:
     def add(self, index: int, spec: CaseSpec, folder: Path, result: Result) -> None:
         """Count case ``index``; save it as a reproducer when it is a finding's first."""
         self.counts[(result.outcome, result.stage)] += 1
+        self.slowest = max(self.slowest, (result.seconds, index))
         if result.outcome not in FINDINGS:
             return
         key = (result.outcome, result.stage, result.signature)
@@ -122,6 +125,7 @@ class Report:
         """Write ``summary.json`` (counts and findings) under ``out``; return its path."""
         summary = {
             "campaign_seed": self.campaign_seed,
+            "slowest_case": {"seconds": self.slowest[0], "index": self.slowest[1]},
             "counts": [
                 {"outcome": o.value, "stage": s, "count": n} for (o, s), n in self.counts.items()
             ],
