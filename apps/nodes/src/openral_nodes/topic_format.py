@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from openral_core.errors import escaped
 
 MAX_ITEMS = 16
 """Sequences longer than this are summarised (numbers) or truncated (strings, messages)."""
@@ -51,16 +52,10 @@ def _is_sequence(value: object) -> bool:
     return isinstance(value, list | tuple | array.array | np.ndarray | bytes)
 
 
-def printable(text: str) -> str:
-    """``text`` as is when printable, else its repr: a peer's string never reaches the
-    terminal as escape codes or control characters."""
-    return text if text.isprintable() else repr(text)
-
-
 def format_value(value: object, max_items: int = MAX_ITEMS) -> str:
     """One-line text of a scalar or a sequence of scalars."""
     if isinstance(value, str):
-        return printable(value) if value else "''"
+        return escaped(value) if value else "''"  # a peer's escape codes never reach a tty
     if isinstance(value, bool):
         return str(value).lower()
     if isinstance(value, float | np.floating):

@@ -15,12 +15,10 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
-from openral_core.errors import OpenralError
+from openral_core.errors import OpenralError, escaped
 from rclpy.exceptions import InvalidTopicNameException
 from rclpy.node import Node
 from rclpy.validate_full_topic_name import validate_full_topic_name
-
-from openral_nodes.topic_format import printable
 
 HIDDEN_TOPICS = frozenset({"/rosout", "/parameter_events"})
 """Topics every node creates; listed only on request."""
@@ -82,7 +80,7 @@ def topic_name(name: str) -> str:
         validate_full_topic_name(full)
     except InvalidTopicNameException as error:
         reason = str(error).splitlines()[0].removeprefix("Invalid topic name: ").rstrip(":")
-        raise TopicNameError(f"{printable(name)} is not a valid ROS topic name: {reason}") from None
+        raise TopicNameError(f"{escaped(name)} is not a valid ROS topic name: {reason}") from None
     return full
 
 
@@ -120,7 +118,7 @@ def message_class(type_name: str, topic: str) -> type[Any]:
         MessageTypeError: not ``pkg/msg/Name``, a package outside the allow-list, or a
             name that package does not define as a message.
     """
-    shown = printable(type_name)
+    shown = escaped(type_name)
     parts = type_name.split("/")
     if len(parts) != 3 or parts[1] != "msg":
         raise MessageTypeError(

@@ -13,14 +13,11 @@ Example::
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TypeVar
 
 from openral_base import OpenralModel
 
 from openral_core.errors import Issue, ManifestError, PathKey, format_field
 from openral_core.yaml_source import LocatedDocument
-
-ErrorT = TypeVar("ErrorT", bound=ManifestError)
 
 
 def remember_source(model: OpenralModel, document: LocatedDocument) -> None:
@@ -52,12 +49,7 @@ def issue_at(model: OpenralModel, path: PathKey, message: str) -> Issue:
     return document.issue(path, message)
 
 
-def error_at(
-    model: OpenralModel,
-    path: PathKey,
-    message: str,
-    kind: type[ErrorT] = ManifestError,  # type: ignore[assignment]
-) -> ErrorT:
-    """A ``kind`` error (a :class:`ManifestError`) with one issue at ``path`` of ``model``."""
+def error_at(model: OpenralModel, path: PathKey, message: str) -> ManifestError:
+    """A :class:`ManifestError` with one issue at ``path`` of the file ``model`` came from."""
     issue = issue_at(model, path, message)
-    return kind(issue.file, [issue])
+    return ManifestError(issue.file, [issue])

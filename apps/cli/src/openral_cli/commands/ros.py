@@ -91,7 +91,7 @@ def topics(
 ) -> None:
     """Table of the topics in the graph: name, type(s), publishers and (--rate) rate."""
     require_ros()
-    from openral_nodes.topic_format import printable
+    from openral_core.errors import escaped
     from openral_nodes.topic_graph import graph_topics
     from openral_nodes.topic_probe import measure_rates
 
@@ -110,7 +110,7 @@ def topics(
     if rate:
         table.add_column("Hz", justify="right", no_wrap=True)
     for info in infos:
-        row = [info.name, ", ".join(map(printable, info.types)), str(info.publishers)]
+        row = [info.name, ", ".join(map(escaped, info.types)), str(info.publishers)]
         if rate:
             hz = rates.get(info.name)
             row.append("-" if hz is None else f"{hz:.1f}")
@@ -163,9 +163,8 @@ def snapshot(
 ) -> None:
     """Save one frame of an Image topic (rgb8, bgr8 or mono8) as PNG."""
     require_ros()
-    from openral_core.errors import OpenralError
+    from openral_core.errors import OpenralError, escaped
     from openral_nodes.topic_codec import image_to_rgb
-    from openral_nodes.topic_format import printable
     from openral_nodes.topic_graph import wait_for_topic
     from openral_nodes.topic_probe import subscribe
     from openral_sim.png import write_png
@@ -174,7 +173,7 @@ def snapshot(
         info = wait_for_topic(node, topic, timeout)
         if "sensor_msgs/msg/Image" not in info.types:
             raise OpenralError(
-                f"{info.name} carries {', '.join(map(printable, info.types))}, "
+                f"{info.name} carries {', '.join(map(escaped, info.types))}, "
                 "not sensor_msgs/msg/Image"
             )
         with subscribe(node, info) as inbox:
