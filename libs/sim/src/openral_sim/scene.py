@@ -21,8 +21,9 @@ def build_sim_env_from_yaml(path: str | Path, robot_id_fallback: str | None = No
         robot_id_fallback: Robot to use when the file names none.
 
     Raises:
-        ManifestError: The file is invalid (every problem as ``file:line:col: field: msg``).
-        OpenralError: No robot named, or the scene cannot be built for the robot.
+        ManifestError: The file is invalid, names no or an unknown robot, or cannot be built
+            for its robot; every problem as ``file:line:col: field: message`` of the scene
+            file or the robot's manifest.
     """
     file = Path(path)
     scene = load_scene(file)
