@@ -8,11 +8,9 @@ has to read it before it describes a real robot.
 
 How the model becomes a manifest:
 
-- One joint per actuator, in actuator order. A joint transmission drives its joint; a
-  fixed-tendon transmission drives the tendon's first joint (the others are coupled
-  fingers). Actuators of other transmissions, and repeats, are skipped.
-- Canonical names are the MJCF names with every character outside ``[A-Za-z0-9_]``
-  replaced by ``_``; ``sim_joint_name`` keeps the MJCF name where they differ.
+- Which joints are listed, and under which canonical names, is
+  :mod:`openral_hal.scaffold_joints`; ``sim_joint_name`` keeps the MJCF name where it
+  differs from the canonical one.
 - qpos/qvel/actuator overrides are written only where the model differs from the
   default wiring (1:1 in manifest order, +7/+6 with a floating base).
 """
@@ -24,31 +22,33 @@ import math
 import re
 import textwrap
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
 
 from openral_hal.errors import HalError
 from openral_hal.mjcf_model import (
-    fixed_tendon_joints,
     is_motor,
     is_position_servo,
-    is_scalar_joint,
     root_is_free,
 )
 from openral_hal.mjcf_uri import resolve_mjcf_uri
+from openral_hal.scaffold_joints import (
+    MJCF_NAME,
+    Driven,
+    driven_joints,
+    joint_name,
+    sensor_name,
+)
 
 SCHEMA_LINE = "# yaml-language-server: $schema=../../schema/robot.schema.json"
 """First line of every manifest under ``robots/<name>/``."""
 
 ROBOT_NAME = re.compile(r"[a-z][a-z0-9_]{1,62}")
-MJCF_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_/.-]{0,126}")
 GRIPPER_WORDS = ("finger", "gripper", "jaw", "hand")
 
 FREE_JOINT_NQPOS = 7
 FREE_JOINT_NDOF = 6
-MAX_NAME = 63
 MAX_QPOS_ADDRS = 8
 LIMIT_BOUND = 1000.0
 EFFORT_BOUND = 100000.0
@@ -66,26 +66,6 @@ CAMERA_RATE_HZ = 10.0
 _REVIEW = "  # REVIEW:"
 _RESERVED = {"true", "false", "null", "yes", "no", "on", "off", "y", "n", "~"}
 _PLAIN = re.compile(r"[A-Za-z][A-Za-z0-9_./:-]*(?: [A-Za-z0-9_./-]+)*")
-_TRANSMISSION_NAMES = {
-    int(mujoco.mjtTrn.mjTRN_JOINT): "joint",
-    int(mujoco.mjtTrn.mjTRN_JOINTINPARENT): "joint in parent",
-    int(mujoco.mjtTrn.mjTRN_SLIDERCRANK): "slider-crank",
-    int(mujoco.mjtTrn.mjTRN_TENDON): "tendon",
-    int(mujoco.mjtTrn.mjTRN_SITE): "site",
-    int(mujoco.mjtTrn.mjTRN_BODY): "body",
-}
-
-
-@dataclass(frozen=True)
-class _Driven:
-    """A joint the manifest lists, and what drives it."""
-
-    jid: int
-    mjcf_name: str
-    name: str
-    actuator: int
-    coupled: tuple[int, ...]
-    """Joints of the fixed tendon the actuator drives (this joint first), or () for a joint."""
 
 
 def scaffold_manifest(
@@ -117,7 +97,7 @@ def scaffold_manifest(
         model = mujoco.MjModel.from_xml_path(str(path))
     except ValueError as error:
         raise HalError(f"{mjcf_uri}: MuJoCo cannot load {path}: {error}") from None
-    driven, skipped, actuated = _driven_joints(model)
+    driven, skipped, actuated = driven_joints(model)
     if not driven:
         why = f" ({'; '.join(skipped)})" if skipped else ""
         raise HalError(
@@ -128,85 +108,6 @@ def scaffold_manifest(
     return "\n".join(_manifest_lines(model, mjcf_uri, name, driven, skipped, actuated)) + "\n"
 
 
-# --------------------------------------------------------------------------- model reading
-
-
-def _driven_joints(model: mujoco.MjModel) -> tuple[list[_Driven], list[str], set[int]]:
-    """Listed joints in actuator order, notes on skipped actuators, and every joint id an
-    actuator drives (listed or not)."""
-    driven: list[_Driven] = []
-    skipped: list[str] = []
-    seen: set[int] = set()
-    names: set[str] = set()
-    for actuator in range(model.nu):
-        label = _actuator_label(model, actuator)
-        kind = int(model.actuator_trntype[actuator])
-        target = int(model.actuator_trnid[actuator, 0])
-        coupled: tuple[int, ...] = ()
-        if kind in (int(mujoco.mjtTrn.mjTRN_JOINT), int(mujoco.mjtTrn.mjTRN_JOINTINPARENT)):
-            jid = target
-        elif kind == int(mujoco.mjtTrn.mjTRN_TENDON):
-            coupled = fixed_tendon_joints(model, target)
-            if not coupled:
-                skipped.append(f"{label} (spatial tendon)")
-                continue
-            jid = coupled[0]
-        else:
-            skipped.append(f"{label} ({_TRANSMISSION_NAMES.get(kind, 'other')} transmission)")
-            continue
-        if jid in seen:
-            continue
-        seen.add(jid)
-        mjcf_name = _joint_name(model, jid)
-        if not is_scalar_joint(model, jid):
-            skipped.append(f"{label} (drives the ball or free joint {mjcf_name or jid})")
-            continue
-        if not MJCF_NAME.fullmatch(mjcf_name):
-            skipped.append(
-                f"{label} (drives joint {mjcf_name or jid!r}, whose name a manifest cannot "
-                "reference as sim_joint_name)"
-            )
-            continue
-        canonical = _unique(_canonical_joint_name(mjcf_name), names)
-        names.add(canonical)
-        driven.append(_Driven(jid, mjcf_name, canonical, actuator, coupled))
-    return driven, skipped, seen
-
-
-def _canonical_joint_name(mjcf_name: str) -> str:
-    name = re.sub(r"[^A-Za-z0-9_]", "_", mjcf_name)
-    if not name[:1].isalpha() or not name[:1].isascii():
-        name = f"j_{name}"
-    return name[:MAX_NAME]
-
-
-def _sensor_name(camera: str) -> str:
-    name = re.sub(r"[^a-z0-9_]", "_", camera.lower())
-    if not name[:1].isalpha() or not name[:1].isascii():
-        name = f"cam_{name}"
-    return name[:MAX_NAME]
-
-
-def _unique(name: str, taken: set[str]) -> str:
-    if name not in taken:
-        return name
-    for n in range(2, 10_000):
-        suffix = f"_{n}"
-        candidate = name[: MAX_NAME - len(suffix)] + suffix
-        if candidate not in taken:
-            return candidate
-    raise HalError(f"cannot make joint name {name!r} unique")  # pragma: no cover
-
-
-def _joint_name(model: mujoco.MjModel, jid: int) -> str:
-    return mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, jid) or ""
-
-
-def _actuator_label(model: mujoco.MjModel, actuator: int) -> str:
-    name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_ACTUATOR, actuator)
-    return f"actuator {actuator} ({name})" if name else f"actuator {actuator}"
-
-
 # --------------------------------------------------------------------------- writing
 
 
@@ -214,7 +115,7 @@ def _manifest_lines(
     model: mujoco.MjModel,
     mjcf_uri: str,
     name: str,
-    driven: Sequence[_Driven],
+    driven: Sequence[Driven],
     skipped: Sequence[str],
     actuated: set[int],
 ) -> list[str]:
@@ -226,10 +127,10 @@ def _manifest_lines(
         "# Lines marked `# REVIEW:` are guesses or placeholders and need a human.",
     ]
     if floating:
-        root = _joint_name(model, 0) or "(unnamed)"
+        root = joint_name(model, 0) or "(unnamed)"
         lines.append(f"# The root free joint {root} is the floating base (sim.floating_base).")
     unlisted = [
-        _joint_name(model, j) or f"(unnamed joint {j})"
+        joint_name(model, j) or f"(unnamed joint {j})"
         for j in range(model.njnt)
         if j not in actuated and not (floating and j == 0)
     ]
@@ -260,7 +161,7 @@ def _comment_block(title: str, items: Sequence[str]) -> list[str]:
     return [f"# {line}" for line in textwrap.wrap(text, width=96, break_on_hyphens=False)]
 
 
-def _joint_lines(model: mujoco.MjModel, joint: _Driven) -> list[str]:
+def _joint_lines(model: mujoco.MjModel, joint: Driven) -> list[str]:
     lines = [f"  - name: {_scalar(joint.name)}"]
     if joint.name != joint.mjcf_name:
         lines.append(f"    sim_joint_name: {_scalar(joint.mjcf_name)}")
@@ -318,7 +219,7 @@ def _limits_line(limits: tuple[float, float], low: float, high: float) -> str:
     return line
 
 
-def _effort(model: mujoco.MjModel, joint: _Driven) -> tuple[float | None, str]:
+def _effort(model: mujoco.MjModel, joint: Driven) -> tuple[float | None, str]:
     """Effort limit and where it came from; (None, why) when the MJCF gives none."""
     jid, actuator = joint.jid, joint.actuator
     candidates: list[tuple[float, str]] = []
@@ -345,7 +246,7 @@ def _sensor_lines(model: mujoco.MjModel) -> list[str]:
         camera = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_CAMERA, cam) or ""
         if not MJCF_NAME.fullmatch(camera):
             continue
-        sensor = _sensor_name(camera)
+        sensor = sensor_name(camera)
         if sensor in taken:
             continue
         taken.add(sensor)
@@ -362,7 +263,7 @@ def _sensor_lines(model: mujoco.MjModel) -> list[str]:
 
 
 def _sim_lines(
-    model: mujoco.MjModel, mjcf_uri: str, driven: Sequence[_Driven], floating: bool
+    model: mujoco.MjModel, mjcf_uri: str, driven: Sequence[Driven], floating: bool
 ) -> list[str]:
     lines = ["sim:", f"  mjcf_uri: {_scalar(mjcf_uri)}"]
     if floating:
@@ -402,7 +303,7 @@ def _sim_lines(
     return lines
 
 
-def _gripper_lines(model: mujoco.MjModel, joint: _Driven) -> list[str]:
+def _gripper_lines(model: mujoco.MjModel, joint: Driven) -> list[str]:
     if not (joint.coupled or any(w in joint.mjcf_name.lower() for w in GRIPPER_WORDS)):
         return []
     actuator = joint.actuator
