@@ -22,7 +22,7 @@ import numpy as np
 import numpy.typing as npt
 from openral_core.errors import OpenralError
 from openral_core.located import error_at
-from openral_core.models import DeployScene, DepthSensor, RgbSensor, RobotDescription
+from openral_core.models import DeployScene, RobotDescription
 from openral_core.tables import hal_wiring, joint_name_map
 from openral_hal.control_law import pd_torque, seed_position_servos
 from openral_hal.mjcf_model import ctrl_limits
@@ -31,12 +31,12 @@ from openral_hal.model_check import manifest_mismatch, unloadable_model
 
 from openral_sim.rollout import Observation, StepResult
 from openral_sim.scene_cameras import (
-    add_fixed_camera,
+    add_fixed_cameras,
     add_mounted_cameras,
     camera_sensors,
     rotate_about_z,
 )
-from openral_sim.scene_checks import check_object_names, physics_steps_per_control
+from openral_sim.scene_checks import check_object_names, check_weld, physics_steps_per_control
 from openral_sim.scene_geometry import lowest_static_point, robot_extent, root_body
 
 ASSETS = ("tabletop", "floor")
@@ -210,10 +210,12 @@ class NativeScene:
         self.data.qpos[free + 3 : free + 7] = quat
 
 
-def _compose(
-    scene: DeployScene, robot: RobotDescription, cameras: dict[str, str]
-) -> mujoco.MjModel:
-    assert robot.sim is not None
+def _robot_spec(robot: RobotDescription) -> tuple[mujoco.MjSpec, mujoco.MjModel]:
+    """The robot's own model as a spec to attach, and compiled, checked against its manifest.
+
+    Raises:
+        ManifestError: At ``sim.mjcf_uri`` or at every manifest field the model contradicts.
+    """
     path = robot_model_file(robot)  # next to the manifest it was loaded from
     try:
         child = mujoco.MjSpec.from_file(str(path))
@@ -223,17 +225,17 @@ def _compose(
     mismatch = manifest_mismatch(robot, child_model)
     if mismatch is not None:
         raise mismatch
+    return child, child_model
+
+
+def _compose(
+    scene: DeployScene, robot: RobotDescription, cameras: dict[str, str]
+) -> mujoco.MjModel:
+    assert robot.sim is not None
+    check_weld(scene, robot)
+    child, child_model = _robot_spec(robot)
     check_object_names(scene, child_model)
-    spec = mujoco.MjSpec()
-    spec.modelname = f"{scene.scene.id}_{robot.name}"
-    for key in ("timestep", "integrator", "cone", "impratio", "noslip_iterations"):
-        setattr(spec.option, key, getattr(child.option, key))
-    spec.compiler.degree = False
-    width, height = scene.scene.observation.width, scene.scene.observation.height
-    spec.visual.global_.offwidth = max(width, 640)
-    spec.visual.global_.offheight = max(height, 480)
-    spec.visual.quality.shadowsize = 0
-    spec.visual.quality.offsamples = 0
+    spec = _scene_spec(scene, robot, child)
     pose = scene.base_pose
     base = np.asarray(pose.position_m if pose and pose.position_m else [0.0, 0.0, 0.0])
     yaw = math.radians(pose.yaw_deg if pose and pose.yaw_deg else 0.0)
@@ -267,25 +269,29 @@ def _compose(
     add_mounted_cameras(child, robot, cameras)
     spec.attach(child, frame=frame, prefix="")
     if pose is not None and pose.weld:
-        if not robot.sim.floating_base:
-            message = (
-                f"robot {robot.name!r} has a fixed base; only a floating base can be welded "
-                "in place"
-            )
-            raise error_at(scene, ("base_pose", "weld"), message)
         _add_base_weld(spec, child_model, robot)
-    for sensor in robot.sensors:  # neither a model camera nor mounted: a fixed camera
-        if not isinstance(sensor, RgbSensor | DepthSensor) or sensor.name not in cameras:
-            continue
-        if sensor.camera is None and sensor.mount_body is None:
-            fovy = sensor.fovy_deg or 45.0
-            target = base + rotate_about_z(yaw, center)
-            add_fixed_camera(spec, cameras[sensor.name], target, yaw, radius, fovy)
+    add_fixed_cameras(spec, robot, cameras, base + rotate_about_z(yaw, center), yaw, radius)
     try:
         return spec.compile()
     except ValueError as error:
         message = f"scene {scene.scene.id!r} for {robot.name!r} does not compile: {error}"
         raise error_at(scene, ("scene",), message) from None
+
+
+def _scene_spec(scene: DeployScene, robot: RobotDescription, child: mujoco.MjSpec) -> mujoco.MjSpec:
+    """An empty world with the robot model's physics options and an offscreen buffer for the
+    scene's images (no shadows or multisampling: they cost more than they show at 128 px)."""
+    spec = mujoco.MjSpec()
+    spec.modelname = f"{scene.scene.id}_{robot.name}"
+    for key in ("timestep", "integrator", "cone", "impratio", "noslip_iterations"):
+        setattr(spec.option, key, getattr(child.option, key))
+    spec.compiler.degree = False
+    width, height = scene.scene.observation.width, scene.scene.observation.height
+    spec.visual.global_.offwidth = max(width, 640)
+    spec.visual.global_.offheight = max(height, 480)
+    spec.visual.quality.shadowsize = 0
+    spec.visual.quality.offsamples = 0
+    return spec
 
 
 def _add_base_weld(

@@ -78,6 +78,24 @@ def looking_along(axis: str) -> tuple[list[float], list[float]]:
     return (0.07 * up).tolist(), [*right.tolist(), *up.tolist()]
 
 
+def add_fixed_cameras(
+    spec: mujoco.MjSpec,
+    robot: RobotDescription,
+    cameras: dict[str, str],
+    target: npt.NDArray[np.float64],
+    yaw: float,
+    radius: float,
+) -> None:
+    """A world camera for each sensor that names neither a model camera nor a mount body,
+    framing a sphere of ``radius`` [m] around ``target`` (world frame) from the front."""
+    for sensor in robot.sensors:
+        if not isinstance(sensor, RgbSensor | DepthSensor) or sensor.name not in cameras:
+            continue
+        if sensor.camera is None and sensor.mount_body is None:
+            fovy = sensor.fovy_deg or 45.0
+            add_fixed_camera(spec, cameras[sensor.name], target, yaw, radius, fovy)
+
+
 def add_fixed_camera(
     spec: mujoco.MjSpec, name: str, target: np.ndarray, yaw: float, radius: float, fovy: float
 ) -> None:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import mujoco
 from openral_core.located import error_at
-from openral_core.models import DeployScene
+from openral_core.models import DeployScene, RobotDescription
 
 MAX_PHYSICS_STEPS_PER_CONTROL = 1_000
 """Most physics steps one control period may take. A period runs in one callback of the
@@ -56,3 +56,13 @@ def check_object_names(scene: DeployScene, model: mujoco.MjModel) -> None:
             if mujoco.mj_name2id(model, kind, name) >= 0:
                 message = f"the robot's model already has an element named {name!r}; rename it"
                 raise error_at(scene, ("scene", "options", "objects", index, "name"), message)
+
+
+def check_weld(scene: DeployScene, robot: RobotDescription) -> None:
+    """Refuse ``base_pose.weld`` on a robot whose base is fixed (only a floating base welds)."""
+    pose = scene.base_pose
+    if pose is not None and pose.weld and not (robot.sim and robot.sim.floating_base):
+        message = (
+            f"robot {robot.name!r} has a fixed base; only a floating base can be welded in place"
+        )
+        raise error_at(scene, ("base_pose", "weld"), message)

@@ -88,11 +88,8 @@ def sim(
             node.destroy_node()
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
-    out.print(
-        f"stopped ({reason}) after {time.monotonic() - started:.1f} s; clean shutdown",
-        soft_wrap=False,
-        highlight=True,
-    )
+    stopped = f"stopped ({reason}) after {time.monotonic() - started:.1f} s; clean shutdown"
+    out.print(stopped, soft_wrap=False, highlight=True)
 
 
 def _scene_robot(config: Path) -> str:
