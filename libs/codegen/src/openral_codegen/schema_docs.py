@@ -9,23 +9,29 @@ Schema cannot state come last, each with the error the validator prints when it 
 
 from __future__ import annotations
 
-import html
 import json
 from collections.abc import Mapping
 from dataclasses import dataclass
-from io import StringIO
 from pathlib import Path
 from typing import Any
 
 from openral_core.schemas import SchemaName
-from ruamel.yaml import YAML
 
 from openral_codegen.manifest_examples import (
     MAX_EXAMPLE_CHARS,
     ManifestExamples,
-    Sample,
     flow,
     short_flow,
+)
+from openral_codegen.reference_text import (
+    broken_text,
+    cell,
+    code,
+    conditions_text,
+    constraint_text,
+    file_of,
+    prose,
+    yaml,
 )
 from openral_codegen.rule_examples import RuleExample, numbered_rules
 
@@ -33,17 +39,6 @@ Schemas = Mapping[SchemaName, dict[str, Any]]
 
 HEADER = "<!-- GENERATED from schema/ by `just schema-export` -- do not edit. -->\n"
 MAX_SNIPPET_LINES = 25
-
-_CONSTRAINTS = (
-    ("minimum", "≥ {}"),
-    ("exclusiveMinimum", "> {}"),
-    ("maximum", "≤ {}"),
-    ("exclusiveMaximum", "< {}"),
-    ("minLength", "length ≥ {}"),
-    ("maxLength", "length ≤ {}"),
-    ("minItems", "items ≥ {}"),
-    ("maxItems", "items ≤ {}"),
-)
 
 
 @dataclass(frozen=True)
@@ -157,7 +152,7 @@ class _Renderer:
         parts = [
             HEADER,
             f"# {page.title or schema['title']}\n",
-            f"{page.intro or _prose(schema['description'])}\n",
+            f"{page.intro or prose(schema['description'])}\n",
             f'!!! note "Generated page"\n    Generated from `{source}` (JSON Schema draft '
             "2020-12) by `just schema-export`. To change it, edit the schema and regenerate.\n",
         ]
@@ -196,7 +191,7 @@ class _Renderer:
                 + ", ".join(f"`{d}`" for d in page.defs)
             )
             title = page.title or schema["title"]
-            lines.append(f"| [{title}]({page.slug}.md) | {_cell(_prose(what))} |")
+            lines.append(f"| [{title}]({page.slug}.md) | {cell(prose(what))} |")
         return "\n".join(lines) + "\n"
 
     # -- sections --------------------------------------------------------------------------
@@ -207,7 +202,7 @@ class _Renderer:
         section = (page.schema, title)
         lines = [f"## {title}\n"]
         if not top and schema.get("description"):
-            lines.append(f"{_prose(schema['description'])}\n")
+            lines.append(f"{prose(schema['description'])}\n")
         required = set(schema.get("required", []))
         lines.append("| Field | Type and allowed values | Description | Example |")
         lines.append("|---|---|---|---|")
@@ -215,25 +210,25 @@ class _Renderer:
             if prop in required:
                 presence = "**required**"
             elif "default" in spec:
-                presence = f"default {_code(flow(spec['default']))}"
+                presence = f"default {code(flow(spec['default']))}"
             else:
                 presence = "optional"
             allowed = self._allowed_text(page, spec)
             cells = [
                 f"`{prop}`<br>{presence}",
                 self._type_text(page, spec) + (f"<br>{allowed}" if allowed else ""),
-                _cell(_prose(spec.get("description", ""))),
+                cell(prose(spec.get("description", ""))),
                 self._example_cell(page, section, prop, spec),
             ]
             lines.append("| " + " | ".join(cells) + " |")
-        conditions = _conditions(schema)
+        conditions = conditions_text(schema)
         if conditions:
             lines.append("\n" + conditions)
         lines.append(self._snippet(section))
         return "\n".join(lines) + "\n"
 
     def _value_section(self, page: ReferencePage, title: str, schema: dict[str, Any]) -> str:
-        text = f"## {title}\n\n{_prose(schema.get('description', ''))}\n\n"
+        text = f"## {title}\n\n{prose(schema.get('description', ''))}\n\n"
         if "enum" in schema:
             text += "Allowed values: " + ", ".join(f"`{v}`" for v in schema["enum"]) + ".\n"
         elif "oneOf" in schema:
@@ -241,7 +236,7 @@ class _Renderer:
             text += "Exactly one of: " + ", ".join(options) + ".\n"
         else:
             kind = schema.get("type", "any")
-            found = _constraint_text(schema)
+            found = constraint_text(schema)
             text += f"Type: {kind}" + (f", {found}" if found else "") + ".\n"
         return text
 
@@ -249,7 +244,7 @@ class _Renderer:
         head, numbered = numbered_rules(comment)
         lines = [
             "## Rules checked after the schema\n",
-            f"{_prose(head)}.\n" if numbered else f"{_prose(comment)}\n",
+            f"{prose(head)}.\n" if numbered else f"{prose(comment)}\n",
         ]
         if name is SchemaName.SIM:
             lines.append(
@@ -260,13 +255,13 @@ class _Renderer:
         by_rule = {e.broken.rule: e for e in examples}
         if numbered:
             for number, text in numbered.items():
-                lines.append(f"### Rule {number}: {_prose(text)}\n")
+                lines.append(f"### Rule {number}: {prose(text)}\n")
                 example = by_rule.get(number)
-                lines.append(_broken_text(example) if example else "No example yet.\n")
+                lines.append(broken_text(example) if example else "No example yet.\n")
         else:
             for example in examples:
                 lines.append(f"### {example.broken.rule}\n")
-                lines.append(_broken_text(example))
+                lines.append(broken_text(example))
         return "\n".join(lines) + "\n"
 
     def _gripper_usage(self) -> str:
@@ -331,10 +326,10 @@ class _Renderer:
             return " \\| ".join(f"`{v}`" for v in target["enum"])
         if "const" in target:
             return f"only `{json.dumps(target['const'])}`"
-        found = _constraint_text(spec)
+        found = constraint_text(spec)
         values = spec.get("additionalProperties")
         if isinstance(values, dict):
-            found = ", ".join(p for p in (found, _constraint_text(values, "each value ")) if p)
+            found = ", ".join(p for p in (found, constraint_text(values, "each value ")) if p)
         return found
 
     def _example_cell(
@@ -343,129 +338,25 @@ class _Renderer:
         sample = self.examples.example(section, prop)
         if sample is None:
             if spec.get("examples"):
-                return f"`{_cell(short_flow(spec['examples'][0]))}` (schema example)"
+                return f"`{cell(short_flow(spec['examples'][0]))}` (schema example)"
             return "*not used by any manifest yet*"
         text = flow(sample.value)
         ref = spec.get("$ref") or spec.get("items", {}).get("$ref")
         if len(text) > MAX_EXAMPLE_CHARS and ref:
             schema, target, _ = self._resolve(page, str(ref))
             return f"see the {self._link(page, schema, target)} example"
-        return f"`{_cell(short_flow(sample.value))}` ({sample.source})"
+        return f"`{cell(short_flow(sample.value))}` ({sample.source})"
 
     def _snippet(self, section: tuple[SchemaName, str]) -> str:
         instances = self.examples.instances.get(section, [])
         if not instances:
             return ""
         sample = instances[0]
-        text = _yaml(sample.value)
+        text = yaml(sample.value)
         if text.count("\n") > MAX_SNIPPET_LINES:
             robot = sample.source.split("/")[0]
             return (
-                f"\nA complete example: `{_file_of(sample)}`, shown on the "
+                f"\nA complete example: `{file_of(sample)}`, shown on the "
                 f"[{robot} page](../robots/{robot}.md).\n"
             )
-        return f"\nExample from `{_file_of(sample)}`:\n\n```yaml\n{text}```\n"
-
-
-def _file_of(sample: Sample) -> str:
-    robot, _, scene = sample.source.partition("/")
-    return f"robots/{robot}/scenes/{scene}.yaml" if scene else f"robots/{robot}/robot.yaml"
-
-
-def _broken_text(example: RuleExample) -> str:
-    broken = example.broken
-    return (
-        f"Checked in `{broken.checked_in}`. Break it with this edit of `{broken.file}`:\n\n"
-        f"```diff\n{_diff(broken.old, broken.new)}```\n\nand the validator reports:\n\n"
-        f"```text\n{example.error}\n```\n"
-    )
-
-
-def _diff(old: str, new: str) -> str:
-    """A unified-diff body for replacing ``old`` with ``new`` (context kept on insertions)."""
-    old_lines, new_lines = old.rstrip("\n").split("\n"), new.rstrip("\n").split("\n")
-    if new_lines[: len(old_lines)] == old_lines:
-        body = [f" {line}" for line in old_lines]
-        body += [f"+{line}" for line in new_lines[len(old_lines) :]]
-    else:
-        body = [f"-{line}" for line in old_lines] + [f"+{line}" for line in new_lines]
-    return "\n".join(body) + "\n"
-
-
-def _yaml(value: Any) -> str:
-    """Block YAML with innermost lists and maps in flow style (as manifests are written)."""
-    yaml = YAML(typ="safe", pure=True)
-    yaml.default_flow_style = None
-    yaml.width = 4096  # never fold a long value (an mjcf_uri) onto its own line
-    yaml.indent(mapping=2, sequence=4, offset=2)
-    yaml.representer.sort_base_mapping_type_on_output = False
-    stream = StringIO()
-    yaml.dump(value, stream)
-    return stream.getvalue()
-
-
-def _constraint_text(spec: dict[str, Any], prefix: str = "") -> str:
-    found = [prefix + fmt.format(spec[key]) for key, fmt in _CONSTRAINTS if key in spec]
-    if "pattern" in spec:
-        found.append(f"{prefix}matches {_code(spec['pattern'])}")
-    items = spec.get("items")
-    if isinstance(items, dict):
-        found += [f"each {fmt.format(items[key])}" for key, fmt in _CONSTRAINTS if key in items]
-        if "pattern" in items:
-            found.append(f"each matches {_code(items['pattern'])}")
-        if "enum" in items:
-            found.append("each one of " + ", ".join(f"`{v}`" for v in items["enum"]))
-    if spec.get("uniqueItems"):
-        found.append("unique items")
-    names = spec.get("propertyNames")
-    if isinstance(names, dict) and "pattern" in names:
-        found.append(f"names match {_code(names['pattern'])}")
-    return _cell(", ".join(found))
-
-
-def _conditions(schema: dict[str, Any]) -> str:
-    blocks = [schema, *schema.get("allOf", [])]
-    notes = []
-    for block in blocks:
-        condition = block.get("if", {}).get("properties", {})
-        if not condition:
-            continue
-        ((key, test),) = condition.items()
-        when = f"When `{key}` is `{test['const']}`"
-        for branch, prefix in (("then", when), ("else", "Otherwise")):
-            rule = block.get(branch)
-            if rule:
-                notes.append(f"- {prefix}: {_rule_text(rule)}.")
-    return "Conditional rules:\n\n" + "\n".join(notes) + "\n" if notes else ""
-
-
-def _rule_text(rule: dict[str, Any]) -> str:
-    parts = []
-    if "required" in rule:
-        parts.append("requires " + ", ".join(f"`{k}`" for k in rule["required"]))
-    forbidden = rule.get("not", {})
-    keys = list(forbidden.get("required", []))
-    for option in forbidden.get("anyOf", []):
-        keys += option.get("required", [])
-    if keys:
-        parts.append("does not allow " + ", ".join(f"`{k}`" for k in keys))
-    return "; ".join(parts)
-
-
-def _prose(text: str) -> str:
-    """Schema text as Markdown: ``<`` and ``>`` outside backticks are shown, not taken as HTML."""
-    parts = text.split("`")
-    for index in range(0, len(parts), 2):  # even parts lie outside code spans
-        parts[index] = html.escape(parts[index], quote=False)
-    return "`".join(parts)
-
-
-def _code(text: str) -> str:
-    """Inline code that survives a table cell (a ``|`` inside backticks would show its ``\\``)."""
-    if "|" not in text:
-        return f"`{text}`"
-    return "<code>" + html.escape(text).replace("|", "&#124;") + "</code>"
-
-
-def _cell(text: str) -> str:
-    return text.replace("|", "\\|").replace("\n", " ")
+        return f"\nExample from `{file_of(sample)}`:\n\n```yaml\n{text}```\n"
