@@ -11,7 +11,7 @@ warning that names the request, the current state and the transitions it allows.
 Example::
 
     node = MyLifecycleNode(...)
-    guard_change_state(node)  # once, right after construction
+    guard_change_state(node, warn_every_s=2.0)  # once, right after construction
 """
 
 from __future__ import annotations
@@ -21,16 +21,13 @@ from typing import Any
 
 from rclpy.lifecycle import LifecycleNode
 
-WARN_EVERY_S = 2.0
-"""At most one refused-transition warning per this many seconds per node [s]."""
-
 LABEL_SHOWN = 40
 """Characters of a requested label quoted in the warning (a hostile label can be long)."""
 
 ServiceCallback = Callable[[Any, Any], Any]
 
 
-def guard_change_state(node: LifecycleNode, warn_every_s: float = WARN_EVERY_S) -> None:
+def guard_change_state(node: LifecycleNode, warn_every_s: float) -> None:
     """Replace ``node``'s ChangeState service callback with a checked one (see module doc).
 
     Args:

@@ -67,7 +67,8 @@ from openral_nodes.runtime import LATCHED
 
 NODE_NAME = "openral_manifest_node"
 WARN_EVERY_S = 2.0
-"""At most one warning per this many seconds for a stream of refused actions [s]."""
+"""At most one warning per this many seconds for a stream of refused actions or
+lifecycle transitions [s]."""
 
 PARAMETERS: dict[str, Any] = {
     "robot_id": "",
@@ -143,7 +144,7 @@ class ManifestLifecycleNode(LifecycleNode):
         self._entities: list[tuple[str, Any]] = []
         self._state_rate_hz = 0.0
         self._shutdown_event = shutdown_event
-        guard_change_state(self)
+        guard_change_state(self, WARN_EVERY_S)
 
     # -- transitions -----------------------------------------------------------------------
 

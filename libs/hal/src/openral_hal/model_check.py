@@ -38,16 +38,19 @@ def check_robot(description: RobotDescription, model: mujoco.MjModel) -> list[Ch
     ]
 
 
-def manifest_mismatch(description: RobotDescription, model: mujoco.MjModel) -> ManifestError | None:
-    """A located error listing every check ``description`` fails against ``model``, or None.
+def require_agreement(description: RobotDescription, model: mujoco.MjModel) -> None:
+    """Refuse ``model`` for ``description`` unless every check of :func:`check_robot` passes.
 
     The HAL and the native scene call this before they use a model: a manifest whose
     addresses, actuators, base or cameras disagree with its model would drive the wrong
     joint or crash later, so it is refused at the fields that are wrong.
+
+    Raises:
+        ManifestError: One located issue per failed check.
     """
     failed = [row for row in check_robot(description, model) if not row.ok]
     if not failed:
-        return None
+        return
     issues = [
         issue_at(
             description,
@@ -57,24 +60,19 @@ def manifest_mismatch(description: RobotDescription, model: mujoco.MjModel) -> M
         )
         for row in failed
     ]
-    return ManifestError(issues[0].file, issues)
+    raise ManifestError(issues[0].file, issues)
 
 
-def load_checked_model(description: RobotDescription, path: Path) -> mujoco.MjModel:
-    """Compile the robot's MJCF at ``path`` and check the manifest against it.
+def compile_robot_model(description: RobotDescription, path: Path) -> mujoco.MjModel:
+    """Compile the robot's MJCF at ``path``.
 
     Raises:
-        ManifestError: At ``sim.mjcf_uri`` when MuJoCo cannot load the file, or at every
-            field that disagrees with the model (:func:`manifest_mismatch`).
+        ManifestError: At ``sim.mjcf_uri`` when MuJoCo cannot load the file.
     """
     try:
-        model = mujoco.MjModel.from_xml_path(str(path))
+        return mujoco.MjModel.from_xml_path(str(path))
     except ValueError as error:  # MuJoCo's parser and compiler report this way
         raise unloadable_model(description, path, error) from None
-    mismatch = manifest_mismatch(description, model)
-    if mismatch is not None:
-        raise mismatch
-    return model
 
 
 def unloadable_model(description: RobotDescription, path: Path, error: Exception) -> ManifestError:

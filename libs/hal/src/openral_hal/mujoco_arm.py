@@ -25,7 +25,7 @@ from openral_hal.errors import EStopLatched, HalError, NotConnected, SimulationD
 from openral_hal.gripper import gripper_ctrl, read_gripper
 from openral_hal.mjcf_model import ctrl_limits
 from openral_hal.mjcf_uri import robot_model_file
-from openral_hal.model_check import load_checked_model
+from openral_hal.model_check import compile_robot_model, require_agreement
 from openral_hal.state import FloatArray, JointStateSample
 
 CONTROL_MODES = ("position", "torque_pd")
@@ -180,7 +180,8 @@ class MujocoArmHAL:
     def connect(self) -> None:
         """Load the model, reset (keyframe), seed the actuators, forward and settle."""
         if self.description is not None:
-            model = load_checked_model(self.description, self.mjcf_path)
+            model = compile_robot_model(self.description, self.mjcf_path)
+            require_agreement(self.description, model)
         else:
             model = mujoco.MjModel.from_xml_path(str(self.mjcf_path))
         self._check_wiring(model)

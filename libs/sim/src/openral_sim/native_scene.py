@@ -3,7 +3,7 @@
 The scene adds a floor, lights, optionally a table and a pedestal, the objects the scene file
 lists, and a camera for every manifest camera sensor the scene file names (placed as
 :mod:`openral_sim.scene_cameras` says). Before composing, the manifest is checked against
-the robot's own model (:func:`~openral_hal.model_check.manifest_mismatch`); every fault of
+the robot's own model (:func:`~openral_hal.model_check.require_agreement`); every fault of
 the scene file or the manifest is reported at its field's line and column.
 
 The action is one control value per actuator of the robot model. For a ``torque_pd`` robot
@@ -27,7 +27,7 @@ from openral_core.tables import hal_wiring, joint_name_map
 from openral_hal.control_law import pd_torque, seed_position_servos
 from openral_hal.mjcf_model import ctrl_limits
 from openral_hal.mjcf_uri import robot_model_file
-from openral_hal.model_check import manifest_mismatch, unloadable_model
+from openral_hal.model_check import require_agreement, unloadable_model
 
 from openral_sim.rollout import Observation, StepResult
 from openral_sim.scene_cameras import (
@@ -222,9 +222,7 @@ def _robot_spec(robot: RobotDescription) -> tuple[mujoco.MjSpec, mujoco.MjModel]
         child_model = child.copy().compile()  # before attach: no compile after it
     except ValueError as error:
         raise unloadable_model(robot, path, error) from None
-    mismatch = manifest_mismatch(robot, child_model)
-    if mismatch is not None:
-        raise mismatch
+    require_agreement(robot, child_model)
     return child, child_model
 
 

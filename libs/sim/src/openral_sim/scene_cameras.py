@@ -53,7 +53,7 @@ def add_mounted_cameras(
         if sensor.camera is not None or sensor.mount_body is None:
             continue
         body = child.body(sensor.mount_body)
-        assert body is not None, "manifest_mismatch checks mount bodies before composing"
+        assert body is not None, "require_agreement checks mount bodies before composing"
         forward = any(word in sensor.mount_body.lower() for word in FORWARD_LOOKING)
         axis = sensor.mount_axis.value if sensor.mount_axis is not None else None
         # A MuJoCo camera looks along its -z axis with +y up.

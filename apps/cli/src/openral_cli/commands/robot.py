@@ -215,9 +215,8 @@ def check(
     control ranges, the keyframe, the floating base and sensor cameras/bodies/sites.
     Exits 1 on any mismatch, 2 when nothing was named.
     """
-    import mujoco
     from openral_hal.mjcf_uri import robot_model_file
-    from openral_hal.model_check import check_robot, unloadable_model
+    from openral_hal.model_check import check_robot, compile_robot_model
 
     files = _named_manifests(targets, all_robots, "check")
     summary = Table(title="robot check")
@@ -228,10 +227,7 @@ def check(
         try:
             robot = load_robot(file, check_folder_name=file.name == MANIFEST_NAME)
             path = robot_model_file(robot, file.parent)  # located error without a sim block
-            try:
-                model = mujoco.MjModel.from_xml_path(str(path))
-            except ValueError as error:  # MuJoCo's compiler does not know the manifest
-                raise unloadable_model(robot, path, error) from None
+            model = compile_robot_model(robot, path)
         except OpenralError as error:  # each names its manifest file already
             failed_robots += 1
             err.print(line(("✗", "red"), f" {error}"))
