@@ -28,8 +28,32 @@ SETTINGS = settings(
 )
 
 
+def _ordered(limits: list[float]) -> list[float]:
+    """Two drawn bounds as lower < upper (rules 5 and 9), kept inside position_limits' +-1000."""
+    lower, upper = sorted(limits)
+    if lower == upper:
+        lower, upper = (lower - 1.0, upper) if lower > -1000 else (lower, upper + 1.0)
+    return [lower, upper]
+
+
+def _distinct_joints(joints: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Keep the first joint of each name and sim_joint_name (rules 2 and 3); one always stays."""
+    seen: set[tuple[str, str]] = set()
+    kept = []
+    for joint in joints:
+        keys = {("name", joint["name"]), ("sim", joint.get("sim_joint_name", ""))} - {("sim", "")}
+        if not keys & seen:
+            kept.append(joint)
+            seen |= keys
+    return kept
+
+
 def _repair(document: dict[str, Any]) -> dict[str, Any]:
     """Point a drawn sim block's joint references at the drawn joints, so rules can pass."""
+    document["joints"] = _distinct_joints(document["joints"])
+    for joint in document["joints"]:
+        if "position_limits" in joint:
+            joint["position_limits"] = _ordered(joint["position_limits"])
     sim = document.get("sim")
     if sim is None:
         return document
@@ -41,7 +65,7 @@ def _repair(document: dict[str, Any]) -> dict[str, Any]:
     grippers = sim.get("grippers", [])[: len(joints)]
     for gripper, joint in zip(grippers, reversed(joints), strict=False):
         gripper["joint"] = joint
-        gripper["ctrl_range"] = sorted(gripper["ctrl_range"])
+        gripper["ctrl_range"] = _ordered(gripper["ctrl_range"])
     sim["grippers"] = grippers
     control = sim.get("control", {})
     for gain in ("kp", "kd"):
