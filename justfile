@@ -51,8 +51,12 @@ docs-images *IDS:
 fuzz N *ARGS:
     python -m tests.fuzz.campaign {{N}} {{ARGS}}
 
-# The static checks CI runs after the tests: lint, types, generated-tree drift.
-check: lint typecheck schema-check
+# The import layers (core -> mujoco -> sim -> hal -> bridge -> apps), as pyproject.toml declares them.
+layers:
+    lint-imports --no-cache
+
+# The static checks CI runs after the tests: lint, types, import layers, generated-tree drift.
+check: lint typecheck layers schema-check
 
 # HAL overhead per robot against a raw mj_step loop; writes benchmarks/results/hal_step.json.
 bench-hal *ARGS:

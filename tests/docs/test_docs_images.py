@@ -28,7 +28,7 @@ scene, pose or viewpoint."""
 
 
 def read_png(path: Path) -> npt.NDArray[np.uint8]:
-    """Decode an 8-bit RGB PNG with filter type 0 rows (what openral_sim.png writes)."""
+    """Decode an 8-bit RGB PNG with filter type 0 rows (what openral_mujoco.png writes)."""
     data = path.read_bytes()
     assert data[:8] == b"\x89PNG\r\n\x1a\n", f"{path} is not a PNG"
     offset, idat, size = 8, b"", (0, 0)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from openral_hal.gripper import gripper_ctrl, read_gripper
+from openral_mujoco.gripper import gripper_ctrl, read_gripper
 
 ranges = st.tuples(st.floats(-5, 5), st.floats(0.01, 5)).map(lambda t: (t[0], t[0] + t[1]))
 

@@ -15,13 +15,13 @@ from pathlib import Path
 import mujoco
 import pytest
 from openral_cli.main import app
-from openral_hal.mjcf_confinement import (
+from openral_mujoco.mjcf_confinement import (
     ALLOW_OUTSIDE_ENV,
     Confinement,
     MjcfConfinementError,
     check_mjcf_files,
 )
-from openral_hal.mjcf_uri import MjcfUriError, locate_mjcf_uri, resolve_mjcf_uri
+from openral_mujoco.mjcf_uri import MjcfUriError, locate_mjcf_uri, resolve_mjcf_uri
 from typer.testing import CliRunner
 
 from tests.conftest import ROBOTS

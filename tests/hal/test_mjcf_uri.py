@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 from openral_core import load_robot_by_id, manifest_path, robot_ids
-from openral_hal import mjcf_uri
-from openral_hal.mjcf_uri import MjcfUriError, extras_providing, resolve_mjcf_uri
+from openral_mujoco import mjcf_uri
+from openral_mujoco.mjcf_uri import MjcfUriError, extras_providing, resolve_mjcf_uri
 
 
 @pytest.mark.parametrize("robot_id", robot_ids())

@@ -8,8 +8,8 @@ import mujoco
 import pytest
 from openral_cli.main import app
 from openral_core import load_robot, robot_ids
-from openral_hal.mjcf_uri import resolve_mjcf_uri
-from openral_hal.model_check import check_robot
+from openral_mujoco.mjcf_uri import resolve_mjcf_uri
+from openral_mujoco.model_check import check_robot
 from typer.testing import CliRunner
 
 from tests.conftest import ROBOTS, ManifestWriter

@@ -15,8 +15,8 @@ from openral_core import load_robot_by_id, manifest_path, robot_ids
 from openral_core.paths import repo_root
 from openral_core.tables import HalWiring, hal_wiring
 from openral_hal.errors import EStopLatched, NotConnected, SimulationDiverged
-from openral_hal.mjcf_uri import resolve_mjcf_uri
 from openral_hal.mujoco_arm import MujocoArmHAL, hal_kwargs
+from openral_mujoco.mjcf_uri import resolve_mjcf_uri
 
 HOLD_STEPS = 200
 HOLD_TOLERANCE = 0.05

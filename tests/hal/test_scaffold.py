@@ -10,9 +10,9 @@ from openral_core.loader import load_robot
 from openral_core.models import LimitedJoint, RgbSensor, RobotDescription, TorquePdControl
 from openral_core.registry import load_robot_by_id, manifest_path, robot_ids
 from openral_hal.errors import HalError
-from openral_hal.mjcf_uri import MjcfUriError, resolve_mjcf_uri
-from openral_hal.model_check import check_robot
 from openral_hal.scaffold import SCHEMA_LINE, scaffold_manifest
+from openral_mujoco.mjcf_uri import MjcfUriError, resolve_mjcf_uri
+from openral_mujoco.model_check import check_robot
 
 IDS = robot_ids()
 

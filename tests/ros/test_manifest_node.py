@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from openral_bridge.topics import ACTION_SPEC, ESTOP, RELEASE_ESTOP, SAFE_ACTION
 from openral_core.models import RgbSensor
-from openral_sim.png import encode_png
+from openral_mujoco.png import encode_png
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from openral_bridge.sim_sensor_bridge import SimSensorBridge
 from openral_core.registry import load_robot_by_id
-from openral_hal.state import JointStateSample
+from openral_mujoco.state import JointStateSample
 from openral_nodes.runtime import Spinner
 from rclpy.context import Context
 from rclpy.node import Node

@@ -22,7 +22,7 @@ WIDE = {"COLUMNS": "200", "ROS_DOMAIN_ID": str(DOMAIN_ID)}
 
 
 def read_png(path: Path) -> np.ndarray:
-    """Pixels of an 8-bit RGB PNG whose rows all use filter 0 (as openral_sim.png writes)."""
+    """Pixels of an 8-bit RGB PNG whose rows all use filter 0 (as openral_mujoco.png writes)."""
     data = path.read_bytes()
     assert data[:8] == b"\x89PNG\r\n\x1a\n"
     pos, idat, size = 8, b"", (0, 0)

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from openral_hal.errors import HalError
-from openral_hal.name_resolution import resolve_joint_names, strip_robot_prefix
+from openral_mujoco.name_resolution import resolve_joint_names, strip_robot_prefix
 
 BASES = ("joint1", "joint2", "shoulder", "elbow", "wrist", "finger_joint1")
 PREFIXES = ("", "robot0_", "robot1_", "robot12_", "gripper0_right_", "gripper0_left_", "gripper1_")

@@ -12,7 +12,7 @@ import sys
 
 import typer
 from openral_core.errors import OpenralError
-from openral_sim.display import render_offscreen_when_headless
+from openral_mujoco.display import render_offscreen_when_headless
 
 from openral_cli.console import error as print_error
 

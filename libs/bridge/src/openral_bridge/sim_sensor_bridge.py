@@ -28,7 +28,7 @@ from typing import Any
 import mujoco
 from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
 from openral_hal.factory import can_idle_step
-from openral_sim.display import has_display
+from openral_mujoco.display import has_display
 
 from openral_bridge import ros_messages
 from openral_bridge.idle import should_idle_step

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -53,7 +52,9 @@ class Render:
 
 def render_robot(root: Path, robot_id: str) -> Render:
     """Render ``robot_id`` in its default scene (HEIGHT x WIDTH x 3, uint8)."""
-    os.environ.setdefault("MUJOCO_GL", "egl")
+    from openral_mujoco.display import use_offscreen_gl
+
+    use_offscreen_gl()
     import mujoco
     from openral_core.loader import load_scene
     from openral_sim.scene import build_sim_env_from_yaml
@@ -107,7 +108,7 @@ def render_robot(root: Path, robot_id: str) -> Render:
 def input_digest(root: Path, robot_id: str) -> str:
     """SHA-256 over everything a picture depends on, besides the scene code itself."""
     from openral_core.loader import load_robot
-    from openral_hal.mjcf_uri import resolve_mjcf_uri
+    from openral_mujoco.mjcf_uri import resolve_mjcf_uri
 
     folder = root / "robots" / robot_id
     manifest = folder / "robot.yaml"
@@ -128,7 +129,7 @@ def input_digest(root: Path, robot_id: str) -> str:
 def write_images(root: Path, robot_ids: list[str] | None = None) -> list[str]:
     """Render the pictures of ``robot_ids`` (default: every robot); returns the paths written."""
     from openral_core.registry import robot_ids as all_robot_ids
-    from openral_sim.png import write_png
+    from openral_mujoco.png import write_png
 
     known = all_robot_ids(root / "robots")
     wanted = robot_ids or known

@@ -1,12 +1,17 @@
-"""Errors raised by HALs."""
+"""Errors raised by HALs: the contract's own (re-exported) plus the HAL lifecycle's."""
 
 from __future__ import annotations
 
-from openral_core.errors import OpenralError
+from openral_mujoco.errors import ActionRejected, HalError, SimulationDiverged
 
-
-class HalError(OpenralError):
-    """A HAL call that cannot be carried out in the HAL's current state."""
+__all__ = [
+    "ActionRejected",
+    "ConfigurationError",
+    "EStopLatched",
+    "HalError",
+    "NotConnected",
+    "SimulationDiverged",
+]
 
 
 class NotConnected(HalError):
@@ -15,14 +20,6 @@ class NotConnected(HalError):
 
 class EStopLatched(HalError):
     """An action was sent while the E-stop is latched; call ``release_estop()`` first."""
-
-
-class ActionRejected(HalError):
-    """An action of the wrong type, width or with a non-finite value; nothing was applied."""
-
-
-class SimulationDiverged(HalError):
-    """MuJoCo met a NaN/Inf acceleration and reset the simulation to its initial state."""
 
 
 class ConfigurationError(HalError):

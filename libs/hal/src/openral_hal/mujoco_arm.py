@@ -18,15 +18,15 @@ import mujoco
 import numpy as np
 from openral_core.models import RobotDescription
 from openral_core.tables import GripperWiring, HalWiring, hal_wiring
+from openral_mujoco.action import validated_action
+from openral_mujoco.control_law import pd_torque, seed_position_servos
+from openral_mujoco.gripper import gripper_ctrl, read_gripper
+from openral_mujoco.mjcf_model import ctrl_limits
+from openral_mujoco.mjcf_uri import robot_model_file
+from openral_mujoco.model_check import compile_robot_model, require_agreement
+from openral_mujoco.state import FloatArray, JointStateSample
 
-from openral_hal.action import validated_action
-from openral_hal.control_law import pd_torque, seed_position_servos
 from openral_hal.errors import EStopLatched, HalError, NotConnected, SimulationDiverged
-from openral_hal.gripper import gripper_ctrl, read_gripper
-from openral_hal.mjcf_model import ctrl_limits
-from openral_hal.mjcf_uri import robot_model_file
-from openral_hal.model_check import compile_robot_model, require_agreement
-from openral_hal.state import FloatArray, JointStateSample
 
 CONTROL_MODES = ("position", "torque_pd")
 _BAD_STATE_WARNINGS = slice(

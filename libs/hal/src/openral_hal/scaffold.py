@@ -3,7 +3,7 @@
 The draft is written by hand, line by line, so it can carry ``# REVIEW:`` comments on
 every value that is a guess or a placeholder (velocity limits, guessed grippers, PD
 gains). It is built so that it loads (:func:`openral_core.loader.load_robot`) and passes
-:func:`openral_hal.model_check.check_robot` against the model it came from; a human still
+:func:`openral_mujoco.model_check.check_robot` against the model it came from; a human still
 has to read it before it describes a real robot.
 
 How the model becomes a manifest:
@@ -25,14 +25,14 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import mujoco
-
-from openral_hal.errors import HalError
-from openral_hal.mjcf_model import (
+from openral_mujoco.mjcf_model import (
     is_motor,
     is_position_servo,
     root_is_free,
 )
-from openral_hal.mjcf_uri import resolve_mjcf_uri
+from openral_mujoco.mjcf_uri import resolve_mjcf_uri
+
+from openral_hal.errors import HalError
 from openral_hal.scaffold_joints import (
     MJCF_NAME,
     Driven,
@@ -74,13 +74,13 @@ def scaffold_manifest(
     """Draft robot.yaml text for the MJCF model `mjcf_uri` names.
 
     Args:
-        mjcf_uri: A ``sim.mjcf_uri`` (see :mod:`openral_hal.mjcf_uri`), written into the draft
+        mjcf_uri: A ``sim.mjcf_uri`` (see :mod:`openral_mujoco.mjcf_uri`), written into the draft
             as given.
         name: Robot id; the draft belongs in ``robots/<name>/robot.yaml``.
         manifest_dir: Folder the draft will be written to (``file:`` URIs start there and
             must stay inside it).
         allow_outside: Accept a model, or files it loads, outside its confinement root
-            (see :func:`openral_hal.mjcf_uri.resolve_mjcf_uri`).
+            (see :func:`openral_mujoco.mjcf_uri.resolve_mjcf_uri`).
 
     Raises:
         MjcfUriError: The URI cannot be resolved to a confined MJCF file.

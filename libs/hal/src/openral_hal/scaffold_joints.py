@@ -12,9 +12,9 @@ import re
 from dataclasses import dataclass
 
 import mujoco
+from openral_mujoco.mjcf_model import fixed_tendon_joints, is_scalar_joint
 
 from openral_hal.errors import HalError
-from openral_hal.mjcf_model import fixed_tendon_joints, is_scalar_joint
 
 MJCF_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_/.-]{0,126}")
 MAX_NAME = 63

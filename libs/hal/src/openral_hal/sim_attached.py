@@ -20,13 +20,13 @@ import numpy.typing as npt
 from openral_core.located import error_at
 from openral_core.models import RgbSensor, RobotDescription
 from openral_core.tables import joint_name_map
+from openral_mujoco.action import validated_action
+from openral_mujoco.mjcf_model import is_scalar_joint
+from openral_mujoco.name_resolution import resolve_joint_names
+from openral_mujoco.state import FloatArray, JointStateSample
 from openral_sim.rollout import HoldingRollout, Observation, SimRollout, StepResult
 
-from openral_hal.action import validated_action
 from openral_hal.errors import ConfigurationError, EStopLatched, HalError, NotConnected
-from openral_hal.mjcf_model import is_scalar_joint
-from openral_hal.name_resolution import resolve_joint_names
-from openral_hal.state import FloatArray, JointStateSample
 
 _log = logging.getLogger(__name__)
 

@@ -3,7 +3,7 @@
 The scene adds a floor, lights, optionally a table and a pedestal, the objects the scene file
 lists, and a camera for every manifest camera sensor the scene file names (placed as
 :mod:`openral_sim.scene_cameras` says). Before composing, the manifest is checked against
-the robot's own model (:func:`~openral_hal.model_check.require_agreement`); every fault of
+the robot's own model (:func:`~openral_mujoco.model_check.require_agreement`); every fault of
 the scene file or the manifest is reported at its field's line and column.
 
 The action is one control value per actuator of the robot model. For a ``torque_pd`` robot
@@ -24,10 +24,10 @@ from openral_core.errors import OpenralError
 from openral_core.located import error_at
 from openral_core.models import DeployScene, RobotDescription
 from openral_core.tables import hal_wiring, joint_name_map
-from openral_hal.control_law import pd_torque, seed_position_servos
-from openral_hal.mjcf_model import ctrl_limits
-from openral_hal.mjcf_uri import robot_model_file
-from openral_hal.model_check import require_agreement, unloadable_model
+from openral_mujoco.control_law import pd_torque, seed_position_servos
+from openral_mujoco.mjcf_model import ctrl_limits
+from openral_mujoco.mjcf_uri import robot_model_file
+from openral_mujoco.model_check import require_agreement, unloadable_model
 
 from openral_sim.rollout import Observation, StepResult
 from openral_sim.scene_cameras import (

@@ -24,11 +24,12 @@ so a HAL attached once stays attached.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 from typing import Any, cast
 
-os.environ.setdefault("MUJOCO_GL", "egl")  # robosuite picks its GL backend on import
+from openral_mujoco.display import use_offscreen_gl
+
+use_offscreen_gl()  # robosuite picks its GL backend on import
 
 import mujoco
 import numpy as np

@@ -215,8 +215,8 @@ def check(
     control ranges, the keyframe, the floating base and sensor cameras/bodies/sites.
     Exits 1 on any mismatch, 2 when nothing was named.
     """
-    from openral_hal.mjcf_uri import robot_model_file
-    from openral_hal.model_check import check_robot, compile_robot_model
+    from openral_mujoco.mjcf_uri import robot_model_file
+    from openral_mujoco.model_check import check_robot, compile_robot_model
 
     files = _named_manifests(targets, all_robots, "check")
     summary = Table(title="robot check")

@@ -164,10 +164,10 @@ def snapshot(
     """Save one frame of an Image topic (rgb8, bgr8 or mono8) as PNG."""
     require_ros()
     from openral_core.errors import OpenralError, escaped
+    from openral_mujoco.png import write_png
     from openral_nodes.topic_codec import image_to_rgb
     from openral_nodes.topic_graph import wait_for_topic
     from openral_nodes.topic_probe import subscribe
-    from openral_sim.png import write_png
 
     with _probe_node(domain_id) as node:
         info = wait_for_topic(node, topic, timeout)

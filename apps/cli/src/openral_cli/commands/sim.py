@@ -88,7 +88,7 @@ def _drive(
     advance: Callable[[], None],
 ) -> tuple[list[dict[str, object]], list[str]]:
     """Step a connected HAL from its hold action; the joint records and the camera names."""
-    from openral_sim.png import write_png
+    from openral_mujoco.png import write_png
 
     hold = hal.hold_action()
     records: list[dict[str, object]] = []

@@ -11,12 +11,12 @@ Schemes:
 - ``openarm_v2:<variant>``: ``openarm_mujoco/v2/openarm_<variant>.xml`` installed by
   openarm-mujoco.
 
-Each resolution has a confinement root (:class:`~openral_hal.mjcf_confinement.Confinement`):
+Each resolution has a confinement root (:class:`~openral_mujoco.mjcf_confinement.Confinement`):
 the robot's folder for ``file:``, the folder holding the distribution's files next to the
 model for the others. The model, and every file it includes or loads, must lie inside it
 (symlinks resolved) unless ``OPENRAL_ALLOW_OUTSIDE=1`` or the caller's ``allow_outside``
 allows otherwise; :func:`resolve_mjcf_uri` returns only files that passed
-:func:`~openral_hal.mjcf_confinement.check_mjcf_files`. Nothing is ever downloaded or imported.
+:func:`~openral_mujoco.mjcf_confinement.check_mjcf_files`. Nothing is ever downloaded or imported.
 Every failure is one :class:`MjcfUriError` that names the manifest, the URI and what to do.
 """
 
@@ -32,7 +32,7 @@ from openral_core.located import error_at, source_file
 from openral_core.models import RobotDescription
 from openral_core.registry import manifest_path
 
-from openral_hal.mjcf_confinement import (
+from openral_mujoco.mjcf_confinement import (
     ALLOW_OUTSIDE_ENV,
     Confinement,
     MjcfConfinementError,

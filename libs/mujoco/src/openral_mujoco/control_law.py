@@ -9,8 +9,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from openral_hal.mjcf_model import is_position_servo, is_scalar_joint
-from openral_hal.state import FloatArray
+from openral_mujoco.mjcf_model import is_position_servo, is_scalar_joint
+from openral_mujoco.state import FloatArray
 
 
 def pd_torque(

@@ -6,7 +6,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from openral_hal.state import FloatArray
+from openral_mujoco.state import FloatArray
 
 
 def ctrl_limits(model: mujoco.MjModel) -> tuple[FloatArray, FloatArray]:

@@ -15,7 +15,7 @@ import re
 from collections import Counter
 from collections.abc import Sequence
 
-from openral_hal.errors import HalError
+from openral_mujoco.errors import HalError
 
 ROBOSUITE_PREFIX = re.compile(r"^(?:robot\d+|gripper\d+(?:_(?:right|left))?)_")
 """The prefixes robosuite gives the joints of robot ``k`` and of its grippers."""

@@ -13,8 +13,8 @@ from numbers import Real
 
 import numpy as np
 
-from openral_hal.errors import ActionRejected
-from openral_hal.state import FloatArray
+from openral_mujoco.errors import ActionRejected
+from openral_mujoco.state import FloatArray
 
 
 def validated_action(action: object, names: Sequence[str]) -> FloatArray:

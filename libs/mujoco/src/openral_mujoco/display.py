@@ -1,4 +1,4 @@
-"""Is there a screen? And, without one, the offscreen GL backend MuJoCo renders with.
+"""Is there a screen? And the one place that chooses the GL backend MuJoCo renders with.
 
 Imports nothing heavy: it must run before the first ``import mujoco``, which reads
 ``MUJOCO_GL`` once.
@@ -21,3 +21,9 @@ def render_offscreen_when_headless() -> None:
     """Without a display, make MuJoCo render with EGL (unless ``MUJOCO_GL`` is already set)."""
     if not has_display():
         os.environ.setdefault("MUJOCO_GL", OFFSCREEN_GL)
+
+
+def use_offscreen_gl() -> None:
+    """Render offscreen with EGL even with a display (unless ``MUJOCO_GL`` is already set):
+    for code that never opens a window (robosuite's renderer, the docs pictures)."""
+    os.environ.setdefault("MUJOCO_GL", OFFSCREEN_GL)

@@ -12,7 +12,7 @@ from openral_core.located import error_at, issue_at
 from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
 from openral_core.tables import HalWiring, hal_wiring
 
-from openral_hal.mjcf_model import actuator_joints, root_is_free
+from openral_mujoco.mjcf_model import actuator_joints, root_is_free
 
 
 @dataclass(frozen=True)
