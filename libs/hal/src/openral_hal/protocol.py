@@ -1,0 +1,155 @@
+"""The HAL contract as typing Protocols: what every HAL does, and what some can do more.
+
+Every HAL (:class:`RobotHal`) connects, reports joint state, takes actions in its action
+spec's slots, and latches an E-stop. Capabilities are separate Protocols, checked with
+``isinstance`` (all are ``runtime_checkable``), never with ``getattr``:
+
+* :class:`CameraHal` renders the manifest's RGB sensors;
+* :class:`IdleSteppable` can be advanced with its hold action between commands (simulated
+  HALs only; a real HAL never is);
+* :class:`MujocoBacked` exposes the live MuJoCo model and data.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol, runtime_checkable
+
+import mujoco
+import numpy as np
+import numpy.typing as npt
+from openral_core.models import RobotDescription
+from openral_mujoco.state import FloatArray, JointStateSample
+
+from openral_hal.errors import EStopLatched
+
+
+@runtime_checkable
+class RobotHal(Protocol):
+    """The core calls every HAL answers, simulated or real."""
+
+    @property
+    def is_real(self) -> bool:
+        """True for real hardware (never idle-stepped, never attached to a scene)."""
+        ...
+
+    @property
+    def description(self) -> RobotDescription:
+        """The manifest this HAL was built from."""
+        ...
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Canonical joint names, in manifest order (the order of every joint state)."""
+        ...
+
+    @property
+    def connected(self) -> bool:
+        """True between :meth:`connect` and :meth:`disconnect`."""
+        ...
+
+    def connect(self) -> None:
+        """Load or open the robot and hold its start pose."""
+        ...
+
+    def disconnect(self) -> None:
+        """Release the robot."""
+        ...
+
+    def read_state(self) -> JointStateSample:
+        """Every manifest joint, in manifest order and manifest units."""
+        ...
+
+    @property
+    def action_names(self) -> tuple[str, ...]:
+        """One name per action slot (the manifest joints on every native path)."""
+        ...
+
+    def hold_action(self) -> FloatArray:
+        """The action that keeps the robot where it is commanded to be now."""
+        ...
+
+    def send_action(self, action: object) -> None:
+        """Command one action (``len(action_names)`` finite values); refused actions change
+        nothing."""
+        ...
+
+    @property
+    def estopped(self) -> bool:
+        """True while the E-stop is latched."""
+        ...
+
+    def estop(self) -> None:
+        """Latch the E-stop: actions are refused and the robot is held."""
+        ...
+
+    def release_estop(self) -> None:
+        """Unlatch the E-stop without moving the robot."""
+        ...
+
+
+@runtime_checkable
+class CameraHal(RobotHal, Protocol):
+    """A HAL that renders the manifest's RGB sensors."""
+
+    def read_images(self) -> dict[str, npt.NDArray[np.uint8]]:
+        """Last frame (H x W x 3, uint8) of each RGB sensor, by sensor name."""
+        ...
+
+    def camera_fovy_deg(self, sensor: str) -> float | None:
+        """Vertical field of view of the camera that renders ``sensor`` [deg], if known."""
+        ...
+
+
+@runtime_checkable
+class IdleSteppable(RobotHal, Protocol):
+    """A simulated HAL that can be advanced with its hold action while nobody commands it."""
+
+    @property
+    def last_action_ns(self) -> int:
+        """``time.monotonic_ns()`` of the last :meth:`send_action` call (0: never)."""
+        ...
+
+    def idle_step(self) -> bool:
+        """Advance one control period holding; False (nothing done) while E-stopped."""
+        ...
+
+
+@runtime_checkable
+class MujocoBacked(Protocol):
+    """A HAL whose robot lives in a MuJoCo model it can hand out."""
+
+    def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
+        """The live (model, data), or None when the backend is not MuJoCo."""
+        ...
+
+
+class EStopLatch:
+    """The E-stop latch, written once for every HAL (a mixin).
+
+    A HAL calls :meth:`_refuse_when_estopped` before applying an action and overrides
+    :meth:`_on_release` to re-aim its targets at the current pose so nothing jumps.
+    """
+
+    _estopped: bool = False
+
+    @property
+    def estopped(self) -> bool:
+        """True while the E-stop is latched."""
+        return self._estopped
+
+    def estop(self) -> None:
+        """Latch the E-stop: actions are refused and the robot is held."""
+        self._estopped = True
+
+    def release_estop(self) -> None:
+        """Unlatch the E-stop; the HAL's targets are the current pose, so nothing jumps."""
+        self._on_release()
+        self._estopped = False
+
+    def _on_release(self) -> None:
+        """Hook run before unlatching (default: nothing)."""
+
+    def _refuse_when_estopped(self) -> None:
+        """Raise EStopLatched while latched."""
+        if self._estopped:
+            raise EStopLatched("E-stop is latched; call release_estop() before sending actions")
