@@ -17,6 +17,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Callable
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -40,6 +41,13 @@ BOOT_TIMEOUT_S = 60.0
 WATCHER_SETTLE_S = 1.5
 """Pause between starting the watcher's participant and launching the command [s]."""
 CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
+Run = dict[str, Any]
+"""One launch's measures, as ``one_run`` returns them and the JSON stores them."""
+
+
+def camera_topic(camera: str) -> str:
+    """The image topic ``openral deploy sim`` publishes for ``camera``."""
+    return f"/openral/cameras/{camera}/image"
 
 
 class Watcher:
@@ -51,7 +59,7 @@ class Watcher:
             JointState, "/joint_states", partial(self._on, "/joint_states"), 50
         )
         for camera in cameras:
-            topic = f"/openral/cameras/{camera}/image"
+            topic = camera_topic(camera)
             self.arrivals[topic] = []
             node.create_subscription(Image, topic, partial(self._on, topic), 50)
         self.changed = threading.Condition()
@@ -61,7 +69,7 @@ class Watcher:
             self.arrivals[topic].append(time.monotonic())
             self.changed.notify_all()
 
-    def wait(self, predicate: Any, timeout_s: float) -> bool:
+    def wait(self, predicate: Callable[[], bool], timeout_s: float) -> bool:
         with self.changed:
             return self.changed.wait_for(predicate, timeout_s)
 
@@ -85,7 +93,7 @@ def _watch_stdout(process: subprocess.Popen[str], active: list[float]) -> None:
             active.append(time.monotonic())
 
 
-def one_run(scene: Path, cameras: list[str], window_s: float, rate_hz: float) -> dict[str, Any]:
+def one_run(scene: Path, cameras: list[str], window_s: float, rate_hz: float) -> Run:
     """Launch, wait for every first message, measure a window, stop with SIGINT."""
     domain = claim_domain_id()
     with ros_session(domain_id=domain) as context, Spinner(context) as spinner:
@@ -127,7 +135,7 @@ def one_run(scene: Path, cameras: list[str], window_s: float, rate_hz: float) ->
                 process.kill()
                 reader.join(5)
         spinner.stop()
-        node.destroy_node()
+        node.destroy_node()  # type: ignore[no-untyped-call]
     rates = {}
     for topic, arrivals in counts.items():
         span = arrivals[-1] - arrivals[0] if len(arrivals) > 1 else float("nan")
@@ -142,39 +150,39 @@ def one_run(scene: Path, cameras: list[str], window_s: float, rate_hz: float) ->
     }
 
 
-def main() -> int:
+def parse_args() -> argparse.Namespace:
+    """The command line: scene, number of runs, measuring window and camera rate."""
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--scene", type=Path, default=DEFAULT_SCENE, help="deploy-scene file")
     parser.add_argument("--runs", type=int, default=3, help="launches to time")
     parser.add_argument("--window", type=float, default=10.0, help="rate/CPU window [s]")
     parser.add_argument("--camera-rate", type=float, default=10.0, help="camera rate [Hz]")
-    args = parser.parse_args()
-    cameras = list(load_scene(args.scene).scene.cameras)
-    console = Console()
-    load_before = os.getloadavg()
+    return parser.parse_args()
+
+
+def time_runs(args: argparse.Namespace, cameras: list[str], console: Console) -> list[Run]:
+    """Launch and measure ``args.runs`` times, announcing each run."""
     runs = []
     for index in range(args.runs):
         console.print(f"run {index + 1}/{args.runs} …")
         runs.append(one_run(args.scene, cameras, args.window, args.camera_rate))
+    return runs
 
-    load = ", ".join(f"{x:.2f}" for x in load_before)
-    table = Table(
-        title=f"deploy sim start-up and streaming: {args.scene.name}, {args.runs} runs",
-        caption=f"load average before: {load} on {os.cpu_count()} cores",
+
+def _target_row(table: Table, label: str, values: list[float], target: float, unit: str) -> None:
+    """A row of median and worst (green within ``target``, red over it) against the target."""
+    worst = max(values)
+    colour = "green" if worst <= target else "red"
+    table.add_row(
+        label,
+        f"{statistics.median(values):.2f} {unit}",
+        f"[{colour}]{worst:.2f} {unit}[/]",
+        f"< {target:g} {unit}",
     )
-    for column in ("measure", "median", "worst", "target"):
-        table.add_column(column, justify="left" if column == "measure" else "right")
 
-    def row(label: str, values: list[float], target: float, unit: str, worst: float) -> None:
-        ok = worst <= target
-        colour = "green" if ok else "red"
-        table.add_row(
-            label,
-            f"{statistics.median(values):.2f} {unit}",
-            f"[{colour}]{worst:.2f} {unit}[/]",
-            f"< {target:g} {unit}",
-        )
 
+def _startup_rows(table: Table, runs: list[Run], cameras: list[str]) -> None:
+    """Launch to node active, to the first joint state and to each camera's first frame."""
     actives = [r["active_s"] for r in runs]
     table.add_row(
         "launch → node active (printed)",
@@ -183,14 +191,18 @@ def main() -> int:
         "",
     )
     states = [r["first_state_s"] for r in runs]
-    row("launch → first /joint_states", states, TARGETS["first_state_s"], "s", max(states))
+    _target_row(table, "launch → first /joint_states", states, TARGETS["first_state_s"], "s")
     for camera in cameras:
-        topic = f"/openral/cameras/{camera}/image"
-        firsts = [r["first_frame_s"][topic] for r in runs]
-        row(f"launch → first {camera} frame", firsts, TARGETS["first_frame_s"], "s", max(firsts))
+        firsts = [r["first_frame_s"][camera_topic(camera)] for r in runs]
+        _target_row(table, f"launch → first {camera} frame", firsts, TARGETS["first_frame_s"], "s")
+
+
+def _streaming_rows(
+    table: Table, runs: list[Run], cameras: list[str], args: argparse.Namespace
+) -> None:
+    """Each camera's rate error over the window, the joint-state rate and the deploy CPU."""
     for camera in cameras:
-        topic = f"/openral/cameras/{camera}/image"
-        rates = [r["rates_hz"][topic] for r in runs]
+        rates = [r["rates_hz"][camera_topic(camera)] for r in runs]
         worst = max(abs(x - args.camera_rate) / args.camera_rate for x in rates)
         table.add_row(
             f"{camera} rate over {args.window:g} s",
@@ -202,13 +214,36 @@ def main() -> int:
     table.add_row("/joint_states rate", f"{statistics.median(states_hz):.1f} Hz", "", "")
     cpu = [r["cpu_percent"] for r in runs]
     table.add_row("deploy process CPU", f"{statistics.median(cpu):.0f} %", f"{max(cpu):.0f} %", "")
-    console.print(table)
-    path = write_results(
+
+
+def results_table(
+    args: argparse.Namespace,
+    cameras: list[str],
+    runs: list[Run],
+    load_before: tuple[float, float, float],
+) -> Table:
+    """The printed summary: start-up rows, then streaming rows, median and worst of the runs."""
+    load = ", ".join(f"{x:.2f}" for x in load_before)
+    table = Table(
+        title=f"deploy sim start-up and streaming: {args.scene.name}, {args.runs} runs",
+        caption=f"load average before: {load} on {os.cpu_count()} cores",
+    )
+    for column in ("measure", "median", "worst", "target"):
+        table.add_column(column, justify="left" if column == "measure" else "right")
+    _startup_rows(table, runs, cameras)
+    _streaming_rows(table, runs, cameras, args)
+    return table
+
+
+def save_results(
+    args: argparse.Namespace, runs: list[Run], load_before: tuple[float, float, float]
+) -> Path:
+    """Write the settings, targets and every run to ``benchmarks/results/deploy_startup.json``."""
+    scene = args.scene.relative_to(REPO) if args.scene.is_relative_to(REPO) else args.scene
+    return write_results(
         "deploy_startup",
         {
-            "scene": str(
-                args.scene.relative_to(REPO) if args.scene.is_relative_to(REPO) else args.scene
-            ),
+            "scene": str(scene),
             "camera_rate_hz": args.camera_rate,
             "window_s": args.window,
             "cpu_count": os.cpu_count(),
@@ -217,6 +252,17 @@ def main() -> int:
             "runs": runs,
         },
     )
+
+
+def main() -> int:
+    """Time the runs, print the table, write the JSON; 1 if any run did not exit cleanly."""
+    args = parse_args()
+    cameras = list(load_scene(args.scene).scene.cameras)
+    console = Console()
+    load_before = os.getloadavg()
+    runs = time_runs(args, cameras, console)
+    console.print(results_table(args, cameras, runs, load_before))
+    path = save_results(args, runs, load_before)
     console.print(
         f"Times from Popen (includes interpreter start-up); rates from arrival times at a "
         f"subscriber in this process; CPU: 100 % = one core. Written to {path}."
