@@ -1,4 +1,5 @@
-"""SimAttachedHAL, build_hal and the idle-step predicate (ADR-0034 scene attach + idle stepper).
+"""SimAttachedHAL and the idle-step predicate (ADR-0034 scene attach + idle stepper);
+build_hal is tested in ``test_build_hal.py``.
 
 Two honest fakes stand in for scene backends: a tiny MuJoCo arm whose joints carry
 robosuite's ``robot0_`` prefix and whose fixed camera really renders, and a non-MuJoCo
@@ -25,8 +26,6 @@ from openral_core.errors import ManifestError
 from openral_core.loader import load_robot
 from openral_core.models import RobotDescription
 from openral_hal.errors import ActionRejected, ConfigurationError, EStopLatched
-from openral_hal.factory import REAL_DRIVERS, build_hal, can_idle_step, register_real_driver
-from openral_hal.mujoco_arm import MujocoArmHAL
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_sim.rollout import Observation, SimRollout, StepResult
 
@@ -381,102 +380,6 @@ def test_connect_without_an_action_width_names_the_backend(fake_arm: RobotDescri
     override = _attached(fake_arm, NonMujocoRollout(action_dim=None), env_action_dim=4)
     assert override.action_dim == 4
     override.send_action([0.0, 1.0, 2.0, 3.0])
-
-
-# -- build_hal ---------------------------------------------------------------------------
-
-
-class FakeRealHAL:
-    is_real = True
-
-    def __init__(self, description: RobotDescription, transport: str | None) -> None:
-        self.description, self.transport = description, transport
-
-
-def test_build_hal_sim_without_scene_gives_the_bare_twin() -> None:
-    hal = build_hal(load_robot_by_id("franka_panda"), mode="sim")
-    assert isinstance(hal, MujocoArmHAL)
-    assert hal.is_real is False and not can_idle_step(hal)
-
-
-def test_build_hal_sim_with_scene_attaches(
-    tmp_path: Path, fake_arm: RobotDescription, arm_env: Callable[..., MujocoArmRollout]
-) -> None:
-    scene = tmp_path / "scene.yaml"
-    scene.write_text(
-        'schema_version: "0.1"\nrobot_id: fake_arm\nseed: 7\n'
-        "scene: {id: t, backend: native, observation: {width: 32, height: 32}, "
-        "cameras: [agentview]}\n"
-    )
-    built: list[Path] = []
-
-    def builder(path: Path) -> SimRollout:
-        built.append(path)
-        return arm_env()
-
-    hal = build_hal(fake_arm, mode="sim", sim_env_yaml=str(scene), env_builder=builder)
-    assert isinstance(hal, SimAttachedHAL) and built == [scene]
-    assert hal.env_reset_seed == 7 and can_idle_step(hal)
-    no_file = build_hal(
-        fake_arm, mode="sim", sim_env_yaml=tmp_path / "none.yaml", env_builder=builder
-    )
-    assert isinstance(no_file, SimAttachedHAL) and no_file.env_reset_seed == 0
-
-
-def test_build_hal_refuses_a_scene_for_another_robot(
-    tmp_path: Path, fake_arm: RobotDescription
-) -> None:
-    scene = tmp_path / "scene.yaml"
-    scene.write_text(
-        'schema_version: "0.1"\nrobot_id: ur5e\n'
-        "scene: {id: t, backend: native, observation: {width: 32, height: 32}, cameras: []}\n"
-    )
-    with pytest.raises(ManifestError, match=r"scene\.yaml:2:1: robot_id: the scene is for ur5e"):
-        build_hal(
-            fake_arm, mode="sim", sim_env_yaml=scene, env_builder=lambda p: NonMujocoRollout()
-        )
-
-
-def test_build_hal_real_never_attaches_a_scene(fake_arm: RobotDescription) -> None:
-    with pytest.raises(ConfigurationError, match="real robot cannot attach"):
-        build_hal(fake_arm, mode="real", sim_env_yaml="scene.yaml")
-
-
-def test_build_hal_real_without_a_driver_names_the_robot(
-    fake_arm: RobotDescription, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    monkeypatch.setitem(REAL_DRIVERS, "other_arm", FakeRealHAL)
-    with pytest.raises(ConfigurationError, match="no real driver registered for fake_arm") as e:
-        build_hal(fake_arm, mode="real")
-    assert "other_arm" in str(e.value)
-
-
-def test_a_real_driver_has_no_idle_step(
-    fake_arm: RobotDescription, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    monkeypatch.setattr("openral_hal.factory.REAL_DRIVERS", {})
-    register_real_driver("fake_arm", FakeRealHAL)
-    hal = build_hal(fake_arm, mode="real", transport="can0")
-    assert isinstance(hal, FakeRealHAL) and hal.transport == "can0"
-    assert not hasattr(hal, "idle_step") and not can_idle_step(hal)
-
-
-def test_a_real_driver_offering_idle_step_is_refused(
-    fake_arm: RobotDescription, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    class SteppingRealHAL(FakeRealHAL):
-        def idle_step(self) -> bool:
-            return True
-
-    monkeypatch.setitem(REAL_DRIVERS, "fake_arm", SteppingRealHAL)
-    with pytest.raises(ConfigurationError, match="idle_step"):
-        build_hal(fake_arm, mode="real")
-    assert not can_idle_step(SteppingRealHAL(fake_arm, None))  # is_real wins regardless
-
-
-def test_build_hal_rejects_an_unknown_mode(fake_arm: RobotDescription) -> None:
-    with pytest.raises(ConfigurationError, match="unknown HAL mode"):
-        build_hal(fake_arm, mode="replay")
 
 
 # -- the idle predicate ------------------------------------------------------------------

@@ -3,7 +3,8 @@
 Parameters (all read at configure):
 
 - ``robot_id`` (str) or ``manifest_path`` (str): which robot; with neither, the robot the
-  ``sim_env_yaml`` scene names;
+  ``sim_env_yaml`` scene names. A ``manifest_path`` runs that file as it reads (not the
+  repository's manifest of the same id); a scene naming another robot is refused;
 - ``hal_mode`` (``sim`` | ``real``), ``sim_env_yaml`` (a deploy-scene file, ``""`` for none);
 - ``viewer_enabled`` (bool), ``camera_publish_rate_hz`` (float) and ``joint_state_rate_hz``
   (float) within :data:`RATE_RANGE_HZ`, ``idle_hold_ms`` (float) within
@@ -11,7 +12,8 @@ Parameters (all read at configure):
 
 Transitions:
 
-- configure → ``build_hal`` (a bad manifest, scene or mode fails here with one message);
+- configure → load the robot and the scene file once, then ``build_hal`` with both (a bad
+  manifest, scene or mode fails here with one message);
 - activate → connect the HAL, publish ``/joint_states``, ``/clock`` and the latched
   ``/openral/action_spec``, subscribe ``/openral/safe_action``, offer the E-stop services and
   start the :class:`~openral_bridge.SimSensorBridge`;
@@ -49,12 +51,14 @@ from openral_bridge.topics import (
     RELEASE_ESTOP,
     SAFE_ACTION,
 )
+from openral_core import LoadedRobot, open_robot, open_robot_by_id
 from openral_core.errors import OpenralError
-from openral_core.loader import load_robot, load_scene
-from openral_core.models import RobotDescription
-from openral_core.registry import load_robot_by_id
-from openral_hal.errors import HalError
+from openral_core.loader import load_scene
+from openral_core.models import DeployScene, RobotDescription
+from openral_hal.errors import HalError, NotConnected
 from openral_hal.factory import build_hal
+from openral_hal.protocol import RobotHal
+from openral_sim.scene import scene_robot
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
@@ -134,7 +138,7 @@ class ManifestLifecycleNode(LifecycleNode):
         for name, default in PARAMETERS.items():
             self.declare_parameter(name, default)
         self.description: RobotDescription | None = None
-        self.hal: Any = None
+        self.hal: RobotHal | None = None
         self.bridge: SimSensorBridge | None = None
         self.log_boot_errors = log_boot_errors
         self.boot_error: str | None = None
@@ -149,26 +153,28 @@ class ManifestLifecycleNode(LifecycleNode):
     # -- transitions -----------------------------------------------------------------------
 
     def on_configure(self, state: LifecycleState) -> Any:
-        """Load the manifest and build the HAL; FAILURE (stay unconfigured) with the reason."""
+        """Load the robot and scene once and build the HAL; FAILURE (stay unconfigured) with
+        the reason."""
         try:
             self._check_rates()
-            self.description = self._load_description()
-            scene = self._param("sim_env_yaml") or None
-            self.hal = build_hal(self.description, mode=self._param("hal_mode"), sim_env_yaml=scene)
+            robot, scene = self._load()
+            self.hal = build_hal(robot, mode=str(self._param("hal_mode")), scene=scene)
+            self.description = robot.description
         except (OpenralError, ValueError) as error:
             return self._fail_configure(str(error))
         except Exception as error:  # anything else is a bug; report it the same way
             return self._fail_configure(f"{type(error).__name__}: {error}")
         self.boot_error = None
-        self._log().info(f"configured {self.description.name} ({type(self.hal).__name__})")
+        self._log().info(f"configured {robot.name} ({type(self.hal).__name__})")
         return Result.SUCCESS
 
     def on_activate(self, state: LifecycleState) -> Any:
         """Connect the HAL and start publishing, subscribing and serving; FAILURE (stay
         inactive) with :attr:`boot_error` set when the HAL does not connect."""
         try:
-            if not self.hal.connected:
-                self.hal.connect()
+            hal = self._hal()
+            if not hal.connected:
+                hal.connect()
         except Exception as error:  # a HAL or renderer failure; report it, stay inactive
             text = (
                 str(error)
@@ -181,11 +187,10 @@ class ManifestLifecycleNode(LifecycleNode):
             return Result.FAILURE
         self._state_rate_hz = float(self._param("joint_state_rate_hz"))
         self._create_entities()
-        assert self.description is not None
         self.bridge = SimSensorBridge(
             self,
-            self.hal,
-            self.description,
+            hal,
+            hal.description,
             viewer_enabled=bool(self._param("viewer_enabled")),
             camera_rate_hz=float(self._param("camera_publish_rate_hz")),
             idle_hold_ms=float(self._param("idle_hold_ms")),
@@ -239,13 +244,9 @@ class ManifestLifecycleNode(LifecycleNode):
 
     def action_layout(self) -> tuple[tuple[str, ...], list[float]]:
         """Slot names and hold action of the connected HAL (what ``action_spec`` carries)."""
-        names = getattr(self.hal, "action_names", None) or tuple(self.hal.joint_names)
-        hold_action = getattr(self.hal, "hold_action", None)
-        if callable(hold_action):
-            hold = np.asarray(hold_action(), dtype=np.float64)
-        else:
-            hold = np.asarray(self.hal.read_state().positions, dtype=np.float64)
-        return tuple(names), hold.tolist()
+        hal = self._hal()
+        hold: list[float] = np.asarray(hal.hold_action(), dtype=np.float64).tolist()
+        return tuple(hal.action_names), hold
 
     # -- internals -------------------------------------------------------------------------
 
@@ -263,18 +264,33 @@ class ManifestLifecycleNode(LifecycleNode):
                     f"parameter {name} must be within {low:g}-{high:g} {unit}, got {value:g}"
                 )
 
-    def _load_description(self) -> RobotDescription:
-        robot_id, manifest = self._param("robot_id"), self._param("manifest_path")
+    def _hal(self) -> RobotHal:
+        if self.hal is None:
+            raise NotConnected("the node has no HAL; configure it first")
+        return self.hal
+
+    def _load(self) -> tuple[LoadedRobot, DeployScene | None]:
+        """The robot and the scene, each read from its file once (the scene's robot is
+        checked against the robot by ``build_hal``)."""
+        robot_id, manifest = str(self._param("robot_id")), str(self._param("manifest_path"))
+        scene_file = str(self._param("sim_env_yaml"))
+        scene = load_scene(Path(scene_file)) if scene_file else None
         if manifest:
-            return load_robot(Path(manifest))
-        if not robot_id and self._param("sim_env_yaml"):
-            robot_id = load_scene(Path(self._param("sim_env_yaml"))).robot_id or ""
-        if not robot_id:
-            raise ValueError(
-                "no robot: set parameter robot_id or manifest_path, or a sim_env_yaml scene "
-                "that names its robot_id"
-            )
-        return load_robot_by_id(robot_id)
+            robot = open_robot(Path(manifest))
+            if robot_id and robot_id != robot.name:
+                raise ValueError(
+                    f"parameter robot_id is {robot_id} but manifest_path {manifest} is "
+                    f"{robot.name}; set one of them"
+                )
+            return robot, scene
+        if robot_id:
+            return open_robot_by_id(robot_id), scene
+        if scene is not None and scene.robot_id:
+            return scene_robot(scene), scene
+        raise ValueError(
+            "no robot: set parameter robot_id or manifest_path, or a sim_env_yaml scene "
+            "that names its robot_id"
+        )
 
     def _fail_configure(self, message: str) -> Any:
         self.boot_error = message
@@ -306,7 +322,7 @@ class ManifestLifecycleNode(LifecycleNode):
         self._publish_state()
 
     def _publish_state(self) -> None:
-        sample = self.hal.read_state()
+        sample = self._hal().read_state()
         sim_time = sample.sim_time_s
         stamp_msg = (
             ros_messages.stamp(sim_time)
@@ -324,7 +340,7 @@ class ManifestLifecycleNode(LifecycleNode):
     def _on_safe_action(self, msg: Any) -> None:
         values = np.asarray(msg.data, dtype=np.float64)
         try:
-            self.hal.send_action(values)
+            self._hal().send_action(values)
         except HalError as error:
             self.actions_refused += 1
             self._log().warning(f"action refused: {error}", throttle_duration_sec=WARN_EVERY_S)
@@ -332,13 +348,13 @@ class ManifestLifecycleNode(LifecycleNode):
         self.actions_applied += 1
 
     def _on_estop(self, request: Any, response: Any) -> Any:
-        self.hal.estop()
+        self._hal().estop()
         self._log().warning("E-stop latched: actions are refused and the scene is frozen")
         response.success, response.message = True, "E-stop latched"
         return response
 
     def _on_release_estop(self, request: Any, response: Any) -> Any:
-        self.hal.release_estop()
+        self._hal().release_estop()
         self._log().info("E-stop released")
         response.success, response.message = True, "E-stop released"
         return response
@@ -359,7 +375,7 @@ class ManifestLifecycleNode(LifecycleNode):
 
     def _release(self) -> None:
         self._stop()
-        if self.hal is not None and getattr(self.hal, "connected", False):
+        if self.hal is not None and self.hal.connected:
             self.hal.disconnect()
         self.hal = None
         self.description = None

@@ -2,9 +2,9 @@
 
 Frames arrive on ``/openral/cameras/<sensor>/image`` keyed by the manifest sensor name;
 policies look them up by VLA slot (``camera1`` …). The two are joined through the
-derived slot table (:func:`openral_core.tables.vla_slots`: the table ``openral robot show``
-prints and ``just schema-export`` writes under ``generated/``), so the rule lives in one
-place.
+derived slot table of the loaded robot (``LoadedRobot.tables.vla_slots``: the table
+``openral robot show`` prints and ``just schema-export`` writes under ``generated/``), so
+the rule lives in one place.
 
 Each tick (``rate_hz``) the node builds an :class:`~openral_nodes.policies.Observation`
 from the latest frames, ``/joint_states`` and the latched ``/openral/action_spec``, calls
@@ -24,7 +24,7 @@ from typing import Any, TypeVar
 import numpy as np
 import numpy.typing as npt
 from openral_bridge import topics
-from openral_core import VlaSlot, load_robot_by_id, vla_slots
+from openral_core import VlaSlot, open_robot_by_id
 from openral_core.errors import OpenralError
 from rclpy.context import Context
 from rclpy.node import Node
@@ -136,9 +136,9 @@ class RskillRunnerNode(Node):
         self.frame_timeout_s = float(self.declare_parameter("frame_timeout_s", 5.0).value)
         if rate_hz <= 0:
             raise RunnerAborted(f"rate_hz must be > 0, got {rate_hz:g}")
-        description = load_robot_by_id(robot_id)
-        self.robot = description.name
-        self.slot_table = vla_slots(description)
+        robot = open_robot_by_id(robot_id)
+        self.robot = robot.name
+        self.slot_table = robot.tables.vla_slots
         self.policy = policy or make_policy(policy_name, parse_params(params or []))
         self.policy_name = policy_name if policy is None else type(policy).__name__
         provided = [entry.slot for entry in self.slot_table]
@@ -152,7 +152,7 @@ class RskillRunnerNode(Node):
                 "the manifest provides",
                 "; pick another policy or set its required_slots parameter",
             )
-        self._joint_names = [joint.name for joint in description.joints]
+        self._joint_names = [joint.name for joint in robot.description.joints]
         self._frames: dict[str, tuple[float, Any]] = {}
         self._joints: dict[str, float] = {}
         self._spec: tuple[tuple[str, ...], npt.NDArray[np.float64]] | None = None

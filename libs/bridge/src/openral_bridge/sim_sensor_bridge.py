@@ -28,6 +28,7 @@ from typing import Any
 import mujoco
 from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
 from openral_hal.factory import can_idle_step
+from openral_hal.protocol import CameraHal, IdleSteppable, MujocoBacked, RobotHal
 from openral_mujoco.display import has_display
 
 from openral_bridge import ros_messages
@@ -53,7 +54,7 @@ class SimSensorBridge:
     def __init__(
         self,
         node: Any,
-        hal: Any,
+        hal: RobotHal,
         description: RobotDescription,
         *,
         viewer_enabled: bool = True,
@@ -65,7 +66,8 @@ class SimSensorBridge:
 
         Args:
             node: The rclpy node that owns the publishers and timers.
-            hal: A connected HAL; images need ``read_images``, idle stepping ``idle_step``.
+            hal: A connected HAL; images need :class:`CameraHal`, idle stepping a simulated
+                :class:`IdleSteppable`, the viewer :class:`MujocoBacked`.
             description: The robot's manifest (sensors, frame ids).
             viewer_enabled: Open the MuJoCo passive viewer when a display exists.
             camera_rate_hz: Camera publish rate, also the idle-step rate [Hz].
@@ -96,6 +98,8 @@ class SimSensorBridge:
         self._publishers: list[Any] = []
         self._image_pubs: dict[str, tuple[Any, Any | None]] = {}
         self._camera_timer: Any = None
+        self._camera_hal: CameraHal | None = None
+        self._stepper: IdleSteppable | None = None
         self._idle_timer: Any = None
         self._viewer: Any = None
         self._viewer_timer: Any = None
@@ -132,6 +136,7 @@ class SimSensorBridge:
         self._publishers.clear()
         self._image_pubs.clear()
         self._cameras.clear()
+        self._camera_hal = self._stepper = None
         if self._viewer is not None:
             viewer, self._viewer = self._viewer, None
             viewer.close()
@@ -150,15 +155,16 @@ class SimSensorBridge:
     # -- cameras ---------------------------------------------------------------------------
 
     def _setup_cameras(self) -> None:
-        if not callable(getattr(self.hal, "read_images", None)):
+        hal = self.hal
+        if not isinstance(hal, CameraHal):
             return
         from sensor_msgs.msg import CameraInfo, Image
 
-        rendered = self.hal.read_images()
+        rendered = hal.read_images()
         for sensor in self.description.sensors:
             if not isinstance(sensor, RgbSensor) or sensor.name not in rendered:
                 continue
-            fovy = self._fovy_deg(sensor)
+            fovy = self._fovy_deg(hal, sensor)
             self._cameras[sensor.name] = (sensor, fovy)
             image = self.node.create_publisher(Image, camera_image(sensor.name), IMAGE_QUEUE_DEPTH)
             self._publishers.append(image)
@@ -169,13 +175,16 @@ class SimSensorBridge:
                 self._publishers.append(info)
             self._image_pubs[sensor.name] = (image, info)
         if self._image_pubs:
+            self._camera_hal = hal
             self._publish_images()
             self._camera_timer = self.node.create_timer(
                 1.0 / self.camera_rate_hz, self._publish_images
             )
 
     def _publish_images(self) -> None:
-        images = self.hal.read_images()
+        if self._camera_hal is None:
+            return
+        images = self._camera_hal.read_images()
         stamp = ros_messages.stamp(self._sim_time_s())
         published = False
         for name, (image_pub, info_pub) in self._image_pubs.items():
@@ -197,10 +206,9 @@ class SimSensorBridge:
             return float(self.node.get_clock().now().nanoseconds) / 1e9
         return float(sim_time)
 
-    def _fovy_deg(self, sensor: RgbSensor) -> float | None:
+    def _fovy_deg(self, hal: CameraHal, sensor: RgbSensor) -> float | None:
         """Vertical field of view [deg]: the scene camera's, else the manifest's."""
-        scene_fovy = getattr(self.hal, "camera_fovy_deg", None)
-        fovy = scene_fovy(sensor.name) if callable(scene_fovy) else None
+        fovy = hal.camera_fovy_deg(sensor.name)
         if fovy is not None:
             return float(fovy)
         if sensor.fovy_deg is not None:
@@ -212,20 +220,23 @@ class SimSensorBridge:
         return None
 
     def _handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
-        get = getattr(self.hal, "mujoco_handles", None)
-        return get() if callable(get) else None
+        return self.hal.mujoco_handles() if isinstance(self.hal, MujocoBacked) else None
 
     # -- idle stepper ----------------------------------------------------------------------
 
     def _setup_idle_stepper(self) -> None:
         if can_idle_step(self.hal):
+            self._stepper = self.hal
             self._idle_timer = self.node.create_timer(1.0 / self.camera_rate_hz, self._idle_tick)
 
     def _idle_tick(self) -> None:
-        if not should_idle_step(time.monotonic_ns(), self.hal.last_action_ns, self.idle_hold_ns):
+        stepper = self._stepper
+        if stepper is None:
+            return
+        if not should_idle_step(time.monotonic_ns(), stepper.last_action_ns, self.idle_hold_ns):
             return
         try:
-            stepped = self.hal.idle_step()
+            stepped = stepper.idle_step()
         except Exception as error:  # one report, then the stepper is off for good
             self.node.get_logger().error(
                 f"idle stepping disabled after {type(error).__name__}: {error}"

@@ -56,13 +56,14 @@ def render_robot(root: Path, robot_id: str) -> Render:
 
     use_offscreen_gl()
     import mujoco
+    from openral_core import open_robot_by_id
     from openral_core.loader import load_scene
-    from openral_sim.scene import build_sim_env_from_yaml
+    from openral_sim.scene import build_scene
 
-    scene_file = root / "robots" / robot_id / DEFAULT_SCENE
-    env = build_sim_env_from_yaml(scene_file)
+    scene = load_scene(root / "robots" / robot_id / DEFAULT_SCENE)
+    env = build_scene(scene, open_robot_by_id(robot_id, root / "robots"))
     try:
-        env.reset(seed=load_scene(scene_file).seed)
+        env.reset(seed=scene.seed)
         handles = env.mujoco_handles()
         if handles is None:
             raise CodegenError(f"{robot_id}: the default scene exposes no MuJoCo model")

@@ -195,10 +195,12 @@ def _robot_error(file: Path) -> str:
 
 
 def _scene_error(file: Path) -> str:
-    from openral_sim.scene import build_sim_env_from_yaml
+    from openral_core.loader import load_scene
+    from openral_sim.scene import build_scene, scene_robot
 
     try:
-        env = build_sim_env_from_yaml(file)
+        scene = load_scene(file)
+        env = build_scene(scene, scene_robot(scene))
     except OpenralError as error:
         return str(error)
     env.close()

@@ -6,6 +6,8 @@ Example::
 
 The scene's robot comes up as one :class:`~openral_nodes.manifest_node.ManifestLifecycleNode`
 in this process, driven through configure and activate here (there is no ``ros2 launch``).
+The node reads the scene file and the robot's manifest once, at configure; a problem in
+either ends the command with one line.
 It runs until Ctrl-C or SIGTERM (or ``--duration``), then deactivates, cleans up and
 exits 0; a ``shutdown`` transition requested over ROS ends it with exit 0 too.
 ``openral ros topics`` in a second terminal lists what it publishes.
@@ -17,7 +19,7 @@ import signal
 import threading
 import time
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from openral_core.errors import OpenralError
@@ -26,6 +28,10 @@ from rich.table import Table
 
 from openral_cli.console import out
 from openral_cli.ros_available import require_ros
+
+if TYPE_CHECKING:
+    from openral_nodes.manifest_node import ManifestLifecycleNode
+    from rclpy.context import Context
 
 app = typer.Typer(help="Run robots as ROS 2 graphs.", no_args_is_help=True)
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -57,13 +63,12 @@ def sim(
     ] = None,
 ) -> None:
     """Bring SCENE's robot up as a ROS 2 graph: joint states, cameras, actions, E-stop."""
-    robot_id = _scene_robot(config)
+    _require_file(config)
     require_ros()
     from openral_nodes.runtime import ros_session, spin_until
     from rclpy.executors import SingleThreadedExecutor
 
     parameters: dict[str, Any] = {
-        "robot_id": robot_id,
         "sim_env_yaml": str(config.resolve()),
         "hal_mode": "sim",
         "viewer_enabled": not no_viewer,
@@ -85,29 +90,25 @@ def sim(
         finally:
             reason = _shut_down(node, stop)
             executor.shutdown()
-            node.destroy_node()
+            node.destroy_node()  # type: ignore[no-untyped-call]
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
     stopped = f"stopped ({reason}) after {time.monotonic() - started:.1f} s; clean shutdown"
     out.print(stopped, soft_wrap=False, highlight=True)
 
 
-def _scene_robot(config: Path) -> str:
-    """The robot id a scene file names (checked before any ROS work starts)."""
-    from openral_core.loader import load_scene
-
+def _require_file(config: Path) -> None:
+    """A missing scene file is reported before any ROS work starts (the node reads it)."""
     if not config.is_file():
         raise OpenralError(
             f"{config}: no such scene file; expected a deploy-scene YAML such as "
             "robots/franka_panda/scenes/tabletop.yaml"
         )
-    scene = load_scene(config)
-    if not scene.robot_id:
-        raise OpenralError(f"{config}: robot_id: the scene names no robot; add robot_id")
-    return scene.robot_id
 
 
-def _make_node(context: Any, parameters: dict[str, Any], stop: threading.Event) -> Any:
+def _make_node(
+    context: Context, parameters: dict[str, Any], stop: threading.Event
+) -> ManifestLifecycleNode:
     """The manifest node as deploy runs it: boot errors reported by the caller, ``stop``
     set by a shutdown transition (also one requested over ROS)."""
     from openral_nodes.manifest_node import ManifestLifecycleNode
@@ -117,7 +118,7 @@ def _make_node(context: Any, parameters: dict[str, Any], stop: threading.Event) 
     )
 
 
-def _transition(node: Any, name: str) -> None:
+def _transition(node: ManifestLifecycleNode, name: str) -> None:
     """Run one lifecycle transition; a failure becomes one clear error."""
     from rclpy.lifecycle import TransitionCallbackReturn
 
@@ -126,7 +127,7 @@ def _transition(node: Any, name: str) -> None:
         raise OpenralError(f"{name} failed: {node.boot_error or result}")
 
 
-def _shut_down(node: Any, stop: threading.Event) -> str:
+def _shut_down(node: ManifestLifecycleNode, stop: threading.Event) -> str:
     """Deactivate and clean up from whatever state the node reached.
 
     Returns:
@@ -137,20 +138,21 @@ def _shut_down(node: Any, stop: threading.Event) -> str:
     if state == "finalized":
         return "shutdown transition requested over ROS"
     if state == "active":
-        node.trigger_deactivate()
+        node.trigger_deactivate()  # type: ignore[no-untyped-call]
         state = "inactive"
     if state == "inactive":
-        node.trigger_cleanup()
+        node.trigger_cleanup()  # type: ignore[no-untyped-call]
     return "signal" if stop.is_set() else "--duration"
 
 
-def _print_interfaces(node: Any, config: Path) -> None:
+def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
     """What the graph offers: published topics in a table (fits 80 columns), then inputs."""
     from openral_bridge.topics import ESTOP, RELEASE_ESTOP, SAFE_ACTION
 
     names, _ = node.action_layout()
+    robot = node.description.name if node.description is not None else "?"
     table = Table(
-        title=f"deploy sim: {node.description.name} in {config.name}",
+        title=f"deploy sim: {robot} in {config.name}",
         box=box.SIMPLE_HEAD,
         pad_edge=False,
     )

@@ -3,6 +3,9 @@
 Example::
 
     openral sim run --config robots/franka_panda/scenes/tabletop.yaml --steps 50 --out o/
+
+``joint_states.jsonl`` holds one line per step: ``{"step", "time", "positions"}`` with the
+positions keyed by the manifest's joint names, as ``/joint_states`` names them.
 """
 
 from __future__ import annotations
@@ -10,19 +13,31 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated
 
 import typer
-from openral_core.tables import joint_name_map
 from rich.table import Table
 
 from openral_cli.console import out, progress
+
+if TYPE_CHECKING:
+    from openral_hal.protocol import RobotHal
 
 app = typer.Typer(help="Run simulated scenes.", no_args_is_help=True)
 
 SWAY_RAD = 0.15
 """Amplitude of the demo motion around the start pose."""
+MOTIONS = ("sway", "hold")
+
+
+@dataclass
+class Recording:
+    """What a run saw: one joint-state record per step and the cameras that rendered."""
+
+    records: list[dict[str, object]] = field(default_factory=list)
+    cameras: list[str] = field(default_factory=list)
 
 
 @app.command("run")
@@ -42,73 +57,63 @@ def run(
     """Run SCENE headless for N control steps; save every camera frame and joint state.
 
     The scene is driven exactly as ``openral deploy sim`` drives it: through the
-    SimAttachedHAL that ``build_hal`` attaches, from the hold action of its backend.
+    SimAttachedHAL that ``build_hal`` attaches, from the hold action of its backend. The
+    scene file and the robot's manifest are each read once.
     """
-    from openral_core.errors import OpenralError
     from openral_core.loader import load_scene
-    from openral_core.registry import load_robot_by_id
-    from openral_hal.factory import build_hal
+    from openral_hal.factory import HalMode, build_hal
+    from openral_sim.scene import scene_robot
 
-    if motion not in ("sway", "hold"):
+    if motion not in MOTIONS:
         raise typer.BadParameter("expected 'sway' or 'hold'", param_hint="--motion")
     scene = load_scene(config)
-    robot_id = scene.robot_id or robot
-    if robot_id is None:
-        raise OpenralError(f"{config}: robot_id: the scene names no robot and none was given")
-    description = load_robot_by_id(robot_id)
-    hal = build_hal(description, mode="sim", sim_env_yaml=config)
+    loaded = scene_robot(scene, robot)
+    hal = build_hal(loaded, mode=HalMode.SIM, scene=scene)
     hal.connect()
     try:
         if out_dir:
             out_dir.mkdir(parents=True, exist_ok=True)
         with progress() as bar:
-            task = bar.add_task(f"{scene.scene.id} · {robot_id}", total=steps)
-            records, cameras = _drive(
-                hal, joint_name_map(description), steps, motion, out_dir, lambda: bar.advance(task)
-            )
+            task = bar.add_task(f"{scene.scene.id} · {loaded.name}", total=steps)
+            seen = _drive(hal, steps, motion, out_dir, lambda: bar.advance(task))
     finally:
         hal.disconnect()
     if out_dir:
-        (out_dir / "joint_states.jsonl").write_text("".join(json.dumps(r) + "\n" for r in records))
+        lines = "".join(json.dumps(record) + "\n" for record in seen.records)
+        (out_dir / "joint_states.jsonl").write_text(lines)
     table = Table(title=f"sim run: {config}")
     for column in ("robot", "backend", "steps", "cameras", "output"):
         table.add_column(column)
-    table.add_row(
-        robot_id, scene.scene.backend.value, str(steps), ", ".join(cameras), str(out_dir or "-")
-    )
+    cameras = ", ".join(seen.cameras)
+    backend = scene.scene.backend.value
+    table.add_row(loaded.name, backend, str(steps), cameras, str(out_dir or "-"))
     out.print(table, soft_wrap=False)  # centred title, as this command always printed it
 
 
 def _drive(
-    hal: Any,
-    mjcf_name: dict[str, str],
+    hal: RobotHal,
     steps: int,
     motion: str,
     out_dir: Path | None,
     advance: Callable[[], None],
-) -> tuple[list[dict[str, object]], list[str]]:
-    """Step a connected HAL from its hold action; the joint records and the camera names."""
+) -> Recording:
+    """Step a connected HAL from its hold action, recording joints (manifest names) and
+    camera frames (PNG files in ``out_dir``)."""
+    from openral_hal.protocol import CameraHal
     from openral_mujoco.png import write_png
 
     hold = hal.hold_action()
-    records: list[dict[str, object]] = []
-    cameras: list[str] = []
+    seen = Recording()
     for step in range(steps):
         phase = math.sin(2 * math.pi * step / max(steps, 20))
         hal.send_action(hold + (SWAY_RAD * phase if motion == "sway" else 0.0))
         state = hal.read_state()
-        positions = zip(state.names, state.positions, strict=True)
-        records.append(
-            {
-                "step": step,
-                "time": state.sim_time_s,
-                "positions": {mjcf_name[name]: float(value) for name, value in positions},
-            }
-        )
-        images = hal.read_images()
-        cameras = list(images)
+        positions = zip(state.names, state.positions.tolist(), strict=True)
+        seen.records.append({"step": step, "time": state.sim_time_s, "positions": dict(positions)})
+        images = hal.read_images() if isinstance(hal, CameraHal) else {}
+        seen.cameras = list(images)
         if out_dir:
             for camera, image in images.items():
                 write_png(out_dir / f"{camera}_{step:04d}.png", image)
         advance()
-    return records, cameras
+    return seen
