@@ -1,10 +1,10 @@
 """Run one fuzzed file through the real stages a user's file goes through.
 
 A manifest: ``load`` (``load_robot``) → ``check`` (the ``openral robot check`` command,
-in-process) → ``hal`` (``build_hal(robot, mode="sim")``: connect, read_state, send a hold
-action, one step, disconnect). A scene: ``load`` (``load_scene``) → ``scene``
-(``build_hal(robot, mode="sim", sim_env_yaml=file)`` with the seed's robot from robots/:
-connect, read_state, send ``hold_action()``, one idle step, disconnect).
+in-process) → ``hal`` (``build_hal(loaded_robot(robot), mode="sim")``: connect, read_state,
+send a hold action, one step, disconnect). A scene: ``load`` (``load_scene``) → ``scene``
+(``build_hal(robot, mode="sim", scene=scene)`` with the seed's robot from robots/ and the
+scene loaded once: connect, read_state, send ``hold_action()``, one idle step, disconnect).
 
 A case stops at the first stage that refuses it. ``robot check`` reporting mismatches (a
 table of fields, no error) is not a refusal: the HAL stage then has to refuse the manifest
@@ -22,13 +22,16 @@ from contextlib import contextmanager, suppress
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from openral_core import loaded_robot, open_robot_by_id
 from openral_core.loader import load_robot, load_scene
-from openral_core.registry import load_robot_by_id
 
 from tests.fuzz.outcome import HANG_SECONDS, Outcome, Result, classify, classify_lines
 from tests.fuzz.seeds import Kind
+
+if TYPE_CHECKING:
+    from openral_hal.protocol import RobotHal
 
 StageHook = Callable[[str], None]
 _SUMMARY = re.compile(r"^\d+ of \d+ robot\(s\) do not match their model$")
@@ -99,6 +102,7 @@ def run_case(case: Case, on_stage: StageHook | None = None) -> Result:
 
 def _manifest_stages(case: Case, enter: StageHook) -> None:
     from openral_hal.factory import build_hal
+    from openral_hal.mujoco_arm import MujocoArmHAL
 
     enter("load")
     robot = load_robot(case.file)
@@ -107,24 +111,27 @@ def _manifest_stages(case: Case, enter: StageHook) -> None:
     enter("check")
     robot_check(case.file)
     enter("hal")
-    hal = build_hal(robot, mode="sim")
+    hal = build_hal(loaded_robot(robot), mode="sim")
+    if not isinstance(hal, MujocoArmHAL):
+        raise TypeError(f"build_hal without a scene gave {type(hal).__name__}")
     _drive(hal, lambda: hal.read_state().positions.copy(), lambda: hal.step())
 
 
 def _scene_stages(case: Case, enter: StageHook) -> None:
-    from openral_hal.factory import build_hal
+    from openral_hal.factory import build_hal, can_idle_step
 
     enter("load")
-    load_scene(case.file)
+    scene = load_scene(case.file)
     if case.load_only:
         return
     enter("scene")
-    robot = load_robot_by_id(case.robot)
-    hal = build_hal(robot, mode="sim", sim_env_yaml=case.file)
+    hal = build_hal(open_robot_by_id(case.robot), mode="sim", scene=scene)
+    if not can_idle_step(hal):
+        raise TypeError(f"build_hal with a scene gave {type(hal).__name__}")
     _drive(hal, lambda: hal.hold_action(), lambda: hal.idle_step())
 
 
-def _drive(hal: Any, hold: Callable[[], Any], step: Callable[[], Any]) -> None:
+def _drive(hal: RobotHal, hold: Callable[[], Any], step: Callable[[], Any]) -> None:
     """connect, read_state, send the hold action, step once, disconnect."""
     try:
         hal.connect()

@@ -10,8 +10,9 @@ from pathlib import Path
 
 import mujoco
 import pytest
+from openral_core import open_robot
 from openral_core.errors import ManifestError
-from openral_core.loader import load_robot, load_scene
+from openral_core.loader import load_scene
 from openral_hal.factory import build_hal
 from openral_sim.native_scene import NativeScene
 from openral_sim.scene_checks import (
@@ -64,7 +65,7 @@ def test_floating_base_on_a_fixed_robot_is_refused_at_the_field(tmp_path: Path) 
         "  keyframe_index: 0\n  floating_base: true\n",
         folder="ur5e",
     )
-    robot = load_robot(manifest)
+    robot = open_robot(manifest)
     hal = build_hal(robot, mode="sim")
     with pytest.raises(ManifestError) as error:
         hal.connect()
@@ -88,7 +89,7 @@ def test_a_manifest_camera_the_model_lacks_is_refused_at_the_field(tmp_path: Pat
     )
     scene = _copy(tmp_path, FRANKA_SCENE, "robot_id: franka_panda", "robot_id: ur5e")
     with pytest.raises(ManifestError) as error:
-        NativeScene(load_scene(scene), load_robot(manifest))
+        NativeScene(load_scene(scene), open_robot(manifest))
     file, line, field, message = _only_issue(error)
     assert (file, line, field) == (
         manifest,
@@ -100,7 +101,7 @@ def test_a_manifest_camera_the_model_lacks_is_refused_at_the_field(tmp_path: Pat
 
 def test_a_control_rate_faster_than_physics_is_refused(tmp_path: Path) -> None:
     scene = _copy(tmp_path, FRANKA_SCENE, "control_freq_hz: 20.0", "control_freq_hz: 2000.0")
-    robot = load_robot(ROBOTS / "franka_panda" / "robot.yaml")
+    robot = open_robot(ROBOTS / "franka_panda" / "robot.yaml")
     with pytest.raises(ManifestError) as error:
         NativeScene(load_scene(scene), robot)
     file, line, field, message = _only_issue(error)

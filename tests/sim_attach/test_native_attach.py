@@ -13,7 +13,7 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 import pytest
-from openral_core import load_robot_by_id
+from openral_core import load_scene, open_robot_by_id
 from openral_hal.factory import build_hal
 from openral_hal.sim_attached import SimAttachedHAL
 
@@ -24,7 +24,7 @@ SCENE = ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml"
 
 @pytest.fixture
 def hal() -> Iterator[SimAttachedHAL]:
-    built = build_hal(load_robot_by_id("franka_panda"), mode="sim", sim_env_yaml=SCENE)
+    built = build_hal(open_robot_by_id("franka_panda"), mode="sim", scene=load_scene(SCENE))
     assert isinstance(built, SimAttachedHAL)
     built.connect()
     yield built
