@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -9,6 +10,7 @@ from openral_codegen import check, export
 
 from tests.conftest import REPO
 
+FRANKA_TABLE = "generated/openral_generated/tables/franka_panda.json"
 COPIED = ("schema", "robots", "generated", "docs", "pyproject.toml")
 
 
@@ -53,3 +55,23 @@ def test_export_is_idempotent_and_removes_orphans(tmp_path: Path) -> None:
     assert not orphan.exists()
     assert export(root) == []
     assert check(root) == []
+
+
+def test_a_table_with_a_wrong_manifest_hash_is_detected(tmp_path: Path) -> None:
+    root = _copy_repo(tmp_path)
+    table = root / FRANKA_TABLE
+    text = table.read_text()
+    table.write_text(text.replace(json.loads(text)["manifest_sha256"], "0" * 64))
+    assert check(root) == [f"stale or edited: {FRANKA_TABLE}"]
+
+
+def test_export_under_another_root_records_the_same_manifest_path(tmp_path: Path) -> None:
+    root = _copy_repo(tmp_path)
+    manifest = root / "robots" / "franka_panda" / "robot.yaml"
+    edited = manifest.read_text().replace("velocity_limit: 0.2,", "velocity_limit: 0.3,")
+    manifest.write_text(edited)
+    assert FRANKA_TABLE in export(root)
+    table = json.loads((root / FRANKA_TABLE).read_text())
+    assert table["manifest"] == "robots/franka_panda/robot.yaml"
+    committed = json.loads((REPO / FRANKA_TABLE).read_text())
+    assert table["manifest_sha256"] != committed["manifest_sha256"]

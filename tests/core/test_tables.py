@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from openral_core import load_robot, robot_tables
+from openral_core import load_robot, manifest_sha256, robot_tables
 from openral_core.tables import FREE_JOINT_NDOF, FREE_JOINT_NQPOS, RobotTables
 
 from tests.conftest import MOCK_ARM, ManifestWriter
@@ -73,4 +73,27 @@ def test_json_round_trip_is_lossless_and_deterministic() -> None:
     tables = robot_tables(load_robot(MOCK_ARM))
     text = tables.to_json()
     assert RobotTables.from_json(text) == tables
+    assert tables.manifest is not None and len(tables.manifest_sha256) == 64
     assert RobotTables.from_json(text).to_json() == text
+
+
+def test_tables_record_their_manifest_and_its_hash(write_manifest: ManifestWriter) -> None:
+    tables = robot_tables(load_robot(MOCK_ARM))
+    assert tables.manifest == "tests/fixtures/robots/mock_arm/robot.yaml"
+    assert tables.manifest_sha256 == manifest_sha256(load_robot(MOCK_ARM))
+    outside = write_manifest(("sim:\n", "# a comment\nsim:\n"))
+    moved = robot_tables(load_robot(outside))
+    assert moved.manifest == str(outside.resolve())
+    assert moved.manifest_sha256 == tables.manifest_sha256
+    assert robot_tables(load_robot(MOCK_ARM), root=MOCK_ARM.parent).manifest == "robot.yaml"
+
+
+def test_manifest_hash_ignores_formatting_and_follows_meaning(
+    write_manifest: ManifestWriter,
+) -> None:
+    original = manifest_sha256(load_robot(MOCK_ARM))
+    text = MOCK_ARM.read_text()
+    reformatted = write_manifest(text="# header comment\n\n" + text.replace(": ", ":   "))
+    assert manifest_sha256(load_robot(reformatted)) == original
+    changed = write_manifest(("velocity_limit: 2.0,", "velocity_limit: 2.5,"))
+    assert manifest_sha256(load_robot(changed)) != original

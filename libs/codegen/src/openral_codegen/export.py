@@ -35,7 +35,9 @@ regeneration would change a byte, add a file or remove one.
 - `openral_generated/models/` — pydantic v2 models of each schema, by datamodel-code-generator
   (flags in `[tool.datamodel-codegen]` of `pyproject.toml`).
 - `openral_generated/tables/<robot>.json` — per-robot tables computed by
-  `openral_core.tables`: HAL wiring kwargs, VLA camera slots, joint-name map.
+  `openral_core.tables`: HAL wiring kwargs, VLA camera slots, joint-name map, and the
+  manifest they came from with its `manifest_sha256`. They are the runtime input of each
+  robot: `openral_core.open_robot` reads them and refuses a stale one.
 """
 
 ExportFiles = dict[str, bytes]
@@ -80,7 +82,7 @@ def derived_files(root: Path) -> ExportFiles:
         except ManifestError as error:
             problems.append(str(error))
             continue
-        tables = robot_tables(robot)
+        tables = robot_tables(robot, root=root)
         files[f"generated/openral_generated/tables/{robot_id}.json"] = tables.to_json().encode()
         folder = robots / robot_id
         scenes = {}

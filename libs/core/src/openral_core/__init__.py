@@ -2,12 +2,13 @@
 
 Typical use::
 
-    from openral_core import load_robot_by_id, robot_tables
-    robot = load_robot_by_id("franka_panda")
-    wiring = robot_tables(robot).hal_wiring
+    from openral_core import open_robot_by_id
+    robot = open_robot_by_id("franka_panda")    # manifest + folder + generated tables
+    wiring = robot.tables.hal_wiring
 """
 
-from openral_core.errors import Issue, ManifestError, OpenralError, UnknownRobot
+from openral_core.errors import Issue, ManifestError, OpenralError, StaleTables, UnknownRobot
+from openral_core.loaded import LoadedRobot, loaded_robot, open_robot, open_robot_by_id
 from openral_core.loader import load_robot, load_scene, validate_robot_file
 from openral_core.models import DeployScene, RobotDescription, SimDescription
 from openral_core.registry import load_robot_by_id, manifest_path, robot_ids
@@ -18,6 +19,7 @@ from openral_core.tables import (
     VlaSlot,
     hal_wiring,
     joint_name_map,
+    manifest_sha256,
     robot_tables,
     vla_slot,
     vla_slots,
@@ -28,11 +30,13 @@ __all__ = [
     "GripperWiring",
     "HalWiring",
     "Issue",
+    "LoadedRobot",
     "ManifestError",
     "OpenralError",
     "RobotDescription",
     "RobotTables",
     "SimDescription",
+    "StaleTables",
     "UnknownRobot",
     "VlaSlot",
     "hal_wiring",
@@ -40,7 +44,11 @@ __all__ = [
     "load_robot",
     "load_robot_by_id",
     "load_scene",
+    "loaded_robot",
     "manifest_path",
+    "manifest_sha256",
+    "open_robot",
+    "open_robot_by_id",
     "robot_ids",
     "robot_tables",
     "validate_robot_file",

@@ -98,3 +98,13 @@ class UnknownRobot(OpenralError):
             f"unknown robot {robot_id!r}; known robots: {', '.join(self.known) or '(none)'}. "
             "Run `openral robot list` to see them."
         )
+
+
+class StaleTables(OpenralError):
+    """A robot's generated tables were not made from its manifest as it reads now."""
+
+    def __init__(self, table: str, manifest: str, problem: str | None = None) -> None:
+        self.table = table
+        self.manifest = manifest
+        why = one_line(problem) if problem else f"stale: made from an earlier {manifest}"
+        super().__init__(escaped(f"{table}: {why}; run `just schema-export`"))

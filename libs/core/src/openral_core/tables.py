@@ -1,8 +1,9 @@
 """Per-robot tables derived from a RobotDescription: the one place each derivation rule lives.
 
-Three tables are derived, both at run time and by ``just schema-export`` (which writes
-them to ``generated/openral_generated/tables/<id>.json`` for review and for consumers
-that must not import the HAL):
+Three tables are derived by ``just schema-export``, which writes them to
+``generated/openral_generated/tables/<id>.json``: the runtime input of a repository robot
+(:mod:`openral_core.loaded` reads them; a robot without a committed file gets the same
+tables computed in memory by :func:`robot_tables`):
 
 * **HAL wiring** — the keyword arguments of ``MujocoArmHAL``: qpos/qvel/actuator index
   per joint (1:1 in canonical order by default, shifted by 7/6 with a floating base),
@@ -10,15 +11,23 @@ that must not import the HAL):
 * **VLA slots** — RGB sensor name → policy slot (suffix of ``vla_feature_key``, else the
   sensor's own name), in manifest order.
 * **Joint-name map** — canonical joint name → MJCF joint name.
+
+Each file also records its origin: the manifest's path and the SHA-256 of the validated
+manifest's canonical JSON (:func:`manifest_sha256`), so a table made from an earlier
+meaning of the manifest is detected while comments and formatting do not matter.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 from typing import Any
 
+from openral_core.located import source_file
 from openral_core.models import RgbSensor, RobotDescription, SimDescription, TorquePdControl
+from openral_core.paths import repo_root
 
 FREE_JOINT_NQPOS = 7
 """qpos entries of a MuJoCo free joint: position (3) + unit quaternion (4)."""
@@ -86,9 +95,14 @@ class VlaSlot:
 
 @dataclass(frozen=True)
 class RobotTables:
-    """Every table derived from one manifest."""
+    """Every table derived from one manifest, and where they came from."""
 
     robot: str
+    manifest: str | None
+    """The manifest's path relative to the repository root (absolute outside it), or None
+    for a model built in code."""
+    manifest_sha256: str
+    """:func:`manifest_sha256` of the manifest the tables were derived from."""
     hal_wiring: HalWiring | None
     vla_slots: tuple[VlaSlot, ...]
     joint_name_map: dict[str, str]
@@ -104,6 +118,8 @@ class RobotTables:
         wiring = data["hal_wiring"]
         return cls(
             robot=data["robot"],
+            manifest=data["manifest"],
+            manifest_sha256=data["manifest_sha256"],
             hal_wiring=None if wiring is None else HalWiring.from_dict(wiring),
             vla_slots=tuple(VlaSlot(**slot) for slot in data["vla_slots"]),
             joint_name_map=dict(data["joint_name_map"]),
@@ -170,9 +186,40 @@ def hal_wiring(robot: RobotDescription) -> HalWiring | None:
     )
 
 
-def robot_tables(robot: RobotDescription) -> RobotTables:
-    """All tables of ``robot``."""
-    return RobotTables(robot.name, hal_wiring(robot), vla_slots(robot), joint_name_map(robot))
+def manifest_sha256(robot: RobotDescription) -> str:
+    """SHA-256 of the validated manifest's canonical JSON (sorted keys, defaults filled in):
+    comments and formatting do not change it, any change of meaning does."""
+    canonical = json.dumps(robot.model_dump(mode="json"), sort_keys=True)
+    return hashlib.sha256(canonical.encode()).hexdigest()
+
+
+def manifest_label(robot: RobotDescription, root: Path | None = None) -> str | None:
+    """The path ``robot`` was loaded from, relative to ``root`` (default: the repository
+    root) when inside it, else absolute; None for a model built in code."""
+    file = source_file(robot)
+    if file is None:
+        return None
+    resolved = file.resolve()
+    base = (root or repo_root()).resolve()
+    return resolved.relative_to(base).as_posix() if resolved.is_relative_to(base) else str(resolved)
+
+
+def robot_tables(robot: RobotDescription, *, root: Path | None = None) -> RobotTables:
+    """All tables of ``robot``: what ``just schema-export`` writes and the in-memory fallback.
+
+    Args:
+        robot: A validated manifest.
+        root: Repository root the manifest path is recorded relative to (default: this
+            repository; the export passes the root it exports).
+    """
+    return RobotTables(
+        robot=robot.name,
+        manifest=manifest_label(robot, root),
+        manifest_sha256=manifest_sha256(robot),
+        hal_wiring=hal_wiring(robot),
+        vla_slots=vla_slots(robot),
+        joint_name_map=joint_name_map(robot),
+    )
 
 
 def _with_defaults(
