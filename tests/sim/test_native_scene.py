@@ -57,7 +57,7 @@ def test_sim_run_writes_frames_and_joint_states(tmp_path: Path) -> None:
         assert frames[0].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     lines = (tmp_path / "joint_states.jsonl").read_text().splitlines()
     assert len(lines) == 5
-    assert "joint1" in json.loads(lines[-1])["positions"]
+    assert "panda_joint1" in json.loads(lines[-1])["positions"]  # manifest names, not MJCF
 
 
 def test_a_camera_the_robot_does_not_have_is_an_error(tmp_path: Path) -> None:
