@@ -5,11 +5,12 @@ from __future__ import annotations
 import importlib
 import json
 import re
+from typing import Any
 
 import pytest
 from openral_codegen.robot_docs import NAV_BEGIN, NAV_END
 from openral_codegen.rule_examples import RULE_BREAKS, numbered_rules, rule_examples
-from openral_codegen.schema_docs import page_files, property_names, read_schemas
+from openral_codegen.schema_docs import PAGES, read_schemas
 from openral_core.registry import robot_ids
 from openral_core.schemas import SchemaName
 
@@ -17,6 +18,28 @@ from tests.conftest import REPO, ROBOTS
 from tests.docs.conftest import BuiltSite
 
 DOCS = REPO / "docs"
+
+
+def page_files(name: SchemaName) -> list[str]:
+    """File names (inside docs/reference/) of the pages that document schema ``name``."""
+    return [f"{page.slug}.md" for page in PAGES if page.schema is name]
+
+
+def property_names(schema: dict[str, Any]) -> set[str]:
+    """Every property name declared anywhere in ``schema``."""
+    names: set[str] = set()
+
+    def walk(node: Any) -> None:
+        if isinstance(node, dict):
+            names.update(node.get("properties", {}))
+            for value in node.values():
+                walk(value)
+        elif isinstance(node, list):
+            for item in node:
+                walk(item)
+
+    walk(schema)
+    return names
 
 
 def test_mkdocs_build_strict_succeeds(built_site: BuiltSite) -> None:

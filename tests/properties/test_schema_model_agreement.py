@@ -16,8 +16,10 @@ from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 from hypothesis_jsonschema import from_schema
 from openral_core.models import DeployScene, RobotDescription, SimDescription
-from openral_core.schemas import SchemaName, bundled_schema, validator
+from openral_core.schemas import SchemaName, validator
 from pydantic import BaseModel, ValidationError
+
+from tests.properties.schema_bundle import bundled_schema
 
 MODELS: dict[SchemaName, type[BaseModel]] = {
     SchemaName.ROBOT: RobotDescription,

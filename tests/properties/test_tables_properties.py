@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from hypothesis_jsonschema import from_schema
 from openral_core.models import RgbSensor, RobotDescription, Sensor
 from openral_core.rules import robot_findings
-from openral_core.schemas import SchemaName, bundled_schema
+from openral_core.schemas import SchemaName
 from openral_core.tables import (
     FREE_JOINT_NDOF,
     FREE_JOINT_NQPOS,
@@ -19,6 +19,8 @@ from openral_core.tables import (
     vla_slots,
 )
 from pydantic import TypeAdapter
+
+from tests.properties.schema_bundle import bundled_schema
 
 SETTINGS = settings(
     max_examples=40,

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from pathlib import Path
 
 from openral_core.models import (
     DeployScene,
@@ -340,8 +339,3 @@ def _num(value: float) -> str:
 
 def _yaml_key(text: str) -> str:
     return f'"{text}"' if re.search(r"[:#\[\]{},&*!|>'\"%@`]", text) else text
-
-
-def default_scene_path(root: Path, robot_id: str) -> Path:
-    """The default scene file of ``robot_id``."""
-    return root / "robots" / robot_id / DEFAULT_SCENE

@@ -89,28 +89,6 @@ def read_schemas(schema_dir: Path) -> dict[SchemaName, dict[str, Any]]:
     return {n: json.loads((schema_dir / n.file_name).read_text("utf-8")) for n in SchemaName}
 
 
-def page_files(name: SchemaName) -> list[str]:
-    """File names (inside docs/reference/) of the pages that document schema ``name``."""
-    return [f"{page.slug}.md" for page in PAGES if page.schema is name]
-
-
-def property_names(schema: dict[str, Any]) -> set[str]:
-    """Every property name declared anywhere in ``schema`` (for coverage tests)."""
-    names: set[str] = set()
-
-    def walk(node: Any) -> None:
-        if isinstance(node, dict):
-            names.update(node.get("properties", {}))
-            for value in node.values():
-                walk(value)
-        elif isinstance(node, list):
-            for item in node:
-                walk(item)
-
-    walk(schema)
-    return names
-
-
 def render_reference(
     schemas: Schemas, examples: ManifestExamples, rules: list[RuleExample]
 ) -> dict[str, str]:
