@@ -6,10 +6,12 @@ import math
 from collections.abc import Iterator
 
 import numpy as np
+import numpy.typing as npt
 import pytest
 from openral_bridge.sim_sensor_bridge import SimSensorBridge
 from openral_core.registry import load_robot_by_id
-from openral_mujoco.state import JointStateSample
+from openral_hal.protocol import CameraHal, EStopLatch, IdleSteppable, MujocoBacked
+from openral_mujoco.state import FloatArray, JointStateSample
 from openral_nodes.runtime import Spinner
 from rclpy.context import Context
 from rclpy.node import Node
@@ -21,10 +23,14 @@ FRANKA = load_robot_by_id("franka_panda")
 SHAPE = (48, 64, 3)
 
 
-class FakeSimHal:
-    """Renders the franka cameras as flat images; idle_step can be made to fail."""
+class FakeSimHal(EStopLatch):
+    """A whole simulated HAL (RobotHal, CameraHal, IdleSteppable, MujocoBacked) of one joint
+    "j": renders the franka cameras as flat images; idle_step can be made to fail."""
 
     is_real = False
+    description = FRANKA
+    joint_names = action_names = ("j",)
+    connected = True
 
     def __init__(self, fail_idle: bool = False) -> None:
         self.fail_idle = fail_idle
@@ -32,8 +38,23 @@ class FakeSimHal:
         self.idle_calls = 0
         self.sim_time_s = 0.0
 
-    def read_images(self) -> dict[str, np.ndarray]:
+    def connect(self) -> None:
+        pass
+
+    def disconnect(self) -> None:
+        pass
+
+    def hold_action(self) -> FloatArray:
+        return np.zeros(1)
+
+    def send_action(self, action: object) -> None:
+        self._refuse_when_estopped()
+
+    def read_images(self) -> dict[str, npt.NDArray[np.uint8]]:
         return {name: np.full(SHAPE, 7, np.uint8) for name in ("agentview", "wrist")}
+
+    def camera_fovy_deg(self, sensor: str) -> float | None:
+        return None  # no scene camera: the manifest's fovy_deg is used
 
     def read_state(self) -> JointStateSample:
         zeros = np.zeros(1)
@@ -84,6 +105,12 @@ def test_a_failing_idle_step_is_reported_once_and_the_stepper_removed(
         )
         assert hal.idle_calls == 1
         spinner.call(bridge.teardown)
+
+
+def test_the_fake_is_a_whole_simulated_hal() -> None:
+    hal = FakeSimHal()
+    assert isinstance(hal, CameraHal) and isinstance(hal, IdleSteppable)
+    assert isinstance(hal, MujocoBacked)
 
 
 def test_no_idle_stepper_for_a_real_hal(ros_context: Context, node: Node) -> None:

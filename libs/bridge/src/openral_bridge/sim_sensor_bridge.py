@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
@@ -34,6 +34,9 @@ from openral_mujoco.display import has_display
 from openral_bridge import ros_messages
 from openral_bridge.idle import should_idle_step
 from openral_bridge.topics import camera_image, camera_info
+
+if TYPE_CHECKING:
+    from rclpy.node import Node
 
 IMAGE_QUEUE_DEPTH = 5
 """Reliable queue of the image publishers: a slow subscriber drops old frames, not new."""
@@ -53,7 +56,7 @@ class SimSensorBridge:
 
     def __init__(
         self,
-        node: Any,
+        node: Node,
         hal: RobotHal,
         description: RobotDescription,
         *,
@@ -213,7 +216,7 @@ class SimSensorBridge:
             return float(fovy)
         if sensor.fovy_deg is not None:
             return float(sensor.fovy_deg)
-        self.node.get_logger().warning(
+        self._log().warning(
             f"camera {sensor.name!r}: no scene camera found and no fovy_deg in the manifest; "
             "its camera_info is not published"
         )
@@ -238,9 +241,7 @@ class SimSensorBridge:
         try:
             stepped = stepper.idle_step()
         except Exception as error:  # one report, then the stepper is off for good
-            self.node.get_logger().error(
-                f"idle stepping disabled after {type(error).__name__}: {error}"
-            )
+            self._log().error(f"idle stepping disabled after {type(error).__name__}: {error}")
             if self._idle_timer is not None:
                 self.node.destroy_timer(self._idle_timer)
                 self._idle_timer = None
@@ -252,7 +253,7 @@ class SimSensorBridge:
     def _setup_viewer(self) -> None:
         if not self.viewer_enabled:
             return
-        log = self.node.get_logger()
+        log = self._log()
         handles = self._handles()
         if handles is None:
             log.warning("viewer requested but the HAL has no MuJoCo model; running without it")
@@ -278,10 +279,14 @@ class SimSensorBridge:
         if viewer.is_running():
             viewer.sync()
             return
-        self.node.get_logger().info("viewer closed; the node keeps running")
+        self._log().info("viewer closed; the node keeps running")
         self.node.destroy_timer(self._viewer_timer)
         self._viewer_timer = self._viewer = None
         viewer.close()
+
+    def _log(self) -> Any:
+        """The node's logger (rclpy's logger is untyped)."""
+        return self.node.get_logger()  # type: ignore[no-untyped-call]
 
     # -- reporting -------------------------------------------------------------------------
 
@@ -293,6 +298,6 @@ class SimSensorBridge:
             or (isinstance(s, RgbSensor) and s.name not in self._image_pubs)
         ]
         if skipped:
-            self.node.get_logger().info(
+            self._log().info(
                 f"not published (the scene does not render them): {', '.join(skipped)}"
             )
