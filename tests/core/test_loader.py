@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import pytest
 from openral_core import ManifestError, load_robot, load_scene
+from openral_core.models import NativeAssets
 
 from tests.conftest import FRANKA, ManifestWriter
 
@@ -88,7 +90,8 @@ def test_variant_errors_explain_the_discriminator(write_manifest: ManifestWriter
     assert messages["sensors[3]"] == "missing required field 'site' (because kind is 'lidar')"
     assert messages["sensors[0].site"] == (
         "unknown field 'site'; expected one of: camera, fovy_deg, frame_id, height, kind, "
-        "mount_axis, mount_body, name, rate_hz, vla_feature_key, width (because kind is 'rgb')"
+        "mount_axis, mount_body, name, rate_hz, robosuite_camera, vla_feature_key, width "
+        "(because kind is 'rgb')"
     )
 
 
@@ -124,6 +127,54 @@ def test_valid_scene_loads_with_defaults(tmp_path: object) -> None:
     )
     scene = load_scene(file)
     assert scene.seed == 0 and scene.scene.assets == "tabletop" and scene.base_pose is None
+
+
+def _scene_file(tmp_path: Path, backend: str, assets: str | None) -> Path:
+    file = tmp_path / "scene.yaml"
+    line = f"  assets: {assets}\n" if assets is not None else ""
+    file.write_text(
+        'schema_version: "0.1"\nrobot_id: franka_panda\nscene:\n  id: lift\n'
+        f"  backend: {backend}\n{line}  observation: {{width: 64, height: 64}}\n"
+        "  cameras: [agentview]\n"
+    )
+    return file
+
+
+@pytest.mark.parametrize(
+    ("backend", "assets", "expected"),
+    [
+        ("native", None, NativeAssets.tabletop),
+        ("native", "floor", NativeAssets.floor),
+        ("robosuite", "PickPlaceCan", "PickPlaceCan"),
+    ],
+)
+def test_scene_assets_are_the_layout_enum_or_an_environment_name(
+    tmp_path: Path, backend: str, assets: str | None, expected: str
+) -> None:
+    loaded = load_scene(_scene_file(tmp_path, backend, assets)).scene.assets
+    assert loaded == expected
+    assert isinstance(loaded, NativeAssets) == (backend == "native")
+
+
+@pytest.mark.parametrize(
+    ("backend", "assets", "expected"),
+    [
+        ("native", "Lift", "expected one of tabletop, floor, got a string 'Lift'"),
+        ("native", "kitchen", "expected one of tabletop, floor, got a string 'kitchen'"),
+        ("robosuite", "tabletop", "'tabletop' does not match the required form ^[A-Z]"),
+        ("robosuite", "lift", "'lift' does not match the required form ^[A-Z]"),
+    ],
+)
+def test_scene_assets_are_checked_against_the_backend(
+    tmp_path: Path, backend: str, assets: str, expected: str
+) -> None:
+    file = _scene_file(tmp_path, backend, assets)
+    with pytest.raises(ManifestError) as info:
+        load_scene(file)
+    (issue,) = info.value.issues  # the precise rule only, not also "no allowed form"
+    assert (issue.line, issue.column, issue.field) == (6, 3, "scene.assets")
+    assert issue.message.startswith(expected)
+    assert issue.message.endswith(f"(because backend is {backend!r})")
 
 
 def test_unknown_discriminator_lists_the_allowed_values(write_manifest: ManifestWriter) -> None:

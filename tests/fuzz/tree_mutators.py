@@ -88,9 +88,10 @@ FIELD_VALUES: dict[str, tuple[Any, ...]] = {
         "pkg:robosuite/robosuite/models/assets/arenas/table_arena.xml",
         "robosuite:robots/panda/robot.xml",
         "robosuite:../../../../etc/passwd",
-        "gym_aloha:../../../etc/passwd",
-        "gym_aloha:bimanual_viperx_transfer_cube",
-        "openarm_v2:../../x",
+        "pkg:gym-aloha/../../../etc/passwd",
+        "pkg:gym-aloha/gym_aloha/assets/bimanual_viperx_transfer_cube.xml",
+        "pkg:openarm-mujoco/../../x",
+        "gym_aloha:bimanual_viperx_transfer_cube",  # a removed scheme
         "robot_descriptions:os",
         "http://example.invalid/robot.xml",
     ),

@@ -315,11 +315,13 @@ def test_robot_check_allows_a_model_outside_with_the_environment(tmp_path: Path)
 
 
 def test_package_models_are_confined_to_their_distribution_folder() -> None:
-    path, confinement = locate_mjcf_uri("gym_aloha:bimanual_viperx_transfer_cube")
+    path, confinement = locate_mjcf_uri(
+        "pkg:gym-aloha/gym_aloha/assets/bimanual_viperx_transfer_cube.xml"
+    )
     assert confinement is not None
     assert confinement.root.name == "gym_aloha" and confinement.contains(path)
     assert "gym-aloha" in confinement.label
-    path, confinement = locate_mjcf_uri("openarm_v2:bimanual")
+    path, confinement = locate_mjcf_uri("pkg:openarm-mujoco/openarm_mujoco/v2/openarm_bimanual.xml")
     assert confinement is not None and confinement.contains(path)
     assert confinement.root.parts[-3:] == ("share", "openarm_mujoco", "v2")
 

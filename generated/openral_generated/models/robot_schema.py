@@ -153,6 +153,15 @@ class RgbSensor(OpenralModel):
     """
     MJCF camera the sensor renders from (rgb and depth). Defaults to the sensor name.
     """
+    robosuite_camera: Annotated[
+        str | None,
+        Field(
+            examples=["robot0_eye_in_hand"], pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$"
+        ),
+    ] = None
+    """
+    Camera in a robosuite environment's model this sensor renders from when a deploy scene uses `backend: robosuite`. Defaults to the sensor name (`agentview` is a camera every robosuite environment has). It sits on the sensor, next to `camera` (the name in the robot's own MJCF), because it is a fact about the robot that every robosuite scene of it shares: robosuite names the cameras it mounts on a robot after the robot's slot, such as `robot0_eye_in_hand` for the first robot's wrist camera.
+    """
     mount_body: Annotated[
         str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
     ] = None

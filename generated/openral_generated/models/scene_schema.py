@@ -163,6 +163,23 @@ Camera = TypeAliasType(
 )
 
 
+class NativeAssets(StrEnum):
+    """
+    A layout the native backend builds around the robot: `tabletop` (floor, lights and a table) or `floor` (floor and lights only, for models that bring their own table).
+    """
+
+    tabletop = "tabletop"
+    floor = "floor"
+
+
+RobosuiteEnvironment = TypeAliasType(
+    "RobosuiteEnvironment", Annotated[str, Field(pattern="^[A-Z][A-Za-z0-9]{0,62}$")]
+)
+"""
+A robosuite environment name, exactly as robosuite spells it (`Lift`, `PickPlaceCan`); checked against the installed robosuite when the scene is built.
+"""
+
+
 class SceneSpec(OpenralModel):
     """
     Scene identity, backend, assets, image size and cameras.
@@ -179,9 +196,9 @@ class SceneSpec(OpenralModel):
     """
     Simulator backend that owns physics and rendering: `native` (a scene composed with mujoco.MjSpec around the robot's own MJCF) or `robosuite` (a robosuite environment).
     """
-    assets: Annotated[str, Field(pattern="^[A-Za-z0-9_:./-]{1,255}$")] = "tabletop"
+    assets: NativeAssets | RobosuiteEnvironment = NativeAssets.tabletop
     """
-    What the backend builds the scene from: for `native` a built-in layout (`tabletop`: floor, lights and a table; `floor`: floor and lights only, for models that bring their own table); for `robosuite` the environment name (`Lift`).
+    What the backend builds the scene from: for `native` one of the built-in layouts (see NativeAssets), for `robosuite` the environment name (see RobosuiteEnvironment). When left out, a native scene is a `tabletop` and a robosuite scene names its environment by `id`.
     """
     observation: Observation
     """

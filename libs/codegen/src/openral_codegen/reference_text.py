@@ -106,6 +106,11 @@ def rule_text(rule: dict[str, Any]) -> str:
         keys += option.get("required", [])
     if keys:
         parts.append("does not allow " + ", ".join(f"`{k}`" for k in keys))
+    for key, spec in rule.get("properties", {}).items():
+        ref = str(spec.get("$ref", ""))
+        if ref.startswith("#/$defs/"):
+            name = ref.removeprefix("#/$defs/")
+            parts.append(f"`{key}` must be a [{name}](#{name.lower()})")
     return "; ".join(parts)
 
 

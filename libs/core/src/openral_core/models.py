@@ -16,12 +16,15 @@ from openral_generated.models.robot_schema import (
     RobotDescription,
 )
 from openral_generated.models.scene_schema import (
+    Backend,
     BasePose,
     DeployScene,
+    NativeAssets,
     Observation,
     SceneObject,
     SceneOptions,
     SceneSpec,
+    Shape,
 )
 from openral_generated.models.sim_schema import (
     GripperReadMode,
@@ -40,6 +43,7 @@ SimControl = PositionControl | TorquePdControl
 """Any control law, discriminated by ``mode``."""
 
 __all__ = [
+    "Backend",
     "Base",
     "BasePose",
     "ContinuousJoint",
@@ -50,6 +54,7 @@ __all__ = [
     "Joint",
     "LidarSensor",
     "LimitedJoint",
+    "NativeAssets",
     "Observation",
     "PositionControl",
     "RgbSensor",
@@ -58,6 +63,7 @@ __all__ = [
     "SceneOptions",
     "SceneSpec",
     "Sensor",
+    "Shape",
     "SimControl",
     "SimDescription",
     "SimGripperDescription",

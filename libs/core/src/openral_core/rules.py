@@ -15,6 +15,7 @@ from openral_core.models import (
     RgbSensor,
     RobotDescription,
     SceneObject,
+    Shape,
     TorquePdControl,
 )
 from openral_core.tables import vla_slot
@@ -65,18 +66,18 @@ def scene_findings(scene: DeployScene) -> list[Finding]:
     return [*_unique(located, "object name"), *_object_sizes(objects)]
 
 
-SIZE_VALUES = {"box": 3, "sphere": 1, "cylinder": 2}
+SIZE_VALUES = {Shape.box: 3, Shape.sphere: 1, Shape.cylinder: 2}
 """How many ``size_m`` values each object shape takes (half-extents; radius; radius and
 half-height)."""
 
 
 def _object_sizes(objects: Sequence[SceneObject]) -> Iterator[Finding]:
     for index, obj in enumerate(objects):
-        wanted = SIZE_VALUES[obj.shape.value]
+        wanted = SIZE_VALUES[obj.shape]
         if len(obj.size_m) != wanted:
             yield (
                 ("scene", "options", "objects", index, "size_m"),
-                f"a {obj.shape.value} takes {wanted} size value(s), got {len(obj.size_m)}",
+                f"a {obj.shape} takes {wanted} size value(s), got {len(obj.size_m)}",
             )
 
 

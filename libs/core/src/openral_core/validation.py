@@ -16,6 +16,9 @@ from openral_core.schemas import SchemaName, validator
 from openral_core.yaml_source import LocatedDocument, PathKey
 
 _DISCRIMINATORS = ("kind", "type", "mode", "backend", "read_mode")
+_DESCENDING = ("properties", "items", "prefixItems", "additionalProperties", "patternProperties")
+"""Schema keywords whose sub-schemas apply one level down the instance."""
+_VAGUE = "does not match any allowed form of this field"
 _JSON_TYPE_NAMES = {
     "object": "a mapping",
     "array": "a list",
@@ -28,13 +31,38 @@ _JSON_TYPE_NAMES = {
 
 
 def schema_issues(document: LocatedDocument, name: SchemaName) -> list[Issue]:
-    """Every violation of schema ``name`` in ``document``, sorted by position, deduplicated."""
+    """Every violation of schema ``name`` in ``document``, sorted by position, deduplicated.
+
+    A field with a precise message (such as a backend's conditional rule) does not also get
+    the vague "does not match any allowed form" one.
+    """
     issues: dict[tuple[int, int, str, str], Issue] = {}
     for error in validator(name).iter_errors(document.data):
-        for path, message in _explain(error):
+        for path, message in _explain(error, _condition(error, document.data)):
             issue = document.issue(path, message)
             issues.setdefault((issue.line, issue.column, issue.field, issue.message), issue)
-    return [issues[key] for key in sorted(issues)]
+    precise = {key[:3] for key, issue in issues.items() if _VAGUE not in issue.message}
+    return [
+        issues[key]
+        for key in sorted(issues)
+        if not (_VAGUE in issues[key].message and key[:3] in precise)
+    ]
+
+
+def _condition(error: ValidationError, data: Any) -> str:
+    """`` (because backend is 'native')`` for an error of an ``if``/``then`` rule whose object
+    has a discriminator; empty otherwise."""
+    schema_path = list(error.schema_path)
+    if "then" not in schema_path:
+        return ""
+    rest = schema_path[len(schema_path) - schema_path[::-1].index("then") :]
+    depth = sum(1 for step in rest if step in _DESCENDING)
+    instance_path = list(error.absolute_path)
+    owner: Any = data
+    for step in instance_path[: len(instance_path) - depth]:
+        owner = owner[step]
+    key = next((k for k in _DISCRIMINATORS if isinstance(owner, dict) and k in owner), None)
+    return f" (because {key} is {owner[key]!r})" if key else ""
 
 
 def describe_value(value: Any) -> str:
@@ -151,7 +179,7 @@ def _message(error: ValidationError) -> str:
     if kind == "uniqueItems":
         return "items must be unique"
     if kind in ("oneOf", "anyOf"):
-        return f"{got} does not match any allowed form of this field"
+        return f"{got} {_VAGUE}"
     if kind == "propertyNames":
         return f"key {instance!r} is not a valid name"
     return str(error.message)

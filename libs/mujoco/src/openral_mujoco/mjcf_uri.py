@@ -5,11 +5,10 @@ Schemes:
 - ``file:<path>``: relative to the manifest's folder, and inside it.
 - ``pkg:<distribution>/<path>``: a file shipped inside an installed distribution, found
   through its installed-files record (``importlib.metadata``); ``<path>`` is matched against
-  the end of each recorded path, so data files installed outside site-packages resolve too.
+  the end of each recorded path, so data files installed outside site-packages resolve too
+  (``pkg:openarm-mujoco/openarm_mujoco/v2/openarm_bimanual.xml`` finds
+  ``share/openarm_mujoco/v2/openarm_bimanual.xml``).
 - ``robosuite:<path>``: ``robosuite/models/assets/<path>`` of the installed robosuite.
-- ``gym_aloha:<scene>``: ``gym_aloha/assets/<scene>.xml`` of the installed gym-aloha.
-- ``openarm_v2:<variant>``: ``openarm_mujoco/v2/openarm_<variant>.xml`` installed by
-  openarm-mujoco.
 
 Each resolution has a confinement root (:class:`~openral_mujoco.mjcf_confinement.Confinement`):
 the robot's folder for ``file:``, the folder holding the distribution's files next to the
@@ -40,7 +39,7 @@ from openral_mujoco.mjcf_confinement import (
     outside_allowed,
 )
 
-SCHEMES = ("file", "pkg", "robosuite", "gym_aloha", "openarm_v2")
+SCHEMES = ("file", "pkg", "robosuite")
 """Every scheme :func:`resolve_mjcf_uri` understands."""
 
 DISTRIBUTION = "openral"
@@ -126,14 +125,12 @@ def locate_mjcf_uri(uri: str, manifest_dir: Path | None = None) -> tuple[Path, C
             raise MjcfUriError(uri, "expected 'pkg:<distribution>/<path inside it>'", manifest_dir)
     elif scheme == "robosuite":
         distribution, inner = "robosuite", f"robosuite/models/assets/{rest}"
-    elif scheme == "gym_aloha":
-        distribution, inner = "gym-aloha", f"gym_aloha/assets/{rest}.xml"
-    elif scheme == "openarm_v2":
-        distribution, inner = "openarm-mujoco", f"openarm_mujoco/v2/openarm_{rest}.xml"
     else:
-        raise MjcfUriError(
-            uri, f"unknown scheme {scheme!r}; expected one of {SCHEMES}", manifest_dir
+        message = (
+            f"unknown scheme {scheme!r}; expected one of {SCHEMES} (a file installed by a "
+            "Python distribution is 'pkg:<distribution>/<path inside it>')"
         )
+        raise MjcfUriError(uri, message, manifest_dir)
     return distribution_file(distribution, inner, uri, manifest_dir)
 
 

@@ -7,9 +7,10 @@ A deploy scene with ``scene.backend: robosuite`` maps onto ``robosuite.make`` li
   name written in snake case (``lift`` → ``Lift``, ``pick_place_can`` → ``PickPlaceCan``): the
   schema keeps ids lower case, so the id is matched against robosuite's environments ignoring
   case and underscores.
-- **robot**: ``robot_id`` through :data:`ROBOSUITE_ROBOTS` (``franka_panda`` → ``Panda``).
-- **cameras**: ``scene.cameras`` through :data:`ROBOSUITE_CAMERAS` (``wrist`` →
-  ``robot0_eye_in_hand``); any other name is passed to robosuite unchanged.
+- **robot**: the robot manifest's ``sim.robosuite_robot`` (``Panda`` for franka_panda).
+- **cameras**: each name in ``scene.cameras`` is an rgb sensor of the robot; it renders the
+  robosuite camera its ``robosuite_camera`` names (``wrist`` → ``robot0_eye_in_hand``), else
+  the camera of the sensor's own name (``agentview``).
 - **options**: ``control_freq_hz``, ``horizon`` (robosuite's own default of 1000 steps when
   left out) and ``controller`` (a composite controller name such as ``BASIC``; the robot's
   default composite controller when left out). ``seed`` seeds object placement and
@@ -24,7 +25,7 @@ so a HAL attached once stays attached.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping
 from typing import Any, cast
 
 from openral_mujoco.display import use_offscreen_gl
@@ -36,27 +37,17 @@ import numpy as np
 import numpy.typing as npt
 import robosuite
 from openral_core.errors import OpenralError
-from openral_core.located import error_at
-from openral_core.models import DeployScene
+from openral_core.located import error_at, source_of
+from openral_core.models import DeployScene, RgbSensor, RobotDescription
+from openral_core.registry import load_robot_by_id
 
 from openral_sim.rollout import Observation, StepResult
-
-ROBOSUITE_ROBOTS: dict[str, str] = {"franka_panda": "Panda", "ur5e": "UR5e"}
-"""openral robot id → robosuite robot name."""
-
-ROBOSUITE_CAMERAS: dict[str, str] = {"agentview": "agentview", "wrist": "robot0_eye_in_hand"}
-"""openral camera name → robosuite camera name; names not listed pass through unchanged."""
 
 _NATIVE_ONLY_OPTIONS = ("table_height_m", "objects")
 
 
 class RobosuiteError(OpenralError):
     """A scene the robosuite backend cannot build."""
-
-
-def robosuite_camera(name: str) -> str:
-    """The robosuite camera an openral camera name renders."""
-    return ROBOSUITE_CAMERAS.get(name, name)
 
 
 class RobosuiteRollout:
@@ -66,7 +57,7 @@ class RobosuiteRollout:
         self,
         env_name: str,
         robot: str,
-        camera_names: Sequence[str],
+        cameras: Mapping[str, str],
         width: int,
         height: int,
         control_freq_hz: float = 20.0,
@@ -79,7 +70,8 @@ class RobosuiteRollout:
         Args:
             env_name: robosuite environment name, such as ``Lift``.
             robot: robosuite robot name, such as ``Panda``.
-            camera_names: openral camera names (mapped by :data:`ROBOSUITE_CAMERAS`).
+            cameras: openral camera name → robosuite camera it renders, such as
+                ``{"wrist": "robot0_eye_in_hand"}``.
             width: Image width [px] of every camera.
             height: Image height [px] of every camera.
             control_freq_hz: Actions per simulated second.
@@ -91,58 +83,18 @@ class RobosuiteRollout:
         Raises:
             RobosuiteError: Unknown environment, robot, controller or camera.
         """
-        if env_name not in robosuite.ALL_ENVIRONMENTS:
-            raise RobosuiteError(
-                f"unknown robosuite environment {env_name!r}; "
-                f"available: {', '.join(sorted(robosuite.ALL_ENVIRONMENTS))}"
-            )
-        if robot not in robosuite.ALL_ROBOTS:
-            raise RobosuiteError(
-                f"unknown robosuite robot {robot!r}; "
-                f"available: {', '.join(sorted(robosuite.ALL_ROBOTS))}"
-            )
-        if (
-            controller is not None
-            and not controller.endswith(".json")
-            and controller not in robosuite.ALL_COMPOSITE_CONTROLLERS
-        ):
-            raise RobosuiteError(
-                f"unknown robosuite composite controller {controller!r}; "
-                f"available: {', '.join(sorted(robosuite.ALL_COMPOSITE_CONTROLLERS))}"
-            )
-        self._names = tuple(camera_names)
-        self._cameras = {name: robosuite_camera(name) for name in self._names}
-        kwargs: dict[str, Any] = {}
+        _check_names(env_name, robot, controller)
+        self._cameras = dict(cameras)
+        self._names = tuple(self._cameras)
+        options: dict[str, Any] = {"control_freq": control_freq_hz, "seed": seed}
         if horizon is not None:
-            kwargs["horizon"] = horizon
+            options["horizon"] = horizon
         if controller is not None:
-            kwargs["controller_configs"] = robosuite.load_composite_controller_config(
+            options["controller_configs"] = robosuite.load_composite_controller_config(
                 controller=controller, robot=robot
             )
-        try:
-            self.env: Any = robosuite.make(
-                env_name,
-                robots=robot,
-                has_renderer=False,
-                has_offscreen_renderer=bool(self._names),
-                use_camera_obs=bool(self._names),
-                camera_names=list(self._cameras.values()) or "agentview",
-                camera_heights=height,
-                camera_widths=width,
-                control_freq=control_freq_hz,
-                ignore_done=False,
-                hard_reset=False,  # keep one MjModel/MjData and render context for life
-                seed=seed,
-                **kwargs,
-            )
-        except (AssertionError, ValueError, KeyError) as error:
-            # robosuite reports e.g. a camera missing from the model this way
-            raise RobosuiteError(
-                f"robosuite could not build {env_name!r} with {robot!r} and cameras "
-                f"{list(self._cameras.values())}: {error!r}"
-            ) from error
+        self.env: Any = _make_env(env_name, robot, self._cameras, (width, height), options)
         self._flip = robosuite.macros.IMAGE_CONVENTION == "opengl"
-        self._last: Observation | None = None
 
     # -- SimRollout ------------------------------------------------------------------------
 
@@ -259,16 +211,104 @@ def robosuite_env_name(scene: DeployScene) -> str:
     raise error_at(scene, ("scene", "id"), message)
 
 
-def build_robosuite_rollout(scene: DeployScene) -> RobosuiteRollout:
+def build_robosuite_rollout(
+    scene: DeployScene, robot: RobotDescription | None = None
+) -> RobosuiteRollout:
     """The robosuite environment a deploy scene describes.
 
+    Args:
+        scene: A scene with ``scene.backend: robosuite``.
+        robot: The scene's robot; read from ``robots/<robot_id>/`` when None.
+
     Raises:
-        ManifestError: At the scene file's field that robosuite cannot serve: no or an
-            unsupported robot, an unknown environment or controller, an option or a base
-            pose that belongs to the native backend, or an environment robosuite fails to
-            build (e.g. a camera it does not have).
+        ManifestError: At the scene file's field that robosuite cannot serve: no robot, a
+            robot without ``sim.robosuite_robot``, a camera that is no rgb sensor of the
+            robot, an unknown environment or controller, an option or a base pose that
+            belongs to the native backend, or an environment robosuite fails to build (e.g.
+            a camera it does not have); at the manifest's ``sim.robosuite_robot`` when
+            robosuite has no such robot.
     """
-    robot = _robosuite_robot(scene)
+    if robot is None:
+        if scene.robot_id is None:
+            raise error_at(scene, (), "the scene names no robot; add robot_id")
+        robot = load_robot_by_id(scene.robot_id)
+    robot_class = _robosuite_robot(scene, robot)
+    cameras = _robosuite_cameras(scene, robot)
+    _check_scene_options(scene)
+    options = scene.scene.options
+    env_name = robosuite_env_name(scene)
+    try:
+        return RobosuiteRollout(
+            env_name=env_name,
+            robot=robot_class,
+            cameras=cameras,
+            width=scene.scene.observation.width,
+            height=scene.scene.observation.height,
+            control_freq_hz=options.control_freq_hz if options else 20.0,
+            horizon=options.horizon if options else None,
+            controller=options.controller if options else None,
+            seed=scene.seed,
+        )
+    except RobosuiteError as error:
+        raise error_at(scene, ("scene",), str(error)) from None
+
+
+def _check_names(env_name: str, robot: str, controller: str | None) -> None:
+    """Refuse an environment, robot or composite controller robosuite does not have."""
+    if env_name not in robosuite.ALL_ENVIRONMENTS:
+        raise RobosuiteError(
+            f"unknown robosuite environment {env_name!r}; "
+            f"available: {', '.join(sorted(robosuite.ALL_ENVIRONMENTS))}"
+        )
+    if robot not in robosuite.ALL_ROBOTS:
+        raise RobosuiteError(
+            f"unknown robosuite robot {robot!r}; "
+            f"available: {', '.join(sorted(robosuite.ALL_ROBOTS))}"
+        )
+    if (
+        controller is not None
+        and not controller.endswith(".json")
+        and controller not in robosuite.ALL_COMPOSITE_CONTROLLERS
+    ):
+        raise RobosuiteError(
+            f"unknown robosuite composite controller {controller!r}; "
+            f"available: {', '.join(sorted(robosuite.ALL_COMPOSITE_CONTROLLERS))}"
+        )
+
+
+def _make_env(
+    env_name: str,
+    robot: str,
+    cameras: Mapping[str, str],
+    size: tuple[int, int],
+    options: Mapping[str, Any],
+) -> Any:
+    """``robosuite.make`` with offscreen cameras; ``options`` are passed on as they are."""
+    width, height = size
+    try:
+        return robosuite.make(
+            env_name,
+            robots=robot,
+            has_renderer=False,
+            has_offscreen_renderer=bool(cameras),
+            use_camera_obs=bool(cameras),
+            camera_names=list(cameras.values()) or "agentview",
+            camera_heights=height,
+            camera_widths=width,
+            ignore_done=False,
+            hard_reset=False,  # keep one MjModel/MjData and render context for life
+            **options,
+        )
+    except (AssertionError, ValueError, KeyError) as error:
+        # robosuite reports e.g. a camera missing from the model this way
+        raise RobosuiteError(
+            f"robosuite could not build {env_name!r} with {robot!r} and cameras "
+            f"{list(cameras.values())}: {error!r}"
+        ) from error
+
+
+def _check_scene_options(scene: DeployScene) -> None:
+    """Refuse native-only options, an unknown controller and a base pose (located)."""
     options = scene.scene.options
     if options is not None:
         for key in _NATIVE_ONLY_OPTIONS:
@@ -285,33 +325,48 @@ def build_robosuite_rollout(scene: DeployScene) -> RobosuiteRollout:
     pose = scene.base_pose
     if pose is not None and (any(pose.position_m or []) or pose.yaw_deg or pose.weld):
         raise error_at(scene, ("base_pose",), "robosuite environments place the robot themselves")
-    env_name = robosuite_env_name(scene)
-    try:
-        return RobosuiteRollout(
-            env_name=env_name,
-            robot=robot,
-            camera_names=scene.scene.cameras,
-            width=scene.scene.observation.width,
-            height=scene.scene.observation.height,
-            control_freq_hz=options.control_freq_hz if options else 20.0,
-            horizon=options.horizon if options else None,
-            controller=options.controller if options else None,
-            seed=scene.seed,
-        )
-    except RobosuiteError as error:
-        raise error_at(scene, ("scene",), str(error)) from None
 
 
-def _robosuite_robot(scene: DeployScene) -> str:
-    """The robosuite robot model of the scene's robot (located error when there is none)."""
-    robot_id = scene.robot_id
-    if robot_id is None:
-        raise error_at(scene, (), "the scene names no robot; add robot_id")
-    robot = ROBOSUITE_ROBOTS.get(robot_id)
-    if robot is None:
+def _robosuite_robot(scene: DeployScene, robot: RobotDescription) -> str:
+    """The robosuite robot class of ``robot``'s ``sim.robosuite_robot`` (located errors)."""
+    name = robot.sim.robosuite_robot if robot.sim is not None else None
+    if name is None:
+        manifest = source_of(robot)
+        where = f" of {manifest.file}" if manifest is not None else ""
         message = (
-            f"{robot_id!r} has no robosuite model; the robosuite backend supports: "
-            f"{', '.join(sorted(ROBOSUITE_ROBOTS))}"
+            f"{robot.name!r} has no robosuite model; add sim.robosuite_robot{where} (the "
+            f"robosuite robot class, one of: {', '.join(sorted(robosuite.ALL_ROBOTS))})"
         )
-        raise error_at(scene, ("robot_id",), message)
-    return robot
+        raise error_at(scene, _robot_field(scene), message)
+    if name not in robosuite.ALL_ROBOTS:
+        message = (
+            f"robosuite has no robot {name!r}; available: {', '.join(sorted(robosuite.ALL_ROBOTS))}"
+        )
+        raise error_at(robot, ("sim", "robosuite_robot"), message)
+    return name
+
+
+def _robot_field(scene: DeployScene) -> tuple[str, ...]:
+    """The scene field an error about its robot points at: ``robot_id`` when the file
+    names the robot, else ``scene.backend`` (the robot came from elsewhere)."""
+    document = source_of(scene)
+    named = document is None or (isinstance(document.data, dict) and "robot_id" in document.data)
+    return ("robot_id",) if named and scene.robot_id is not None else ("scene", "backend")
+
+
+def _robosuite_cameras(scene: DeployScene, robot: RobotDescription) -> dict[str, str]:
+    """Scene camera → robosuite camera: each an rgb sensor's ``robosuite_camera``, else
+    its name (located error at a camera that is no rgb sensor of ``robot``)."""
+    sensors = {sensor.name: sensor for sensor in robot.sensors}
+    cameras: dict[str, str] = {}
+    for index, name in enumerate(scene.scene.cameras):
+        sensor = sensors.get(name)
+        if not isinstance(sensor, RgbSensor):
+            rgb = [s.name for s in sensors.values() if isinstance(s, RgbSensor)]
+            message = (
+                f"{name!r} is not an rgb sensor of {robot.name}; "
+                f"robosuite renders its rgb sensors: {', '.join(rgb) or 'none'}"
+            )
+            raise error_at(scene, ("scene", "cameras", index), message)
+        cameras[name] = sensor.robosuite_camera or name
+    return cameras

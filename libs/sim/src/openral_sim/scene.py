@@ -18,7 +18,7 @@ from openral_core import LoadedRobot, open_robot_by_id
 from openral_core.errors import UnknownRobot
 from openral_core.loader import load_scene
 from openral_core.located import error_at
-from openral_core.models import DeployScene
+from openral_core.models import Backend, DeployScene
 
 from openral_sim.rollout import SimRollout
 
@@ -60,13 +60,13 @@ def build_scene(scene: DeployScene, robot: LoadedRobot) -> SimRollout:
             robot's manifest.
     """
     check_scene_robot(scene, robot)
-    if scene.scene.backend.value == "robosuite":
+    if scene.scene.backend is Backend.robosuite:
         try:
             from openral_sim.robosuite_backend import build_robosuite_rollout
         except ModuleNotFoundError as error:
             message = f"the robosuite backend is unavailable ({error})"
             raise error_at(scene, ("scene", "backend"), message) from None
-        return build_robosuite_rollout(scene.model_copy(update={"robot_id": robot.name}))
+        return build_robosuite_rollout(scene, robot.description)
     from openral_sim.native_scene import NativeScene
 
     return NativeScene(scene, robot)
