@@ -5,18 +5,17 @@ Parametrised over the robots/ folder, so a new manifest is covered without editi
 
 from __future__ import annotations
 
-import json
+from dataclasses import replace
 from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
-from openral_core import load_robot_by_id, manifest_path, robot_ids
-from openral_core.paths import repo_root
-from openral_core.tables import HalWiring, hal_wiring
+from openral_core import load_robot_by_id, robot_ids
+from openral_core.loaded import open_robot_by_id
+from openral_core.tables import hal_wiring, robot_tables
 from openral_hal.errors import EStopLatched, NotConnected, SimulationDiverged
-from openral_hal.mujoco_arm import MujocoArmHAL, hal_kwargs
-from openral_mujoco.mjcf_uri import resolve_mjcf_uri
+from openral_hal.mujoco_arm import MujocoArmHAL
 
 HOLD_STEPS = 200
 HOLD_TOLERANCE = 0.05
@@ -116,20 +115,16 @@ def test_gripper_opens_and_closes_with_the_reading_following(robot_id: str, join
 
 
 def test_generated_table_wires_the_same_hal_as_the_manifest() -> None:
-    table = repo_root() / "generated" / "openral_generated" / "tables" / "franka_panda.json"
-    wiring = json.loads(table.read_text())["hal_wiring"]
-    path = resolve_mjcf_uri(wiring["mjcf_uri"], manifest_path("franka_panda").parent)
-    from_table = MujocoArmHAL(mjcf_path=path, **hal_kwargs(HalWiring.from_dict(wiring)))
-    from_manifest = MujocoArmHAL.from_description(load_robot_by_id("franka_panda"))
-    for hal in (from_table, from_manifest):
+    from_table = open_robot_by_id("franka_panda")  # reads generated/…/franka_panda.json
+    computed = replace(from_table, tables=robot_tables(from_table.description))
+    hals = [MujocoArmHAL.from_robot(robot) for robot in (from_table, computed)]
+    for hal in hals:
         hal.connect()
-    action = from_table.read_state().positions + 0.02
-    for hal in (from_table, from_manifest):
+    action = hals[0].read_state().positions + 0.02
+    for hal in hals:
         hal.send_action(action)
         hal.step(50)
-    np.testing.assert_array_equal(
-        from_table.read_state().positions, from_manifest.read_state().positions
-    )
+    np.testing.assert_array_equal(hals[0].read_state().positions, hals[1].read_state().positions)
 
 
 def test_estop_freezes_physics_and_refuses_actions_until_released() -> None:
@@ -149,7 +144,7 @@ def test_estop_freezes_physics_and_refuses_actions_until_released() -> None:
 
 def test_torque_pd_robot_is_driven_by_the_manifest_gains() -> None:
     hal = _hal("h1")
-    assert hal.control_mode == "torque_pd"
+    assert hal.wiring.control_mode == "torque_pd"
     model, data = hal.mujoco_handles()
     action = _hold_action(hal)
     knee = hal.joint_names.index("left_knee")
@@ -204,7 +199,7 @@ def test_a_diverging_simulation_is_reported_not_silently_reset(
 
 
 def test_divergence_watch_covers_exactly_the_bad_state_warnings() -> None:
-    from openral_hal.mujoco_arm import _BAD_STATE_WARNINGS
+    from openral_mujoco.joint_driver import _BAD_STATE_WARNINGS
 
     watched = set(range(len(mujoco.mjtWarning.__members__))[_BAD_STATE_WARNINGS])
     expected = {

@@ -14,6 +14,8 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
+from openral_core.loaded import loaded_robot, open_robot_by_id
+
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 import mujoco
@@ -21,7 +23,6 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 from openral_bridge.idle import should_idle_step
-from openral_core import load_robot_by_id
 from openral_core.errors import ManifestError
 from openral_core.loader import load_robot
 from openral_core.models import RobotDescription
@@ -189,7 +190,7 @@ def arm_env() -> Iterator[Callable[..., MujocoArmRollout]]:
 
 
 def _attached(description: RobotDescription, env: SimRollout, **kwargs: Any) -> SimAttachedHAL:
-    hal = SimAttachedHAL(env, description, **kwargs)
+    hal = SimAttachedHAL(env, loaded_robot(description), **kwargs)
     hal.connect()
     return hal
 
@@ -239,7 +240,7 @@ def test_a_joint_missing_from_the_scene_fails_at_connect(
     arm_env: Callable[..., MujocoArmRollout],
 ) -> None:
     env = arm_env()
-    hal = SimAttachedHAL(env, load_robot_by_id("franka_panda"))
+    hal = SimAttachedHAL(env, open_robot_by_id("franka_panda"))
     with pytest.raises(ManifestError) as error:
         hal.connect()
     (issue,) = error.value.issues
@@ -374,7 +375,7 @@ def test_non_mujoco_idle_step_advances_the_scene(fake_arm: RobotDescription) -> 
 
 
 def test_connect_without_an_action_width_names_the_backend(fake_arm: RobotDescription) -> None:
-    hal = SimAttachedHAL(NonMujocoRollout(action_dim=None), fake_arm)
+    hal = SimAttachedHAL(NonMujocoRollout(action_dim=None), loaded_robot(fake_arm))
     with pytest.raises(ConfigurationError, match="NonMujocoRollout"):
         hal.connect()
     override = _attached(fake_arm, NonMujocoRollout(action_dim=None), env_action_dim=4)

@@ -1,9 +1,12 @@
 """SimAttachedHAL: a HAL that drives a scene it does not own the physics of.
 
 Under ``deploy sim`` with a scene file, the scene backend (a :class:`SimRollout`) owns
-physics and pixels; this HAL is the robot-side view of it. Joint state is read from the
-scene's MuJoCo data by joint name (or from ``obs["joint_positions"]`` for a non-MuJoCo
-backend), camera frames from the last observation, and every action is one ``env.step``.
+physics and pixels; this HAL is the robot-side view of it. Every action is one ``env.step``
+and camera frames come from the last observation. A native scene drives its robot by the
+manifest's contract (:class:`~openral_sim.rollout.ManifestRollout`): then the action is one
+value per manifest joint and the joint state is the scene's own, in manifest units. Another
+backend (robosuite) keeps its controller's action; its joint state is read from the MuJoCo
+data by joint name (or from ``obs["joint_positions"]`` for a non-MuJoCo backend).
 Between skills the sensor bridge keeps the scene alive with :meth:`SimAttachedHAL.idle_step`,
 which exists only on this simulated HAL.
 """
@@ -17,25 +20,32 @@ from typing import Any
 import mujoco
 import numpy as np
 import numpy.typing as npt
+from openral_core.loaded import LoadedRobot
 from openral_core.located import error_at
 from openral_core.models import RgbSensor, RobotDescription
-from openral_core.tables import joint_name_map
 from openral_mujoco.action import validated_action
 from openral_mujoco.mjcf_model import is_scalar_joint
 from openral_mujoco.name_resolution import resolve_joint_names
 from openral_mujoco.state import FloatArray, JointStateSample
-from openral_sim.rollout import HoldingRollout, Observation, SimRollout, StepResult
+from openral_sim.rollout import (
+    HoldingRollout,
+    ManifestRollout,
+    Observation,
+    SimRollout,
+    StepResult,
+)
 
-from openral_hal.errors import ConfigurationError, EStopLatched, HalError, NotConnected
+from openral_hal.errors import ConfigurationError, HalError, NotConnected
+from openral_hal.protocol import EStopLatch
 
 _log = logging.getLogger(__name__)
 
 
-class SimAttachedHAL:
+class SimAttachedHAL(EStopLatch):
     """A robot inside a simulated scene; one action is one step of the scene.
 
-    The action is the scene's own action (``action_dim`` values, whatever its controller
-    takes), not necessarily one value per manifest joint.
+    The action is the scene's own action (``action_dim`` values): one per manifest joint on
+    a native scene, whatever its controller takes on robosuite.
     """
 
     is_real = False
@@ -44,7 +54,7 @@ class SimAttachedHAL:
     def __init__(
         self,
         env: SimRollout,
-        description: RobotDescription,
+        robot: LoadedRobot,
         *,
         env_reset_seed: int | None = 0,
         env_action_dim: int | None = None,
@@ -53,29 +63,34 @@ class SimAttachedHAL:
 
         Args:
             env: The scene backend.
-            description: The robot's manifest (joint order, names and sensors).
+            robot: The loaded robot (manifest: joint order, names and sensors; tables).
             env_reset_seed: Seed of every episode reset (None: the backend's own choice).
             env_action_dim: Action width, for a backend that does not report ``action_dim``.
         """
         self.env = env
-        self.description = description
+        self.robot = robot
+        description = robot.description
         self.env_reset_seed = env_reset_seed
         self.env_action_dim = env_action_dim
         self.joint_names = tuple(j.name for j in description.joints)
         self.last_action_ns = 0
         """``time.monotonic_ns()`` of the last :meth:`send_action` call (0: never)."""
-        self._mjcf_names = tuple(joint_name_map(description)[n] for n in self.joint_names)
+        self._mjcf_names = tuple(robot.tables.joint_name_map[n] for n in self.joint_names)
         self._rgb = tuple(s.name for s in description.sensors if isinstance(s, RgbSensor))
         self._action_dim: int | None = None
         self._action_names: tuple[str, ...] = ()
         self._obs: Observation | None = None
         self._last_env_action: FloatArray = np.zeros(0)
         self._episode_done = False
-        self._estopped = False
         self._closed = False
         self._addr_model: mujoco.MjModel | None = None
         self._qpos = self._dof = np.zeros(0, dtype=np.intp)
         self._warned_width = False
+
+    @property
+    def description(self) -> RobotDescription:
+        """The manifest of the attached robot."""
+        return self.robot.description
 
     # -- lifecycle -------------------------------------------------------------------------
 
@@ -111,7 +126,7 @@ class SimAttachedHAL:
             raise ConfigurationError(f"{type(self.env).__name__}: action width {width} < 1")
         obs = self.env.reset(seed=self.env_reset_seed)
         handles = self.env.mujoco_handles()
-        if handles is not None:
+        if handles is not None and not isinstance(self.env, ManifestRollout):
             self._resolve_addresses(handles[0])
         self._action_dim = width
         self._action_names = self._slot_names(width)
@@ -122,9 +137,7 @@ class SimAttachedHAL:
     @property
     def action_names(self) -> tuple[str, ...]:
         """One name per action slot: the backend's, else the manifest joints when the widths
-        agree, else ``env_action[i]``."""
-        if self._action_dim is None:
-            raise NotConnected("the HAL is not connected; call connect() first")
+        agree, else ``env_action[i]`` (empty until :meth:`connect` learns the width)."""
         return self._action_names
 
     def hold_action(self) -> FloatArray:
@@ -147,6 +160,7 @@ class SimAttachedHAL:
             self._closed = True
         self._obs = None
         self._action_dim = None
+        self._action_names = ()
 
     def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
         """The scene's live MuJoCo (model, data), or None for a non-MuJoCo backend."""
@@ -167,11 +181,14 @@ class SimAttachedHAL:
     def read_state(self) -> JointStateSample:
         """Every manifest joint, in manifest order, under its canonical name.
 
-        A MuJoCo scene gives positions, velocities and actuator efforts; another backend
+        A native scene reports it in manifest units (grippers per their read mode). Another
+        MuJoCo scene gives raw positions, velocities and actuator efforts; another backend
         gives positions from ``obs["joint_positions"]`` (zeros when absent) and zero
         velocities and efforts.
         """
         obs = self._require_obs()
+        if isinstance(self.env, ManifestRollout):
+            return self.env.joint_state()
         handles = self.env.mujoco_handles()
         count = len(self.joint_names)
         if handles is None:
@@ -225,8 +242,7 @@ class SimAttachedHAL:
         self.last_action_ns = time.monotonic_ns()
         self._require_obs()
         values = validated_action(action, self._action_names)
-        if self._estopped:
-            raise EStopLatched("E-stop is latched; call release_estop() before sending actions")
+        self._refuse_when_estopped()
         self._reset_if_done()
         self._last_env_action = self.merge(values)
         self._step(self._last_env_action.copy())
@@ -256,22 +272,12 @@ class SimAttachedHAL:
         self._step(self.hold_action())
         return True
 
-    # -- E-stop ----------------------------------------------------------------------------
-
-    @property
-    def estopped(self) -> bool:
-        """True while the E-stop is latched."""
-        return self._estopped
-
-    def estop(self) -> None:
-        """Latch the E-stop: actions are refused and the scene is not idle-stepped."""
-        self._estopped = True
-
-    def release_estop(self) -> None:
-        """Unlatch the E-stop."""
-        self._estopped = False
-
     # -- internals -------------------------------------------------------------------------
+
+    def _on_release(self) -> None:
+        """A native scene holds the pose the E-stop froze; nothing jumps on release."""
+        if isinstance(self.env, ManifestRollout) and self._obs is not None:
+            self.env.hold_current_pose()
 
     def _require_obs(self) -> Observation:
         if self._obs is None:

@@ -1,4 +1,5 @@
-"""Gripper value conventions: how a qpos reading becomes a gripper value and back.
+"""Gripper value conventions: how finger positions become a gripper value, and a gripper
+command becomes an actuator control (and back, for the hold action).
 
 Normalised values run from 0 (closed) to 1 (open); ``ctrl_range`` is (closed, open).
 """
@@ -7,8 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-READ_MODES = ("sum_over_scale", "affine_low_high", "passthrough")
-WRITE_MODES = ("normalised", "passthrough")
+from openral_core.models import GripperReadMode, GripperWriteMode
 
 
 def read_gripper(
@@ -21,14 +21,15 @@ def read_gripper(
       whose closed position is not 0).
     - ``passthrough``: the first finger position verbatim (metres or radians).
     """
-    if mode == "sum_over_scale":
+    if mode == GripperReadMode.sum_over_scale:
         return float(sum(qpos)) / qpos_scale
-    if mode == "affine_low_high":
+    if mode == GripperReadMode.affine_low_high:
         low, high = ctrl_range
         return (float(qpos[0]) - low) / (high - low)
-    if mode == "passthrough":
+    if mode == GripperReadMode.passthrough:
         return float(qpos[0])
-    raise ValueError(f"unknown gripper read mode {mode!r}; expected one of {READ_MODES}")
+    expected = [m.value for m in GripperReadMode]
+    raise ValueError(f"unknown gripper read mode {mode!r}; expected one of {expected}")
 
 
 def gripper_ctrl(mode: str, command: float, ctrl_range: tuple[float, float]) -> float:
@@ -38,9 +39,19 @@ def gripper_ctrl(mode: str, command: float, ctrl_range: tuple[float, float]) -> 
       [0, 1] first.
     - ``passthrough``: the command verbatim.
     """
-    if mode == "normalised":
+    if mode == GripperWriteMode.normalised:
         low, high = ctrl_range
         return low + min(max(command, 0.0), 1.0) * (high - low)
-    if mode == "passthrough":
+    if mode == GripperWriteMode.passthrough:
         return command
-    raise ValueError(f"unknown gripper write mode {mode!r}; expected one of {WRITE_MODES}")
+    expected = [m.value for m in GripperWriteMode]
+    raise ValueError(f"unknown gripper write mode {mode!r}; expected one of {expected}")
+
+
+def gripper_command(mode: str, ctrl: float, ctrl_range: tuple[float, float]) -> float:
+    """The command that gives actuator control ``ctrl`` (inverse of :func:`gripper_ctrl`):
+    what holds a gripper where it is commanded now."""
+    if mode == GripperWriteMode.normalised:
+        low, high = ctrl_range
+        return min(max((ctrl - low) / (high - low), 0.0), 1.0)
+    return gripper_ctrl(mode, ctrl, ctrl_range)

@@ -9,6 +9,7 @@ from typing import Any, Protocol, runtime_checkable
 import mujoco
 import numpy as np
 import numpy.typing as npt
+from openral_mujoco.state import JointStateSample
 
 Observation = dict[str, Any]
 """Backend observation. Camera images are ``obs["images"][<camera name>]`` (HxWx3 uint8);
@@ -79,4 +80,21 @@ class HoldingRollout(SimRollout, Protocol):
 
     def hold_action(self) -> npt.NDArray[np.float64]:
         """The action that keeps the robot where it is commanded to be now."""
+        ...
+
+
+@runtime_checkable
+class ManifestRollout(HoldingRollout, Protocol):
+    """A rollout that drives its robot by the manifest's contract: the action slots are the
+    manifest joints (in manifest units) and it reports their state in the same units.
+
+    A HAL attached to it delegates joint state to it instead of reading raw ``qpos``.
+    """
+
+    def joint_state(self) -> JointStateSample:
+        """Every manifest joint, in manifest order and units."""
+        ...
+
+    def hold_current_pose(self) -> None:
+        """Make the present pose the targets (after an E-stop, so nothing jumps)."""
         ...

@@ -1,0 +1,77 @@
+"""The manifest's command envelope: each action slot's allowed range, clamped and reported.
+
+An arm joint's target is clamped to its ``position_limits`` (a continuous joint has none);
+a ``normalised`` gripper command to [0, 1]; a ``passthrough`` gripper command to its
+``ctrl_range``. Every clamp is counted per joint, and logged as a warning naming the joint,
+the value and the limits at most once per :data:`WARN_EVERY_S` per joint.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Sequence
+
+import numpy as np
+from openral_core.models import GripperWriteMode, LimitedJoint, RobotDescription
+from openral_core.tables import GripperWiring
+
+from openral_mujoco.state import FloatArray
+
+WARN_EVERY_S = 2.0
+"""Shortest interval between two clamp warnings of one joint [s]."""
+
+_log = logging.getLogger(__name__)
+
+
+class CommandLimits:
+    """Per-slot [low, high] of one robot's action, with clamp counters."""
+
+    def __init__(self, robot: RobotDescription, grippers: Sequence[GripperWiring]) -> None:
+        """Ranges of every manifest joint, in manifest order."""
+        by_joint = {g.joint: g for g in grippers}
+        self.names = tuple(j.name for j in robot.joints)
+        ranges = [
+            _gripper_range(by_joint[j.name])
+            if j.name in by_joint
+            else (j.position_limits if isinstance(j, LimitedJoint) else [-np.inf, np.inf])
+            for j in robot.joints
+        ]
+        self.low = np.array([r[0] for r in ranges], dtype=np.float64)
+        self.high = np.array([r[1] for r in ranges], dtype=np.float64)
+        self.clamped = dict.fromkeys(self.names, 0)
+        """Joint → how many commands were clamped onto its limits so far."""
+        self._warned_ns = dict.fromkeys(self.names, -(1 << 62))
+
+    def clamp(self, values: FloatArray) -> FloatArray:
+        """``values`` inside the limits; any value outside is counted and reported."""
+        outside = (values < self.low) | (values > self.high)
+        if not outside.any():
+            return values
+        now = time.monotonic_ns()
+        for index in np.flatnonzero(outside).tolist():
+            self._report(index, float(values[index]), now)
+        clamped: FloatArray = np.minimum(np.maximum(values, self.low), self.high)
+        return clamped
+
+    def _report(self, index: int, value: float, now_ns: int) -> None:
+        name = self.names[index]
+        self.clamped[name] += 1
+        if now_ns - self._warned_ns[name] < WARN_EVERY_S * 1e9:
+            return
+        self._warned_ns[name] = now_ns
+        _log.warning(
+            "%s: command %.6g is outside its limits [%.6g, %.6g]; clamped (%d so far)",
+            name,
+            value,
+            self.low[index],
+            self.high[index],
+            self.clamped[name],
+        )
+
+
+def _gripper_range(gripper: GripperWiring) -> tuple[float, float]:
+    if gripper.write_mode == GripperWriteMode.normalised:
+        return (0.0, 1.0)
+    low, high = gripper.ctrl_range
+    return (min(low, high), max(low, high))

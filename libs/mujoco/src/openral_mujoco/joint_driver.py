@@ -1,0 +1,207 @@
+"""The action contract, implemented once: one robot's joints in a MuJoCo model, driven and
+read in manifest units.
+
+An action is one value per manifest joint, in manifest order:
+
+* an arm joint takes a position target [rad or m], clamped to its ``position_limits``
+  (reported, see :mod:`openral_mujoco.command_limits`) and approached no faster than its
+  ``velocity_limit`` (the set point is slewed, as a real arm's interpolator does); the
+  ``position`` law writes the set point to the actuator, the ``torque_pd`` law turns it into
+  a torque every physics step;
+* a gripper joint takes the command of its ``write_mode``, mapped through ``ctrl_range`` to
+  its actuator (and negated onto its mirror actuator).
+
+A joint state reports every manifest joint in the same units: grippers through their
+``read_mode``, efforts from the actuator forces. :class:`MujocoArmHAL` (the robot alone) and
+the native scene (the robot composed with props) both drive their robot with this class;
+only the addresses differ (:mod:`openral_mujoco.robot_addresses`).
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+from openral_core.models import RobotDescription
+from openral_core.tables import HalWiring
+
+from openral_mujoco.action import validated_action
+from openral_mujoco.command_limits import CommandLimits
+from openral_mujoco.control_law import pd_torque, seed_position_servos
+from openral_mujoco.errors import SimulationDiverged
+from openral_mujoco.gripper import gripper_command, gripper_ctrl, read_gripper
+from openral_mujoco.mjcf_model import ctrl_limits
+from openral_mujoco.robot_addresses import RobotAddresses
+from openral_mujoco.state import FloatArray
+
+SLEW_CHUNK_STEPS = 5
+"""Physics steps per set-point update while a target is being approached."""
+RAMP_S = 0.25
+"""Time the set point takes to reach a joint's velocity limit from rest (and to stop) [s]."""
+_BAD_STATE_WARNINGS = slice(
+    int(mujoco.mjtWarning.mjWARN_BADQPOS), int(mujoco.mjtWarning.mjWARN_BADQACC) + 1
+)
+"""MuJoCo's NaN/Inf position, velocity and acceleration warnings (consecutive in mjtWarning)."""
+
+
+class JointDriver:
+    """Drives one robot's joints in one model, in manifest units (see the module doc)."""
+
+    def __init__(
+        self,
+        robot: RobotDescription,
+        wiring: HalWiring,
+        model: mujoco.MjModel,
+        addresses: RobotAddresses,
+    ) -> None:
+        """Wire the driver to ``model``, where the robot sits at ``addresses``."""
+        self.names = wiring.joint_names
+        self.wiring = wiring
+        self.limits = CommandLimits(robot, wiring.grippers)
+        self._at = addresses
+        self._arm = addresses.arm_slots
+        arm_names = [self.names[i] for i in self._arm]
+        self._arm_qpos = addresses.qpos[self._arm]
+        self._arm_qvel = addresses.qvel[self._arm]
+        self._arm_act = addresses.actuator[self._arm]
+        self.torque_pd = wiring.control_mode == "torque_pd"
+        self._kp = np.array([wiring.kp.get(n, 0.0) for n in arm_names])
+        self._kd = np.array([wiring.kd.get(n, 0.0) for n in arm_names])
+        self._vmax = np.array([wiring.velocity_limit.get(n, np.inf) for n in arm_names])
+        self._amax = self._vmax / RAMP_S
+        self._dt = model.opt.timestep
+        self._ctrl_low, self._ctrl_high = ctrl_limits(model)
+        self._arm_low = self._ctrl_low[self._arm_act]
+        self._arm_high = self._ctrl_high[self._arm_act]
+        self._targets = np.zeros(len(self._arm))
+        self._setpoint = self._targets.copy()
+        self._speed = np.zeros(len(self._arm))
+        self._slewing = False
+
+    # -- start and hold --------------------------------------------------------------------
+
+    def reset_to_keyframe(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+        """Load the manifest's keyframe (if any) into ``data``."""
+        if self.wiring.keyframe_index is not None:
+            mujoco.mj_resetDataKeyframe(model, data, self.wiring.keyframe_index)
+
+    def start(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+        """Seed the servos (if the manifest says so), forward, and hold the pose now."""
+        if self.wiring.seed_ctrl_from_qpos:
+            seed_position_servos(model, data)
+        mujoco.mj_forward(model, data)
+        self.hold_current_pose(data)
+
+    def hold_current_pose(self, data: mujoco.MjData) -> None:
+        """Targets and set point ← the arm joints' positions now (nothing moves, nothing jumps)."""
+        self._targets = data.qpos[self._arm_qpos].astype(np.float64)
+        self._setpoint = self._targets.copy()
+        self._speed = np.zeros(len(self._arm))
+        self._slewing = False
+        if not self.torque_pd:
+            data.ctrl[self._arm_act] = np.clip(self._setpoint, self._arm_low, self._arm_high)
+
+    def hold_action(self, data: mujoco.MjData) -> FloatArray:
+        """The action that keeps the robot where it is commanded now: the arm targets, and
+        each gripper's command that gives its actuator's present control."""
+        action = np.empty(len(self.names))
+        action[self._arm] = self._targets
+        for g in self._at.grippers:
+            ctrl = float(data.ctrl[g.actuator])
+            action[g.slot] = gripper_command(g.wiring.write_mode, ctrl, g.wiring.ctrl_range)
+        return action
+
+    # -- command, advance, read ------------------------------------------------------------
+
+    def command(self, action: object, data: mujoco.MjData) -> None:
+        """Validate, clamp and apply one action (see the module doc).
+
+        Raises:
+            ActionRejected: Wrong type, width, or a non-finite value; nothing is changed.
+        """
+        values = self.limits.clamp(validated_action(action, self.names))
+        targets = values[self._arm]
+        if not self.torque_pd:  # once here, so the set point never leaves the servo's range
+            targets = np.minimum(np.maximum(targets, self._arm_low), self._arm_high)
+        self._targets = targets
+        self._slewing = True
+        for g in self._at.grippers:
+            ctrl = gripper_ctrl(g.wiring.write_mode, float(values[g.slot]), g.wiring.ctrl_range)
+            self._set_ctrl(data, g.actuator, ctrl)
+            if g.mirror_actuator is not None:
+                self._set_ctrl(data, g.mirror_actuator, -ctrl)
+
+    def advance(self, model: mujoco.MjModel, data: mujoco.MjData, steps: int) -> None:
+        """Advance physics ``steps`` steps, slewing the set point and applying the law.
+
+        Raises:
+            SimulationDiverged: MuJoCo met a NaN/Inf state and reset it.
+        """
+        bad_state = data.warning.number[_BAD_STATE_WARNINGS]  # a live view of the counters
+        diverged_before = bad_state.tobytes()
+        remaining = steps
+        while remaining > 0:
+            chunk = min(remaining, SLEW_CHUNK_STEPS) if self._slewing else remaining
+            if self._slewing:
+                self._advance_setpoint(chunk * self._dt, data)
+            if self.torque_pd:
+                for _ in range(chunk):
+                    data.ctrl[self._arm_act] = self._pd_torque(data)
+                    mujoco.mj_step(model, data)
+            else:
+                mujoco.mj_step(model, data, nstep=chunk)
+            remaining -= chunk
+        if bad_state.tobytes() != diverged_before:
+            raise SimulationDiverged(
+                "the simulation diverged (NaN/Inf state) and MuJoCo reset it; lower the "
+                "gains or the targets"
+            )
+
+    def read(self, data: mujoco.MjData) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """(positions, velocities, efforts) of every manifest joint, in manifest units."""
+        positions = data.qpos[self._at.qpos].astype(np.float64)
+        for g in self._at.grippers:
+            w = g.wiring
+            fingers = data.qpos[g.finger_qpos].tolist()
+            positions[g.slot] = read_gripper(w.read_mode, fingers, w.ctrl_range, w.qpos_scale)
+        velocities = data.qvel[self._at.qvel].astype(np.float64)
+        efforts = data.actuator_force[self._at.actuator].astype(np.float64)
+        return positions, velocities, efforts
+
+    @property
+    def setpoint(self) -> FloatArray:
+        """The arm joints' present set point (a copy), in arm-slot order."""
+        return self._setpoint.copy()
+
+    # -- internals -------------------------------------------------------------------------
+
+    def _advance_setpoint(self, dt: float, data: mujoco.MjData) -> None:
+        """Move the set point ``dt`` seconds towards the targets: speed at most the velocity
+        limit, changed by at most the limit per :data:`RAMP_S` (a trapezoidal profile that
+        brakes in time to stop on the target)."""
+        error = self._targets - self._setpoint
+        braking = np.sqrt(2.0 * self._amax * np.abs(error))
+        wanted = np.sign(error) * np.minimum(self._vmax, braking)
+        step = self._amax * dt
+        speed = np.clip(wanted, self._speed - step, self._speed + step)
+        moved = self._setpoint + speed * dt
+        arrived = (np.abs(error) <= np.abs(speed) * dt) | ~np.isfinite(self._vmax)
+        self._setpoint = np.where(arrived, self._targets, moved)
+        self._speed = np.where(arrived, 0.0, speed)
+        self._slewing = bool((self._setpoint != self._targets).any())
+        if not self.torque_pd:
+            data.ctrl[self._arm_act] = self._setpoint
+
+    def _pd_torque(self, data: mujoco.MjData) -> FloatArray:
+        return pd_torque(
+            self._kp,
+            self._kd,
+            self._setpoint,
+            data.qpos[self._arm_qpos],
+            data.qvel[self._arm_qvel],
+            self._arm_low,
+            self._arm_high,
+        )
+
+    def _set_ctrl(self, data: mujoco.MjData, actuator: int, value: float) -> None:
+        """ctrl[actuator] = value clipped to the actuator's ctrlrange."""
+        data.ctrl[actuator] = min(max(value, self._ctrl_low[actuator]), self._ctrl_high[actuator])

@@ -1,0 +1,201 @@
+"""How a native scene is composed with MjSpec: an empty world with the robot model's
+physics options, floor, lights and sky, an optional table and pedestal, the scene's objects,
+the robot attached at its base pose (welded if asked), and the cameras.
+
+Every fault is reported at its field of the scene file or the manifest.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import numpy.typing as npt
+from openral_core.located import error_at
+from openral_core.models import DeployScene, RobotDescription, SceneObject
+from openral_mujoco.mjcf_uri import robot_model_file
+from openral_mujoco.model_check import require_agreement, unloadable_model
+
+from openral_sim.scene_cameras import add_fixed_cameras, add_mounted_cameras, rotate_about_z
+from openral_sim.scene_checks import check_object_names, check_weld
+from openral_sim.scene_geometry import lowest_static_point, robot_extent, root_body
+
+DEFAULT_TABLE_HEIGHT_M = 0.75
+BASE_WELD = "scene_base_weld"
+"""Name of the equality constraint that holds a welded floating base."""
+PHYSICS_OPTIONS = tuple(key for key in dir(mujoco.MjSpec().option) if not key.startswith("_"))
+"""Every ``<option>`` of MjSpec (timestep, integrator, solver, tolerances, gravity, flags…)."""
+
+
+def robot_spec(robot: RobotDescription, folder: Path) -> tuple[mujoco.MjSpec, mujoco.MjModel]:
+    """The robot's own model as a spec to attach, and compiled, checked against its manifest.
+
+    Raises:
+        ManifestError: At ``sim.mjcf_uri`` or at every manifest field the model contradicts.
+    """
+    path = robot_model_file(robot, folder)
+    try:
+        child = mujoco.MjSpec.from_file(str(path))
+        child_model = child.copy().compile()  # before attach: no compile after it
+    except ValueError as error:
+        raise unloadable_model(robot, path, error) from None
+    require_agreement(robot, child_model)
+    return child, child_model
+
+
+@dataclass(frozen=True)
+class ComposedScene:
+    """The compiled scene, and the robot's own compiled model (where its wiring's addresses
+    are taken)."""
+
+    model: mujoco.MjModel
+    robot_model: mujoco.MjModel
+
+
+def compose(
+    scene: DeployScene, robot: RobotDescription, folder: Path, cameras: dict[str, str]
+) -> ComposedScene:
+    """Compose and compile ``scene`` around ``robot`` (manifest in ``folder``).
+
+    Raises:
+        ManifestError: At the scene file's or manifest's field that cannot be built.
+    """
+    assert robot.sim is not None
+    check_weld(scene, robot)
+    child, child_model = robot_spec(robot, folder)
+    check_object_names(scene, child_model)
+    spec = _scene_spec(scene, robot, child)
+    pose = scene.base_pose
+    base = np.asarray(pose.position_m if pose and pose.position_m else [0.0, 0.0, 0.0])
+    yaw = math.radians(pose.yaw_deg if pose and pose.yaw_deg else 0.0)
+    options = scene.scene.options
+    own_floor = any(g.type == mujoco.mjtGeom.mjGEOM_PLANE for g in child.geoms)  # no 2nd
+    floor_z = 0.0
+    if scene.scene.assets == "floor":  # the model brings a table: the floor goes under it
+        floor_z = min(0.0, base[2] + lowest_static_point(child_model) - 0.001)
+    own_sky = any(t.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX for t in child.textures)
+    _add_world(spec, floor_z=None if own_floor else floor_z, sky=not own_sky)
+    if scene.scene.assets == "tabletop":
+        table_h = (
+            options.table_height_m
+            if options and options.table_height_m is not None
+            else DEFAULT_TABLE_HEIGHT_M
+        )
+        _add_table(spec, base, yaw, table_h)
+        fixed = robot.sim.floating_base is False
+        if fixed and base[2] > 0.05:
+            spec.worldbody.add_geom(
+                name="scene_pedestal",
+                type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+                size=[0.09, base[2] / 2, 0],
+                pos=[base[0], base[1], base[2] / 2],
+                rgba=[0.3, 0.3, 0.32, 1],
+            )
+    for obj in options.objects if options and options.objects else []:
+        _add_object(spec, obj)
+    frame = spec.worldbody.add_frame(pos=base.tolist(), quat=yaw_quat(yaw).tolist())
+    center, radius = robot_extent(child_model, robot)
+    add_mounted_cameras(child, robot, cameras)
+    spec.attach(child, frame=frame, prefix="")
+    if pose is not None and pose.weld:
+        _add_base_weld(spec, child_model, robot)
+    add_fixed_cameras(spec, robot, cameras, base + rotate_about_z(yaw, center), yaw, radius)
+    try:
+        return ComposedScene(spec.compile(), child_model)
+    except ValueError as error:
+        message = f"scene {scene.scene.id!r} for {robot.name!r} does not compile: {error}"
+        raise error_at(scene, ("scene",), message) from None
+
+
+def _scene_spec(scene: DeployScene, robot: RobotDescription, child: mujoco.MjSpec) -> mujoco.MjSpec:
+    """An empty world with every physics option of the robot's model (so the robot moves as
+    it does alone) and an offscreen buffer for the scene's images (no shadows or
+    multisampling: they cost more than they show at 128 px)."""
+    spec = mujoco.MjSpec()
+    spec.modelname = f"{scene.scene.id}_{robot.name}"
+    for key in PHYSICS_OPTIONS:
+        setattr(spec.option, key, getattr(child.option, key))
+    spec.compiler.degree = False
+    width, height = scene.scene.observation.width, scene.scene.observation.height
+    spec.visual.global_.offwidth = max(width, 640)
+    spec.visual.global_.offheight = max(height, 480)
+    spec.visual.quality.shadowsize = 0
+    spec.visual.quality.offsamples = 0
+    return spec
+
+
+def _add_base_weld(
+    spec: mujoco.MjSpec, child_model: mujoco.MjModel, robot: RobotDescription
+) -> None:
+    """A weld holding the floating root body; its pose is set at every reset."""
+    assert robot.sim is not None and robot.sim.floating_base, "_compose checks the base"
+    root = root_body(child_model, robot)
+    timestep = spec.option.timestep
+    spec.add_equality(
+        name=BASE_WELD,
+        type=mujoco.mjtEq.mjEQ_WELD,
+        objtype=mujoco.mjtObj.mjOBJ_BODY,
+        name1=mujoco.mj_id2name(child_model, mujoco.mjtObj.mjOBJ_BODY, root),
+        solref=[2 * timestep, 1.0],  # as stiff as the time step allows
+    )
+
+
+def _add_world(spec: mujoco.MjSpec, *, floor_z: float | None, sky: bool) -> None:
+    spec.worldbody.add_light(name="scene_key_light", pos=[0.5, -1.0, 3.0], dir=[0, 0.3, -1])
+    spec.worldbody.add_light(name="scene_fill_light", pos=[-1.0, 1.0, 2.5], dir=[0.4, -0.3, -1])
+    if sky:  # a camera looking up or away sees a sky, not black
+        spec.add_texture(
+            name="scene_sky",
+            type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
+            builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT,
+            rgb1=[0.62, 0.72, 0.82],
+            rgb2=[0.16, 0.18, 0.22],
+            width=256,
+            height=256,
+        )
+    if floor_z is None:
+        return
+    spec.worldbody.add_geom(
+        pos=[0.0, 0.0, floor_z],
+        name="scene_floor",
+        type=mujoco.mjtGeom.mjGEOM_PLANE,
+        size=[5, 5, 0.05],
+        rgba=[0.55, 0.6, 0.65, 1],
+    )
+
+
+def _add_table(spec: mujoco.MjSpec, base: np.ndarray, yaw: float, height: float) -> None:
+    centre = base + rotate_about_z(yaw, np.array([0.55, 0.0, 0.0]))
+    spec.worldbody.add_geom(
+        name="scene_table",
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[0.4, 0.6, height / 2],
+        pos=[centre[0], centre[1], height / 2],
+        quat=yaw_quat(yaw).tolist(),
+        rgba=[0.72, 0.55, 0.38, 1],
+    )
+
+
+def _add_object(spec: mujoco.MjSpec, obj: SceneObject) -> None:
+    shapes = {
+        "box": mujoco.mjtGeom.mjGEOM_BOX,
+        "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
+        "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
+    }
+    size = [*obj.size_m, 0.0, 0.0][:3]
+    body = spec.worldbody.add_body(name=f"scene_{obj.name}", pos=list(obj.position_m))
+    body.add_freejoint(name=f"scene_{obj.name}_joint")
+    body.add_geom(
+        name=f"scene_{obj.name}_geom",
+        type=shapes[obj.shape],
+        size=size,
+        rgba=list(obj.rgba or [0.8, 0.2, 0.2, 1.0]),
+        mass=obj.mass_kg or 0.1,
+    )
+
+
+def yaw_quat(yaw: float) -> npt.NDArray[np.float64]:
+    return np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
