@@ -108,6 +108,14 @@ class SimulatedArm(RealArm):
     is_real = False
 
 
+class UnreadyArm(RealArm):
+    """Breaks the contract: a property that raises before connect()."""
+
+    @property
+    def action_names(self) -> tuple[str, ...]:
+        raise RuntimeError("no bus yet")
+
+
 class NotAHal:
     """Breaks the contract: no HAL at all."""
 
@@ -230,6 +238,7 @@ def test_a_conforming_real_driver_is_built_with_the_transport_and_drives(
         (NotAHal, "(NotAHal) does not implement openral_hal.protocol.RobotHal"),
         (SteppingRealArm, "(SteppingRealArm) can idle_step; a real HAL must never be stepped"),
         (SimulatedArm, "(SimulatedArm) reports is_real=False; a real HAL is real"),
+        (UnreadyArm, "(UnreadyArm): a property raised RuntimeError before connect(): no bus yet"),
     ],
 )
 def test_a_driver_breaking_the_contract_is_one_line(

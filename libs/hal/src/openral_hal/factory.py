@@ -110,6 +110,18 @@ def _real_hal(description: RobotDescription, transport: str | None) -> RobotHal:
         )
     hal: object = factory(description, transport)
     driver = f"the real driver of {description.name} ({type(hal).__name__})"
+    try:
+        return _conforming_real_hal(hal, driver)
+    except ConfigurationError:
+        raise
+    except Exception as error:  # isinstance on a Protocol reads every property (Python 3.11)
+        raise ConfigurationError(
+            f"{driver}: a property raised {type(error).__name__} before connect(): {error}"
+        ) from None
+
+
+def _conforming_real_hal(hal: object, driver: str) -> RobotHal:
+    """``hal`` when it is a RobotHal, is real and cannot idle-step."""
     if not isinstance(hal, RobotHal):
         raise ConfigurationError(f"{driver} does not implement openral_hal.protocol.RobotHal")
     if isinstance(hal, IdleSteppable):
