@@ -32,6 +32,17 @@ def read_gripper(
     raise ValueError(f"unknown gripper read mode {mode!r}; expected one of {expected}")
 
 
+def gripper_rate(
+    mode: str, qvel: Sequence[float], ctrl_range: tuple[float, float], qpos_scale: float
+) -> float:
+    """Rate of change of :func:`read_gripper`'s value from the finger joint velocities (the
+    same mapping without its offset: per second, in the read mode's units)."""
+    if mode == GripperReadMode.affine_low_high:
+        low, high = ctrl_range
+        return float(qvel[0]) / (high - low)
+    return read_gripper(mode, qvel, ctrl_range, qpos_scale)
+
+
 def gripper_ctrl(mode: str, command: float, ctrl_range: tuple[float, float]) -> float:
     """Actuator control for a gripper command, before clipping to the actuator's ctrlrange.
 

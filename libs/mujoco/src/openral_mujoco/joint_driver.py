@@ -12,7 +12,8 @@ An action is one value per manifest joint, in manifest order:
   its actuator (and negated onto its mirror actuator).
 
 A joint state reports every manifest joint in the same units: grippers through their
-``read_mode``, efforts from the actuator forces. :class:`MujocoArmHAL` (the robot alone) and
+``read_mode`` (their velocities as the rate of that reading), efforts from the actuator
+forces. :class:`MujocoArmHAL` (the robot alone) and
 the native scene (the robot composed with props) both drive their robot with this class;
 only the addresses differ (:mod:`openral_mujoco.robot_addresses`).
 """
@@ -28,7 +29,7 @@ from openral_mujoco.action import validated_action
 from openral_mujoco.command_limits import CommandLimits
 from openral_mujoco.control_law import pd_torque, seed_position_servos
 from openral_mujoco.errors import SimulationDiverged
-from openral_mujoco.gripper import gripper_command, gripper_ctrl, read_gripper
+from openral_mujoco.gripper import gripper_command, gripper_ctrl, gripper_rate, read_gripper
 from openral_mujoco.mjcf_model import ctrl_limits
 from openral_mujoco.robot_addresses import RobotAddresses
 from openral_mujoco.state import FloatArray
@@ -72,6 +73,8 @@ class JointDriver:
         self._ctrl_low, self._ctrl_high = ctrl_limits(model)
         self._arm_low = self._ctrl_low[self._arm_act]
         self._arm_high = self._ctrl_high[self._arm_act]
+        self._limit_low = self.limits.low[self._arm]
+        self._limit_high = self.limits.high[self._arm]
         self._targets = np.zeros(len(self._arm))
         self._setpoint = self._targets.copy()
         self._speed = np.zeros(len(self._arm))
@@ -164,6 +167,10 @@ class JointDriver:
             fingers = data.qpos[g.finger_qpos].tolist()
             positions[g.slot] = read_gripper(w.read_mode, fingers, w.ctrl_range, w.qpos_scale)
         velocities = data.qvel[self._at.qvel].astype(np.float64)
+        for g in self._at.grippers:
+            w = g.wiring
+            rates = data.qvel[g.finger_qvel].tolist()
+            velocities[g.slot] = gripper_rate(w.read_mode, rates, w.ctrl_range, w.qpos_scale)
         efforts = data.actuator_force[self._at.actuator].astype(np.float64)
         return positions, velocities, efforts
 
@@ -177,16 +184,23 @@ class JointDriver:
     def _advance_setpoint(self, dt: float, data: mujoco.MjData) -> None:
         """Move the set point ``dt`` seconds towards the targets: speed at most the velocity
         limit, changed by at most the limit per :data:`RAMP_S` (a trapezoidal profile that
-        brakes in time to stop on the target)."""
+        brakes in time to stop on the target). A set point that would pass its target stops
+        on it, and one that brakes after a reversed target stops on the joint's limit: it
+        never leaves the manifest's limits (unless it started outside them)."""
         error = self._targets - self._setpoint
         braking = np.sqrt(2.0 * self._amax * np.abs(error))
         wanted = np.sign(error) * np.minimum(self._vmax, braking)
         step = self._amax * dt
         speed = np.clip(wanted, self._speed - step, self._speed + step)
+        low = np.minimum(self._limit_low, self._setpoint)  # a start outside may move in
+        high = np.maximum(self._limit_high, self._setpoint)
         moved = self._setpoint + speed * dt
-        arrived = (np.abs(error) <= np.abs(speed) * dt) | ~np.isfinite(self._vmax)
-        self._setpoint = np.where(arrived, self._targets, moved)
-        self._speed = np.where(arrived, 0.0, speed)
+        crossed = (self._targets - moved) * error <= 0.0  # never past the target
+        arrived = crossed | ~np.isfinite(self._vmax)
+        moved = np.where(arrived, self._targets, moved)
+        inside = np.minimum(np.maximum(moved, low), high)  # a reversal never overshoots
+        self._setpoint = inside
+        self._speed = np.where(arrived | (inside != moved), 0.0, speed)
         self._slewing = bool((self._setpoint != self._targets).any())
         if not self.torque_pd:
             data.ctrl[self._arm_act] = self._setpoint

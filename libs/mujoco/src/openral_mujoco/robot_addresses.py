@@ -31,6 +31,7 @@ class LocatedGripper:
     slot: int
     wiring: GripperWiring
     finger_qpos: IntArray
+    finger_qvel: IntArray
     actuator: int
     mirror_actuator: int | None
 
@@ -67,6 +68,7 @@ def locate_robot(wiring: HalWiring, own: mujoco.MjModel, model: mujoco.MjModel) 
             slot=names.index(g.joint),
             wiring=g,
             finger_qpos=np.array([joints.qpos(a) for a in g.qpos_addrs], dtype=np.intp),
+            finger_qvel=np.array([_dof_of(own, model, joints, a) for a in g.qpos_addrs], np.intp),
             actuator=actuators.index(g.actuator_index),
             mirror_actuator=None
             if g.mirror_actuator_index is None
@@ -80,6 +82,12 @@ def locate_robot(wiring: HalWiring, own: mujoco.MjModel, model: mujoco.MjModel) 
         actuator=np.array([actuators.index(wiring.actuator_index[n]) for n in names], np.intp),
         grippers=grippers,
     )
+
+
+def _dof_of(own: mujoco.MjModel, model: mujoco.MjModel, joints: _JointMap, qpos: int) -> int:
+    """The qvel address (in ``model``) of the one-value joint at ``qpos`` of ``own``."""
+    joint = int(np.flatnonzero(own.jnt_qposadr <= qpos)[-1])
+    return joints.qvel(int(own.jnt_dofadr[joint]))
 
 
 class _JointMap:
