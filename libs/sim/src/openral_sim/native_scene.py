@@ -21,10 +21,9 @@ import time
 import mujoco
 import numpy as np
 import numpy.typing as npt
-from openral_core.errors import OpenralError
 from openral_core.loaded import LoadedRobot
 from openral_core.located import error_at
-from openral_core.models import DeployScene
+from openral_core.models import DeployScene, NativeAssets
 from openral_core.tables import HalWiring
 from openral_mujoco.errors import HalError
 from openral_mujoco.joint_driver import JointDriver
@@ -37,14 +36,6 @@ from openral_sim.scene_checks import physics_steps_per_control
 from openral_sim.scene_compose import BASE_WELD, compose, yaw_quat
 from openral_sim.scene_geometry import root_body
 
-ASSETS = ("tabletop", "floor")
-"""``scene.assets`` values: a table in front of the robot, or only floor and lights (for
-models that bring their own table)."""
-
-
-class SceneError(OpenralError):
-    """A scene file that cannot be built for its robot."""
-
 
 class NativeScene:
     """A MuJoCo scene composed from a loaded robot and a deploy-scene file (a SimRollout
@@ -55,15 +46,16 @@ class NativeScene:
 
         Raises:
             ManifestError: At the field of the scene file or manifest that cannot be built:
-                an unknown asset or camera, a manifest that disagrees with its model, an
+                an unknown camera, a manifest that disagrees with its model, an
                 object name the model already uses, a weld on a fixed base, a control rate
                 the model's physics step cannot serve, a robot joint not found in the scene.
         """
         self.scene = scene
         self.robot = robot
         description = robot.description
-        if scene.scene.assets not in ASSETS:
-            message = f"{scene.scene.assets!r} is not a native scene; expected one of {ASSETS}"
+        if not isinstance(scene.scene.assets, NativeAssets):  # the schema's if/then: never
+            expected = ", ".join(a.value for a in NativeAssets)
+            message = f"{scene.scene.assets!r} is not a native scene; expected one of {expected}"
             raise error_at(scene, ("scene", "assets"), message)
         wiring = robot.tables.hal_wiring
         if wiring is None:

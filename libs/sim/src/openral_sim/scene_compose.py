@@ -15,7 +15,7 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 from openral_core.located import error_at
-from openral_core.models import DeployScene, RobotDescription, SceneObject
+from openral_core.models import DeployScene, NativeAssets, RobotDescription, SceneObject
 from openral_mujoco.mjcf_uri import robot_model_file
 from openral_mujoco.model_check import require_agreement, unloadable_model
 
@@ -74,11 +74,11 @@ def compose(
     options = scene.scene.options
     own_floor = any(g.type == mujoco.mjtGeom.mjGEOM_PLANE for g in child.geoms)  # no 2nd
     floor_z = 0.0
-    if scene.scene.assets == "floor":  # the model brings a table: the floor goes under it
+    if scene.scene.assets is NativeAssets.floor:  # the model brings a table: floor under it
         floor_z = min(0.0, base[2] + lowest_static_point(child_model) - 0.001)
     own_sky = any(t.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX for t in child.textures)
     _add_world(spec, floor_z=None if own_floor else floor_z, sky=not own_sky)
-    if scene.scene.assets == "tabletop":
+    if scene.scene.assets is NativeAssets.tabletop:
         table_h = (
             options.table_height_m
             if options and options.table_height_m is not None
