@@ -17,7 +17,7 @@ from pathlib import Path
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
-from openral_core import load_robot_by_id
+from openral_core import open_robot_by_id
 from openral_core.paths import repo_root
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_sim.scene import build_sim_env_from_yaml
@@ -34,7 +34,7 @@ TARGET_RATIO = 2.0
 def attached(scene_file: str) -> SimAttachedHAL:
     """A connected SimAttachedHAL on one of franka_panda's scene files."""
     path = repo_root() / "robots" / "franka_panda" / "scenes" / scene_file
-    hal = SimAttachedHAL(build_sim_env_from_yaml(path), load_robot_by_id("franka_panda"))
+    hal = SimAttachedHAL(build_sim_env_from_yaml(path), open_robot_by_id("franka_panda"))
     hal.connect()
     return hal
 
