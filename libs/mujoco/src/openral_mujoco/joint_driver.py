@@ -36,6 +36,9 @@ from openral_mujoco.state import FloatArray
 
 SLEW_CHUNK_STEPS = 5
 """Physics steps per set-point update while a target is being approached."""
+UNLIMITED = 1e9
+"""Speed of a joint without a velocity limit [rad/s or m/s]: finite, so the profile's
+arithmetic stays finite, and fast enough to reach any target within one update."""
 RAMP_S = 0.25
 """Time the set point takes to reach a joint's velocity limit from rest (and to stop) [s]."""
 _BAD_STATE_WARNINGS = slice(
@@ -67,8 +70,9 @@ class JointDriver:
         self.torque_pd = wiring.control_mode == "torque_pd"
         self._kp = np.array([wiring.kp.get(n, 0.0) for n in arm_names])
         self._kd = np.array([wiring.kd.get(n, 0.0) for n in arm_names])
-        self._vmax = np.array([wiring.velocity_limit.get(n, np.inf) for n in arm_names])
+        self._vmax = np.array([wiring.velocity_limit.get(n, UNLIMITED) for n in arm_names])
         self._amax = self._vmax / RAMP_S
+        self._two_a = 2.0 * self._amax
         self._dt = model.opt.timestep
         self._ctrl_low, self._ctrl_high = ctrl_limits(model)
         self._arm_low = self._ctrl_low[self._arm_act]
@@ -187,20 +191,21 @@ class JointDriver:
         brakes in time to stop on the target). A set point that would pass its target stops
         on it, and one that brakes after a reversed target stops on the joint's limit: it
         never leaves the manifest's limits (unless it started outside them)."""
-        error = self._targets - self._setpoint
-        braking = np.sqrt(2.0 * self._amax * np.abs(error))
-        wanted = np.sign(error) * np.minimum(self._vmax, braking)
+        setpoint, targets = self._setpoint, self._targets
+        error = targets - setpoint
+        wanted = np.copysign(np.minimum(self._vmax, np.sqrt(self._two_a * np.abs(error))), error)
         step = self._amax * dt
-        speed = np.clip(wanted, self._speed - step, self._speed + step)
-        low = np.minimum(self._limit_low, self._setpoint)  # a start outside may move in
-        high = np.maximum(self._limit_high, self._setpoint)
-        moved = self._setpoint + speed * dt
-        crossed = (self._targets - moved) * error <= 0.0  # never past the target
-        arrived = crossed | ~np.isfinite(self._vmax)
-        moved = np.where(arrived, self._targets, moved)
+        speed = np.minimum(np.maximum(wanted, self._speed - step), self._speed + step)
+        moved = setpoint + speed * dt
+        arrived = (targets - moved) * error <= 0.0  # never past the target
+        if arrived.any():
+            moved[arrived] = targets[arrived]
+            speed[arrived] = 0.0
+        low = np.minimum(self._limit_low, setpoint)  # a start outside may move in
+        high = np.maximum(self._limit_high, setpoint)
         inside = np.minimum(np.maximum(moved, low), high)  # a reversal never overshoots
         self._setpoint = inside
-        self._speed = np.where(arrived | (inside != moved), 0.0, speed)
+        self._speed = np.where(inside != moved, 0.0, speed)
         self._slewing = bool((self._setpoint != self._targets).any())
         if not self.torque_pd:
             data.ctrl[self._arm_act] = self._setpoint
