@@ -74,6 +74,10 @@ class JointDriver:
         self._amax = self._vmax / RAMP_S
         self._two_a = 2.0 * self._amax
         self._dt = model.opt.timestep
+        self._one_update = {  # within this of its target, a set point at rest lands on it
+            n: np.minimum(self._amax * (n * self._dt) ** 2, self._vmax * n * self._dt)
+            for n in range(1, SLEW_CHUNK_STEPS + 1)
+        }
         self._ctrl_low, self._ctrl_high = ctrl_limits(model)
         self._arm_low = self._ctrl_low[self._arm_act]
         self._arm_high = self._ctrl_high[self._arm_act]
@@ -149,7 +153,7 @@ class JointDriver:
         while remaining > 0:
             chunk = min(remaining, SLEW_CHUNK_STEPS) if self._slewing else remaining
             if self._slewing:
-                self._advance_setpoint(chunk * self._dt, data)
+                self._advance_setpoint(chunk, data)
             if self.torque_pd:
                 for _ in range(chunk):
                     data.ctrl[self._arm_act] = self._pd_torque(data)
@@ -165,17 +169,17 @@ class JointDriver:
 
     def read(self, data: mujoco.MjData) -> tuple[FloatArray, FloatArray, FloatArray]:
         """(positions, velocities, efforts) of every manifest joint, in manifest units."""
-        positions = data.qpos[self._at.qpos].astype(np.float64)
+        positions = data.qpos[self._at.qpos]  # fancy indexing copies: safe to write into
         for g in self._at.grippers:
             w = g.wiring
             fingers = data.qpos[g.finger_qpos].tolist()
             positions[g.slot] = read_gripper(w.read_mode, fingers, w.ctrl_range, w.qpos_scale)
-        velocities = data.qvel[self._at.qvel].astype(np.float64)
+        velocities = data.qvel[self._at.qvel]
         for g in self._at.grippers:
             w = g.wiring
             rates = data.qvel[g.finger_qvel].tolist()
             velocities[g.slot] = gripper_rate(w.read_mode, rates, w.ctrl_range, w.qpos_scale)
-        efforts = data.actuator_force[self._at.actuator].astype(np.float64)
+        efforts = data.actuator_force[self._at.actuator]
         return positions, velocities, efforts
 
     @property
@@ -185,14 +189,27 @@ class JointDriver:
 
     # -- internals -------------------------------------------------------------------------
 
-    def _advance_setpoint(self, dt: float, data: mujoco.MjData) -> None:
+    def _advance_setpoint(self, chunk: int, data: mujoco.MjData) -> None:
+        """Move the set point ``chunk`` physics steps towards the targets (see
+        :meth:`_profile`) and hand it to the position servos."""
+        error = self._targets - self._setpoint
+        if not self._speed.any() and (np.abs(error) <= self._one_update[chunk]).all():
+            # From rest, the profile would land every joint on its target in this update
+            # (a holding loop's case); neither array is ever changed in place.
+            self._setpoint = self._targets
+            self._slewing = False
+        else:
+            self._profile(error, chunk * self._dt)
+        if not self.torque_pd:
+            data.ctrl[self._arm_act] = self._setpoint
+
+    def _profile(self, error: FloatArray, dt: float) -> None:
         """Move the set point ``dt`` seconds towards the targets: speed at most the velocity
         limit, changed by at most the limit per :data:`RAMP_S` (a trapezoidal profile that
         brakes in time to stop on the target). A set point that would pass its target stops
         on it, and one that brakes after a reversed target stops on the joint's limit: it
         never leaves the manifest's limits (unless it started outside them)."""
         setpoint, targets = self._setpoint, self._targets
-        error = targets - setpoint
         wanted = np.copysign(np.minimum(self._vmax, np.sqrt(self._two_a * np.abs(error))), error)
         step = self._amax * dt
         speed = np.minimum(np.maximum(wanted, self._speed - step), self._speed + step)
@@ -206,9 +223,7 @@ class JointDriver:
         inside = np.minimum(np.maximum(moved, low), high)  # a reversal never overshoots
         self._setpoint = inside
         self._speed = np.where(inside != moved, 0.0, speed)
-        self._slewing = bool((self._setpoint != self._targets).any())
-        if not self.torque_pd:
-            data.ctrl[self._arm_act] = self._setpoint
+        self._slewing = bool((inside != targets).any())
 
     def _pd_torque(self, data: mujoco.MjData) -> FloatArray:
         return pd_torque(
