@@ -13,9 +13,10 @@ import time
 from collections.abc import Sequence
 
 import numpy as np
-from openral_core.models import GripperWriteMode, LimitedJoint, RobotDescription
+from openral_core.models import LimitedJoint, RobotDescription
 from openral_core.tables import GripperWiring
 
+from openral_mujoco.gripper import command_range
 from openral_mujoco.state import FloatArray
 
 WARN_EVERY_S = 2.0
@@ -32,27 +33,28 @@ class CommandLimits:
         by_joint = {g.joint: g for g in grippers}
         self.names = tuple(j.name for j in robot.joints)
         ranges = [
-            _gripper_range(by_joint[j.name])
+            command_range(by_joint[j.name].write_mode, by_joint[j.name].ctrl_range)
             if j.name in by_joint
             else (j.position_limits if isinstance(j, LimitedJoint) else [-np.inf, np.inf])
             for j in robot.joints
         ]
         self.low = np.array([r[0] for r in ranges], dtype=np.float64)
         self.high = np.array([r[1] for r in ranges], dtype=np.float64)
+        self._low, self._high = self.low.tolist(), self.high.tolist()
         self.clamped = dict.fromkeys(self.names, 0)
         """Joint → how many commands were clamped onto its limits so far."""
         self._warned_ns = dict.fromkeys(self.names, -(1 << 62))
 
-    def clamp(self, values: FloatArray) -> FloatArray:
-        """``values`` inside the limits; any value outside is counted and reported."""
-        outside = (values < self.low) | (values > self.high)
-        if not outside.any():
-            return values
-        now = time.monotonic_ns()
-        for index in np.flatnonzero(outside).tolist():
-            self._report(index, float(values[index]), now)
-        clamped: FloatArray = np.minimum(np.maximum(values, self.low), self.high)
-        return clamped
+    def report(self, values: FloatArray) -> None:
+        """Count (and, rate-limited, log) every value of ``values`` outside its limits.
+
+        A control loop calls this only when its own one-pass clamp changed something."""
+        now = None
+        bounds = zip(values.tolist(), self._low, self._high, strict=True)
+        for index, (value, low, high) in enumerate(bounds):
+            if value < low or value > high:
+                now = time.monotonic_ns() if now is None else now
+                self._report(index, value, now)
 
     def _report(self, index: int, value: float, now_ns: int) -> None:
         name = self.names[index]
@@ -68,10 +70,3 @@ class CommandLimits:
             self.high[index],
             self.clamped[name],
         )
-
-
-def _gripper_range(gripper: GripperWiring) -> tuple[float, float]:
-    if gripper.write_mode == GripperWriteMode.normalised:
-        return (0.0, 1.0)
-    low, high = gripper.ctrl_range
-    return (min(low, high), max(low, high))

@@ -29,9 +29,9 @@ from openral_mujoco.action import validated_action
 from openral_mujoco.command_limits import CommandLimits
 from openral_mujoco.control_law import pd_torque, seed_position_servos
 from openral_mujoco.errors import SimulationDiverged
-from openral_mujoco.gripper import gripper_command, gripper_ctrl, gripper_rate, read_gripper
+from openral_mujoco.gripper import command_map, gripper_command, reading_map
 from openral_mujoco.mjcf_model import ctrl_limits
-from openral_mujoco.robot_addresses import RobotAddresses
+from openral_mujoco.robot_addresses import LocatedGripper, RobotAddresses
 from openral_mujoco.state import FloatArray
 
 SLEW_CHUNK_STEPS = 5
@@ -83,6 +83,9 @@ class JointDriver:
         self._arm_high = self._ctrl_high[self._arm_act]
         self._limit_low = self.limits.low[self._arm]
         self._limit_high = self.limits.high[self._arm]
+        self._command_low, self._command_high = self._command_bounds()
+        self._writes = tuple(self._gripper_write(g) for g in addresses.grippers)
+        self._reads = tuple(_gripper_read(g) for g in addresses.grippers)
         self._targets = np.zeros(len(self._arm))
         self._setpoint = self._targets.copy()
         self._speed = np.zeros(len(self._arm))
@@ -129,17 +132,19 @@ class JointDriver:
         Raises:
             ActionRejected: Wrong type, width, or a non-finite value; nothing is changed.
         """
-        values = self.limits.clamp(validated_action(action, self.names))
-        targets = values[self._arm]
-        if not self.torque_pd:  # once here, so the set point never leaves the servo's range
-            targets = np.minimum(np.maximum(targets, self._arm_low), self._arm_high)
-        self._targets = targets
+        values = validated_action(action, self.names)
+        bounded = np.minimum(np.maximum(values, self._command_low), self._command_high)
+        if bounded.tobytes() != values.tobytes():  # one pass decides; counting is rare
+            self.limits.report(values)
+        self._targets = bounded[self._arm]
         self._slewing = True
-        for g in self._at.grippers:
-            ctrl = gripper_ctrl(g.wiring.write_mode, float(values[g.slot]), g.wiring.ctrl_range)
-            self._set_ctrl(data, g.actuator, ctrl)
-            if g.mirror_actuator is not None:
-                self._set_ctrl(data, g.mirror_actuator, -ctrl)
+        if self._writes:
+            ctrl, commands = data.ctrl, bounded.tolist()
+            for slot, actuator, offset, scale, low, high, mirror in self._writes:
+                value = _clip(offset + scale * commands[slot], low, high)
+                ctrl[actuator] = value
+                if mirror is not None:
+                    ctrl[mirror[0]] = _clip(-value, mirror[1], mirror[2])
 
     def advance(self, model: mujoco.MjModel, data: mujoco.MjData, steps: int) -> None:
         """Advance physics ``steps`` steps, slewing the set point and applying the law.
@@ -169,18 +174,17 @@ class JointDriver:
 
     def read(self, data: mujoco.MjData) -> tuple[FloatArray, FloatArray, FloatArray]:
         """(positions, velocities, efforts) of every manifest joint, in manifest units."""
-        positions = data.qpos[self._at.qpos]  # fancy indexing copies: safe to write into
-        for g in self._at.grippers:
-            w = g.wiring
-            fingers = data.qpos[g.finger_qpos].tolist()
-            positions[g.slot] = read_gripper(w.read_mode, fingers, w.ctrl_range, w.qpos_scale)
-        velocities = data.qvel[self._at.qvel]
-        for g in self._at.grippers:
-            w = g.wiring
-            rates = data.qvel[g.finger_qvel].tolist()
-            velocities[g.slot] = gripper_rate(w.read_mode, rates, w.ctrl_range, w.qpos_scale)
-        efforts = data.actuator_force[self._at.actuator]
-        return positions, velocities, efforts
+        qpos, qvel = data.qpos, data.qvel
+        positions = qpos[self._at.qpos]  # fancy indexing copies: safe to write into
+        velocities = qvel[self._at.qvel]
+        for slot, fingers, finger_dofs, weights, offset in self._reads:
+            position, rate = offset, 0.0
+            for q, v, w in zip(fingers, finger_dofs, weights, strict=True):
+                position += w * qpos[q]
+                rate += w * qvel[v]
+            positions[slot] = position
+            velocities[slot] = rate
+        return positions, velocities, data.actuator_force[self._at.actuator]
 
     @property
     def setpoint(self) -> FloatArray:
@@ -236,6 +240,45 @@ class JointDriver:
             self._arm_high,
         )
 
-    def _set_ctrl(self, data: mujoco.MjData, actuator: int, value: float) -> None:
-        """ctrl[actuator] = value clipped to the actuator's ctrlrange."""
-        data.ctrl[actuator] = min(max(value, self._ctrl_low[actuator]), self._ctrl_high[actuator])
+    def _command_bounds(self) -> tuple[FloatArray, FloatArray]:
+        """Per slot, the range a command is clamped to in one pass: the manifest's limits
+        (:class:`CommandLimits`), narrowed to the servo's ctrlrange for position-law arm
+        joints, so the set point never leaves what the servo accepts."""
+        low, high = self.limits.low.copy(), self.limits.high.copy()
+        if not self.torque_pd:
+            low[self._arm] = np.maximum(low[self._arm], self._arm_low)
+            high[self._arm] = np.minimum(high[self._arm], self._arm_high)
+        return low, high
+
+    def _gripper_write(self, g: LocatedGripper) -> _Write:
+        """One gripper's precomputed command path (see :func:`command_map`)."""
+        forward = command_map(g.wiring.write_mode, g.wiring.ctrl_range)
+        a = g.actuator
+        mirror = (
+            None
+            if g.mirror_actuator is None
+            else (
+                g.mirror_actuator,
+                float(self._ctrl_low[g.mirror_actuator]),
+                float(self._ctrl_high[g.mirror_actuator]),
+            )
+        )
+        low, high = float(self._ctrl_low[a]), float(self._ctrl_high[a])
+        return (g.slot, a, forward.offset, forward.weights[0], low, high, mirror)
+
+
+_Write = tuple[int, int, float, float, float, float, tuple[int, float, float] | None]
+"""(slot, actuator, offset, scale, ctrl low, ctrl high, (mirror, low, high) or None)."""
+_Read = tuple[int, list[int], list[int], tuple[float, ...], float]
+"""(slot, finger qpos addresses, finger dof addresses, weights, offset)."""
+
+
+def _gripper_read(g: LocatedGripper) -> _Read:
+    """One gripper's precomputed reading (see :func:`reading_map`)."""
+    w = g.wiring
+    reading = reading_map(w.read_mode, len(g.finger_qpos), w.ctrl_range, w.qpos_scale)
+    return (g.slot, g.finger_qpos.tolist(), g.finger_qvel.tolist(), reading.weights, reading.offset)
+
+
+def _clip(value: float, low: float, high: float) -> float:
+    return low if value < low else high if value > high else value
