@@ -69,11 +69,13 @@ def test_random_valid_actions_keep_state_finite(robot_id: str, data: st.DataObje
 def _bad_actions(width: int) -> st.SearchStrategy[object]:
     finite = st.floats(-3, 3, allow_nan=False)
     good = st.lists(finite, min_size=width, max_size=width)
+    non_finite = st.tuples(
+        good, st.integers(0, width - 1), st.sampled_from([np.nan, np.inf, -np.inf])
+    ).map(lambda t: [*t[0][: t[1]], t[2], *t[0][t[1] + 1 :]])
     return st.one_of(
-        # a non-finite value somewhere
-        st.tuples(good, st.integers(0, width - 1), st.sampled_from([np.nan, np.inf, -np.inf])).map(
-            lambda t: [*t[0][: t[1]], t[2], *t[0][t[1] + 1 :]]
-        ),
+        # a non-finite value somewhere, as a list and as the float64 array of a control loop
+        non_finite,
+        non_finite.map(lambda v: np.array(v, dtype=np.float64)),
         # the wrong width
         st.lists(finite, max_size=width + 3).filter(lambda v: len(v) != width),
         # the wrong element or container type

@@ -50,6 +50,31 @@ def test_a_refused_action_leaves_targets_counters_and_ctrl_as_they_were() -> Non
     assert not any(hal.driver.limits.clamped.values())
 
 
+def test_a_repeated_command_is_applied_again_after_an_estop_release() -> None:
+    hal = _panda()
+    action = hal.hold_action()
+    action[0] += 0.2
+    hal.send_action(action)
+    hal.step(100)
+    hal.estop()
+    hal.release_estop()  # targets <- the pose now, short of the target
+    assert hal.hold_action()[0] < action[0] - 1e-3
+    hal.send_action(action.copy())  # the same bytes as the command before the E-stop
+    assert hal.hold_action()[0] == action[0]
+
+
+def test_a_repeated_clamped_command_is_counted_each_time() -> None:
+    hal = _panda()
+    action = hal.hold_action()
+    action[7] = 1.5  # the gripper, beyond open
+    for _ in range(3):
+        hal.send_action(action)
+    assert hal.driver.limits.clamped == {
+        **dict.fromkeys(hal.joint_names, 0),
+        "panda_finger_joint1": 3,
+    }
+
+
 @pytest.mark.parametrize("robot_id", ["franka_panda", "so101", "aloha"])
 def test_a_gripper_velocity_is_the_rate_of_its_reading(robot_id: str) -> None:
     """sum_over_scale, affine_low_high and passthrough: d(reading)/dt = reported velocity."""

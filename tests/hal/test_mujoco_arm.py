@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from openral_core import load_robot_by_id, robot_ids
 from openral_core.loaded import open_robot_by_id
-from openral_core.tables import hal_wiring, robot_tables
+from openral_core.tables import robot_tables
 from openral_hal.errors import EStopLatched, NotConnected, SimulationDiverged
 from openral_hal.mujoco_arm import MujocoArmHAL
 
@@ -146,17 +146,26 @@ def test_torque_pd_robot_is_driven_by_the_manifest_gains() -> None:
     hal = _hal("h1")
     assert hal.wiring.control_mode == "torque_pd"
     model, data = hal.mujoco_handles()
-    action = _hold_action(hal)
+    wiring = hal.wiring
     knee = hal.joint_names.index("left_knee")
+    actuator = wiring.actuator_index["left_knee"]
+    qpos, dof = wiring.joint_qpos_addr["left_knee"], wiring.joint_qvel_addr["left_knee"]
+    kp, kd = wiring.kp["left_knee"], wiring.kd["left_knee"]
+    start = float(data.qpos[qpos])
+    action = _hold_action(hal)
     action[knee] += 0.3
     hal.send_action(action)
-    hal.step(1)
-    # Motor ctrl is a torque: kp * error, clipped to the motor's range, pushes the knee.
-    wiring = hal_wiring(load_robot_by_id("h1"))
-    assert wiring is not None
-    actuator = wiring.actuator_index["left_knee"]
-    assert data.ctrl[actuator] > 0
-    assert data.ctrl[actuator] <= model.actuator_ctrlrange[actuator, 1]
+    low, high = model.actuator_forcerange[actuator]
+    motor = mujoco.MjModel.from_xml_path(str(hal.mjcf_path))
+    assert (low, high) == tuple(motor.actuator_ctrlrange[actuator])  # its torque limits, kept
+    for _ in range(40):  # MuJoCo applies kp * (set point - q) - kd * dq, clipped
+        q, dq = float(data.qpos[qpos]), float(data.qvel[dof])
+        hal.step(1)
+        setpoint = float(data.ctrl[actuator])  # the set point this step used
+        wanted = kp * (setpoint - q) - kd * dq
+        assert data.actuator_force[actuator] == pytest.approx(min(max(wanted, low), high))
+    assert start < setpoint <= action[knee]  # slewed towards the target
+    assert data.qpos[qpos] > start  # and the torque moved the knee that way
 
 
 def test_gravity_can_be_switched_off() -> None:

@@ -176,14 +176,10 @@ class MujocoArmHAL(EStopLatch):
         _, data, driver = self._handles()
         positions, velocities, efforts = driver.read(data)
         now = time.monotonic_ns()
+        stale = now - self._last_step_ns > self.staleness_limit_s * 1e9
+        # (names, positions, velocities, efforts, stamp_ns, sim_time_s, stale)
         return JointStateSample(
-            names=self.joint_names,
-            positions=positions,
-            velocities=velocities,
-            efforts=efforts,
-            stamp_ns=now,
-            sim_time_s=float(data.time),
-            stale=(now - self._last_step_ns) > self.staleness_limit_s * 1e9,
+            self.joint_names, positions, velocities, efforts, now, data.time, stale
         )
 
     def hold_action(self) -> FloatArray:

@@ -45,16 +45,18 @@ class CommandLimits:
         """Joint → how many commands were clamped onto its limits so far."""
         self._warned_ns = dict.fromkeys(self.names, -(1 << 62))
 
-    def report(self, values: FloatArray) -> None:
-        """Count (and, rate-limited, log) every value of ``values`` outside its limits.
-
-        A control loop calls this only when its own one-pass clamp changed something."""
-        now = None
+    def outside(self, values: FloatArray) -> tuple[int, ...]:
+        """Indices of the values outside their limits (a control loop asks only when its own
+        one-pass clamp changed something)."""
         bounds = zip(values.tolist(), self._low, self._high, strict=True)
-        for index, (value, low, high) in enumerate(bounds):
-            if value < low or value > high:
-                now = time.monotonic_ns() if now is None else now
-                self._report(index, value, now)
+        return tuple(i for i, (v, low, high) in enumerate(bounds) if v < low or v > high)
+
+    def report(self, indices: tuple[int, ...], values: FloatArray) -> None:
+        """Count the clamp of each of ``values[indices]``; log it at most once per
+        :data:`WARN_EVERY_S` per joint."""
+        now = time.monotonic_ns()
+        for index in indices:
+            self._report(index, float(values[index]), now)
 
     def _report(self, index: int, value: float, now_ns: int) -> None:
         name = self.names[index]

@@ -6,8 +6,9 @@ An action is one value per manifest joint, in manifest order:
 * an arm joint takes a position target [rad or m], clamped to its ``position_limits``
   (reported, see :mod:`openral_mujoco.command_limits`) and approached no faster than its
   ``velocity_limit`` (the set point is slewed, as a real arm's interpolator does); the
-  ``position`` law writes the set point to the actuator, the ``torque_pd`` law turns it into
-  a torque every physics step;
+  set point is the actuator's ctrl: a position servo's target, or (``torque_pd``) the set
+  point of the PD law compiled into the motor (``control_law.compile_pd_servos``), so
+  MuJoCo applies either law at every physics step with no Python in the loop;
 * a gripper joint takes the command of its ``write_mode``, mapped through ``ctrl_range`` to
   its actuator (and negated onto its mirror actuator).
 
@@ -20,14 +21,17 @@ only the addresses differ (:mod:`openral_mujoco.robot_addresses`).
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import mujoco
 import numpy as np
+import numpy.typing as npt
 from openral_core.models import RobotDescription
 from openral_core.tables import HalWiring
 
 from openral_mujoco.action import validated_action
 from openral_mujoco.command_limits import CommandLimits
-from openral_mujoco.control_law import pd_torque, seed_position_servos
+from openral_mujoco.control_law import compile_pd_servos, seed_position_servos
 from openral_mujoco.errors import SimulationDiverged
 from openral_mujoco.gripper import command_map, gripper_command, reading_map
 from openral_mujoco.mjcf_model import ctrl_limits
@@ -65,11 +69,11 @@ class JointDriver:
         self._arm = addresses.arm_slots
         arm_names = [self.names[i] for i in self._arm]
         self._arm_qpos = addresses.qpos[self._arm]
-        self._arm_qvel = addresses.qvel[self._arm]
         self._arm_act = addresses.actuator[self._arm]
-        self.torque_pd = wiring.control_mode == "torque_pd"
-        self._kp = np.array([wiring.kp.get(n, 0.0) for n in arm_names])
-        self._kd = np.array([wiring.kd.get(n, 0.0) for n in arm_names])
+        if wiring.control_mode == "torque_pd":  # before the ctrl limits are read below
+            kp = np.array([wiring.kp.get(n, 0.0) for n in arm_names])
+            kd = np.array([wiring.kd.get(n, 0.0) for n in arm_names])
+            compile_pd_servos(model, self._arm_act, kp, kd)
         self._vmax = np.array([wiring.velocity_limit.get(n, UNLIMITED) for n in arm_names])
         self._amax = self._vmax / RAMP_S
         self._two_a = 2.0 * self._amax
@@ -89,7 +93,11 @@ class JointDriver:
         self._targets = np.zeros(len(self._arm))
         self._setpoint = self._targets.copy()
         self._speed = np.zeros(len(self._arm))
+        self._moving = False  # any _speed nonzero
         self._slewing = False
+        self._data_views: _Views | None = None
+        self._in_force = b""  # the bytes of the last applied command
+        self._in_force_clamped: tuple[int, ...] = ()  # its slots outside their limits
 
     # -- start and hold --------------------------------------------------------------------
 
@@ -110,9 +118,9 @@ class JointDriver:
         self._targets = data.qpos[self._arm_qpos].astype(np.float64)
         self._setpoint = self._targets.copy()
         self._speed = np.zeros(len(self._arm))
-        self._slewing = False
-        if not self.torque_pd:
-            data.ctrl[self._arm_act] = np.clip(self._setpoint, self._arm_low, self._arm_high)
+        self._moving = self._slewing = False
+        self._in_force = b""  # the next command applies in full, even a repeated one
+        data.ctrl[self._arm_act] = np.clip(self._setpoint, self._arm_low, self._arm_high)
 
     def hold_action(self, data: mujoco.MjData) -> FloatArray:
         """The action that keeps the robot where it is commanded now: the arm targets, and
@@ -132,12 +140,22 @@ class JointDriver:
         Raises:
             ActionRejected: Wrong type, width, or a non-finite value; nothing is changed.
         """
-        values = validated_action(action, self.names)
-        bounded = np.minimum(np.maximum(values, self._command_low), self._command_high)
-        if bounded.tobytes() != values.tobytes():  # one pass decides; counting is rare
-            self.limits.report(values)
-        self._targets = bounded[self._arm]
-        self._slewing = True
+        values = validated_action(action, self.names, finite_checked_by_caller=True)
+        raw = values.tobytes()
+        if raw == self._in_force:  # the command in force again: only its clamps count again
+            if self._in_force_clamped:
+                self.limits.report(self._in_force_clamped, values)
+            return
+        bounded = np.fmin(np.fmax(values, self._command_low), self._command_high)
+        clamped: tuple[int, ...] = ()
+        if bounded.tobytes() != raw:  # one pass decides; the rest is rare
+            validated_action(values, self.names)  # NaN/Inf never pass fmin/fmax unchanged
+            clamped = self.limits.outside(values)
+            self.limits.report(clamped, values)
+        self._in_force, self._in_force_clamped = raw, clamped
+        targets = bounded[self._arm]
+        self._targets = targets  # a set point at rest on its targets has nothing to do:
+        self._slewing = self._moving or targets.tobytes() != self._setpoint.tobytes()
         if self._writes:
             ctrl, commands = data.ctrl, bounded.tolist()
             for slot, actuator, offset, scale, low, high, mirror in self._writes:
@@ -152,20 +170,12 @@ class JointDriver:
         Raises:
             SimulationDiverged: MuJoCo met a NaN/Inf state and reset it.
         """
-        bad_state = data.warning.number[_BAD_STATE_WARNINGS]  # a live view of the counters
+        bad_state = self._views(data).bad_state
         diverged_before = bad_state.tobytes()
-        remaining = steps
-        while remaining > 0:
-            chunk = min(remaining, SLEW_CHUNK_STEPS) if self._slewing else remaining
-            if self._slewing:
-                self._advance_setpoint(chunk, data)
-            if self.torque_pd:
-                for _ in range(chunk):
-                    data.ctrl[self._arm_act] = self._pd_torque(data)
-                    mujoco.mj_step(model, data)
-            else:
-                mujoco.mj_step(model, data, nstep=chunk)
-            remaining -= chunk
+        if self._slewing:
+            self._slew(model, data, steps)
+        else:
+            mujoco.mj_step(model, data, nstep=steps)
         if bad_state.tobytes() != diverged_before:
             raise SimulationDiverged(
                 "the simulation diverged (NaN/Inf state) and MuJoCo reset it; lower the "
@@ -174,17 +184,17 @@ class JointDriver:
 
     def read(self, data: mujoco.MjData) -> tuple[FloatArray, FloatArray, FloatArray]:
         """(positions, velocities, efforts) of every manifest joint, in manifest units."""
-        qpos, qvel = data.qpos, data.qvel
+        _, qpos, qvel, force, _ = self._views(data)
         positions = qpos[self._at.qpos]  # fancy indexing copies: safe to write into
         velocities = qvel[self._at.qvel]
         for slot, fingers, finger_dofs, weights, offset in self._reads:
             position, rate = offset, 0.0
             for q, v, w in zip(fingers, finger_dofs, weights, strict=True):
-                position += w * qpos[q]
-                rate += w * qvel[v]
+                position += w * qpos.item(q)
+                rate += w * qvel.item(v)
             positions[slot] = position
             velocities[slot] = rate
-        return positions, velocities, data.actuator_force[self._at.actuator]
+        return positions, velocities, force[self._at.actuator]
 
     @property
     def setpoint(self) -> FloatArray:
@@ -197,15 +207,14 @@ class JointDriver:
         """Move the set point ``chunk`` physics steps towards the targets (see
         :meth:`_profile`) and hand it to the position servos."""
         error = self._targets - self._setpoint
-        if not self._speed.any() and (np.abs(error) <= self._one_update[chunk]).all():
+        if not self._moving and (np.abs(error) <= self._one_update[chunk]).all():
             # From rest, the profile would land every joint on its target in this update
             # (a holding loop's case); neither array is ever changed in place.
             self._setpoint = self._targets
             self._slewing = False
         else:
             self._profile(error, chunk * self._dt)
-        if not self.torque_pd:
-            data.ctrl[self._arm_act] = self._setpoint
+        data.ctrl[self._arm_act] = self._setpoint
 
     def _profile(self, error: FloatArray, dt: float) -> None:
         """Move the set point ``dt`` seconds towards the targets: speed at most the velocity
@@ -227,27 +236,41 @@ class JointDriver:
         inside = np.minimum(np.maximum(moved, low), high)  # a reversal never overshoots
         self._setpoint = inside
         self._speed = np.where(inside != moved, 0.0, speed)
+        self._moving = bool(self._speed.any())
         self._slewing = bool((inside != targets).any())
 
-    def _pd_torque(self, data: mujoco.MjData) -> FloatArray:
-        return pd_torque(
-            self._kp,
-            self._kd,
-            self._setpoint,
-            data.qpos[self._arm_qpos],
-            data.qvel[self._arm_qvel],
-            self._arm_low,
-            self._arm_high,
-        )
+    def _views(self, data: mujoco.MjData) -> _Views:
+        """Live views of ``data``'s arrays, made once per data (each attribute access of
+        the bindings builds a new array object)."""
+        views = self._data_views
+        if views is None or views.data is not data:
+            bad_state = data.warning.number[_BAD_STATE_WARNINGS]
+            views = _Views(data, data.qpos, data.qvel, data.actuator_force, bad_state)
+            self._data_views = views
+        return views
+
+    def _slew(self, model: mujoco.MjModel, data: mujoco.MjData, steps: int) -> None:
+        """``steps`` physics steps, the set point updated every :data:`SLEW_CHUNK_STEPS`
+        until it rests on the targets."""
+        remaining = steps
+        while remaining > 0 and self._slewing:
+            chunk = min(remaining, SLEW_CHUNK_STEPS)
+            self._advance_setpoint(chunk, data)
+            mujoco.mj_step(model, data, nstep=chunk)
+            remaining -= chunk
+        if remaining > 0:
+            mujoco.mj_step(model, data, nstep=remaining)
 
     def _command_bounds(self) -> tuple[FloatArray, FloatArray]:
         """Per slot, the range a command is clamped to in one pass: the manifest's limits
-        (:class:`CommandLimits`), narrowed to the servo's ctrlrange for position-law arm
-        joints, so the set point never leaves what the servo accepts."""
-        low, high = self.limits.low.copy(), self.limits.high.copy()
-        if not self.torque_pd:
-            low[self._arm] = np.maximum(low[self._arm], self._arm_low)
-            high[self._arm] = np.minimum(high[self._arm], self._arm_high)
+        (:class:`CommandLimits`, unlimited as the largest finite float), narrowed to the
+        servo's ctrlrange (a compiled PD law has none), so the set point never leaves what
+        the servo accepts."""
+        largest = np.finfo(np.float64).max  # finite, so an infinite command always changes
+        low = np.maximum(self.limits.low, -largest)
+        high = np.minimum(self.limits.high, largest)
+        low[self._arm] = np.maximum(low[self._arm], self._arm_low)
+        high[self._arm] = np.minimum(high[self._arm], self._arm_high)
         return low, high
 
     def _gripper_write(self, g: LocatedGripper) -> _Write:
@@ -265,6 +288,15 @@ class JointDriver:
         )
         low, high = float(self._ctrl_low[a]), float(self._ctrl_high[a])
         return (g.slot, a, forward.offset, forward.weights[0], low, high, mirror)
+
+
+class _Views(NamedTuple):
+    data: mujoco.MjData
+    qpos: FloatArray
+    qvel: FloatArray
+    actuator_force: FloatArray
+    bad_state: npt.NDArray[np.int32]
+    """MuJoCo's NaN/Inf position, velocity and acceleration warning counters."""
 
 
 _Write = tuple[int, int, float, float, float, float, tuple[int, float, float] | None]
