@@ -118,7 +118,7 @@ def _manifest_stages(case: Case, enter: StageHook) -> None:
 
 
 def _scene_stages(case: Case, enter: StageHook) -> None:
-    from openral_hal.factory import build_hal, can_idle_step
+    from openral_hal.factory import build_hal, can_tick
 
     enter("load")
     scene = load_scene(case.file)
@@ -126,9 +126,9 @@ def _scene_stages(case: Case, enter: StageHook) -> None:
         return
     enter("scene")
     hal = build_hal(open_robot_by_id(case.robot), mode="sim", scene=scene)
-    if not can_idle_step(hal):
+    if not can_tick(hal):
         raise TypeError(f"build_hal with a scene gave {type(hal).__name__}")
-    _drive(hal, lambda: hal.hold_action(), lambda: hal.idle_step())
+    _drive(hal, lambda: hal.hold_action(), lambda: hal.tick(None))
 
 
 def _drive(hal: RobotHal, hold: Callable[[], Any], step: Callable[[], Any]) -> None:

@@ -25,11 +25,7 @@ def ros_context() -> Iterator[Context]:
 
 @pytest.fixture(scope="module")
 def deployed(ros_context: Context) -> Iterator[Deployed]:
-    """``deploy sim`` on the franka default scene, in-process, headless, probed from the start.
-
-    The idle hold is 500 ms (default 200) so that a busy machine stalling the test's action
-    stream for a moment cannot make the yield test flaky.
-    """
+    """``deploy sim`` on the franka default scene, in-process, headless, probed from the start."""
     spinner = Spinner(ros_context).start()
     probe = Probe(ros_context, PROBE_TOPICS)
     spinner.add_node(probe.node)
@@ -38,7 +34,6 @@ def deployed(ros_context: Context) -> Iterator[Deployed]:
         parameter_overrides={
             "sim_env_yaml": str(FRANKA_SCENE),
             "viewer_enabled": False,
-            "idle_hold_ms": 500.0,
         },
     )
     spinner.add_node(node)

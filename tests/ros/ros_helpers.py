@@ -130,11 +130,13 @@ class Deployed:
         """Counters of the node, read on the spin thread (no race with its callbacks)."""
 
         def read() -> dict[str, int]:
-            bridge = self.node.bridge
+            loop = self.node.loop
             return {
-                "applied": self.node.actions_applied,
+                "accepted": self.node.actions_accepted,
                 "refused": self.node.actions_refused,
-                "idle_steps": bridge.idle_steps if bridge else -1,
+                "applied": loop.applied if loop else -1,
+                "superseded": loop.superseded if loop else -1,
+                "ticks": loop.ticks if loop else -1,
             }
 
         return self.spinner.call(read)

@@ -72,10 +72,10 @@ def cycle(spinner: Spinner, node: ManifestLifecycleNode) -> None:
     hal = node.hal
     assert spinner.call(node.trigger_activate) == SUCCESS
     assert hal.connected
-    # Let the camera and idle timers run at least once before tearing them down.
+    # Let the control loop's timer tick at least once more before tearing it down.
     wait_until(
-        lambda: spinner.call(lambda: node.bridge is not None and node.bridge.idle_steps >= 1),
-        what="one idle step",
+        lambda: spinner.call(lambda: node.loop is not None and node.loop.ticks >= 2),
+        what="a timer tick of the control loop",
     )
     assert spinner.call(node.trigger_deactivate) == SUCCESS
     assert hal.connected, "deactivate must keep the HAL (and its scene) connected"

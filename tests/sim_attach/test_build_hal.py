@@ -1,4 +1,4 @@
-"""build_hal: which HAL a loaded robot gets, the real-driver contract and can_idle_step.
+"""build_hal: which HAL a loaded robot gets, the real-driver contract and can_tick.
 
 The real drivers here are small honest fakes: one conforms to ``RobotHal``; the others
 break the contract in one way each (not a HAL, idle-steppable, not real).
@@ -20,9 +20,9 @@ from openral_core.errors import ManifestError
 from openral_core.loader import load_scene
 from openral_core.models import DeployScene, RobotDescription
 from openral_hal.errors import ConfigurationError, EStopLatched
-from openral_hal.factory import HalMode, build_hal, can_idle_step, register_real_driver
+from openral_hal.factory import HalMode, build_hal, can_tick, register_real_driver
 from openral_hal.mujoco_arm import MujocoArmHAL
-from openral_hal.protocol import EStopLatch, IdleSteppable, RobotHal
+from openral_hal.protocol import EStopLatch, RobotHal, Tickable
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_mujoco.state import FloatArray, JointStateSample
 from openral_sim.rollout import Observation, SimRollout, StepResult
@@ -94,11 +94,11 @@ class RealArm(EStopLatch):
 
 
 class SteppingRealArm(RealArm):
-    """Breaks the contract: a real HAL that could be idle-stepped."""
+    """Breaks the contract: a real HAL that a control loop could tick."""
 
-    last_action_ns = 0
+    control_period_s = 0.02
 
-    def idle_step(self) -> bool:
+    def tick(self, action: object | None) -> bool:
         return True
 
 
@@ -129,6 +129,7 @@ class StillRollout:
     action_dim = 2
     camera_names: tuple[str, ...] = ()
     camera_models: ClassVar[dict[str, str]] = {}
+    control_period_s = 0.05
 
     def reset(self, seed: int | None = None) -> Observation:
         return {"images": {}, "joint_positions": np.array([0.1, 0.2])}
@@ -167,7 +168,9 @@ def no_drivers(monkeypatch: pytest.MonkeyPatch) -> dict[str, Any]:
 def test_sim_without_a_scene_gives_the_bare_twin() -> None:
     hal = build_hal(open_robot_by_id("franka_panda"), mode=HalMode.SIM)
     assert isinstance(hal, MujocoArmHAL) and isinstance(hal, RobotHal)
-    assert hal.is_real is False and not can_idle_step(hal)
+    hal.connect()  # isinstance on a Protocol reads its properties (Python 3.11)
+    assert hal.is_real is False and can_tick(hal)  # the robot alone is ticked too
+    assert hal.control_period_s == pytest.approx(0.02)
 
 
 def test_sim_with_a_scene_attaches_to_what_the_builder_makes_of_the_loaded_objects(
@@ -184,7 +187,7 @@ def test_sim_with_a_scene_attaches_to_what_the_builder_makes_of_the_loaded_objec
     assert isinstance(hal, SimAttachedHAL) and hal.env_reset_seed == 7
     assert len(calls) == 1 and calls[0][0] is scene and calls[0][1] is arm
     hal.connect()  # isinstance on a Protocol reads its properties (Python 3.11)
-    assert can_idle_step(hal) and isinstance(hal, IdleSteppable)
+    assert can_tick(hal) and isinstance(hal, Tickable)
     assert hal.read_state().names == ("joint1", "joint2")
 
 
@@ -222,7 +225,7 @@ def test_a_conforming_real_driver_is_built_with_the_transport_and_drives(
     assert no_drivers == {"fake_arm": RealArm}
     hal = build_hal(arm, mode=HalMode.REAL, transport="can0")
     assert isinstance(hal, RealArm) and hal.transport == "can0"
-    assert hal.description is arm.description and not can_idle_step(hal)
+    assert hal.description is arm.description and not can_tick(hal)
     hal.connect()
     hal.send_action([0.5, -0.5])
     assert hal.read_state().positions.tolist() == [0.5, -0.5]
@@ -236,7 +239,7 @@ def test_a_conforming_real_driver_is_built_with_the_transport_and_drives(
     ("driver", "problem"),
     [
         (NotAHal, "(NotAHal) does not implement openral_hal.protocol.RobotHal"),
-        (SteppingRealArm, "(SteppingRealArm) can idle_step; a real HAL must never be stepped"),
+        (SteppingRealArm, "(SteppingRealArm) has tick(); a real HAL must never be stepped"),
         (SimulatedArm, "(SimulatedArm) reports is_real=False; a real HAL is real"),
         (UnreadyArm, "(UnreadyArm): a property raised RuntimeError before connect(): no bus yet"),
     ],
@@ -252,9 +255,9 @@ def test_a_driver_breaking_the_contract_is_one_line(
     assert "\n" not in message
 
 
-def test_is_real_wins_over_idle_step() -> None:
+def test_is_real_wins_over_tick() -> None:
     stepping = SteppingRealArm(open_robot_by_id("franka_panda").description, None)
-    assert isinstance(stepping, IdleSteppable) and not can_idle_step(stepping)
+    assert isinstance(stepping, Tickable) and not can_tick(stepping)
 
 
 @pytest.mark.parametrize("mode", ["replay", "SIM", ""])

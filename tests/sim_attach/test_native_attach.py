@@ -42,11 +42,11 @@ def test_action_slots_are_the_scene_actuators(hal: SimAttachedHAL) -> None:
     assert len(set(hal.action_names)) == hal.action_dim
 
 
-def test_idle_holds_the_start_pose(hal: SimAttachedHAL) -> None:
+def test_hold_ticks_keep_the_start_pose(hal: SimAttachedHAL) -> None:
     start = hal.read_state()
     hold = hal.hold_action()
     for _ in range(40):  # two seconds of scene time
-        assert hal.idle_step()
+        assert hal.tick(None)
     later = hal.read_state()
     assert later.sim_time_s is not None and start.sim_time_s is not None
     assert later.sim_time_s == pytest.approx(start.sim_time_s + 2.0, abs=0.01)
@@ -56,20 +56,20 @@ def test_idle_holds_the_start_pose(hal: SimAttachedHAL) -> None:
     np.testing.assert_array_equal(hal.hold_action(), hold)
 
 
-def test_idle_finishes_the_last_move_and_the_frame_follows(hal: SimAttachedHAL) -> None:
+def test_hold_ticks_finish_the_last_move_and_the_frame_follows(hal: SimAttachedHAL) -> None:
     target = hal.hold_action()
     target[0] += 0.6  # swing the base joint
     hal.send_action(target)
     moved_once = hal.read_state().positions[0]
     frames = [hal.read_images()["agentview"]]
     for _ in range(30):
-        assert hal.idle_step()
+        assert hal.tick(None)
         frames.append(hal.read_images()["agentview"])
     settled = hal.read_state().positions[0]
-    np.testing.assert_allclose(hal.hold_action(), target)  # idle holds the command
+    np.testing.assert_allclose(hal.hold_action(), target)  # hold ticks keep the command
     np.testing.assert_allclose(hal.last_env_action, target)
     assert abs(settled - target[0]) < 0.05 < abs(moved_once - target[0])
-    assert _changed(frames[0], frames[10]) > 0.1, "idle steps did not advance the picture"
+    assert _changed(frames[0], frames[10]) > 0.1, "hold ticks did not advance the picture"
 
 
 def test_estop_freezes_the_scene(hal: SimAttachedHAL) -> None:
@@ -79,7 +79,7 @@ def test_estop_freezes_the_scene(hal: SimAttachedHAL) -> None:
     hal.estop()
     frame, state = hal.read_images()["wrist"], hal.read_state()
     for _ in range(5):
-        assert not hal.idle_step()
+        assert not hal.tick(None)
     np.testing.assert_array_equal(hal.read_images()["wrist"], frame)
     np.testing.assert_array_equal(hal.read_state().positions, state.positions)
 

@@ -1,5 +1,5 @@
-"""SimAttachedHAL and the idle-step predicate (ADR-0034 scene attach + idle stepper);
-build_hal is tested in ``test_build_hal.py``.
+"""SimAttachedHAL (ADR-0034 scene attach; a control loop ticks it, see
+``tests/bridge/test_control_loop.py``); build_hal is tested in ``test_build_hal.py``.
 
 Two honest fakes stand in for scene backends: a tiny MuJoCo arm whose joints carry
 robosuite's ``robot0_`` prefix and whose fixed camera really renders, and a non-MuJoCo
@@ -22,7 +22,6 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 import pytest
-from openral_bridge.idle import should_idle_step
 from openral_core.errors import ManifestError
 from openral_core.loader import load_robot
 from openral_core.models import RobotDescription
@@ -96,6 +95,10 @@ class MujocoArmRollout:
     def camera_models(self) -> dict[str, str]:
         return {"agentview": "agentview"}
 
+    @property
+    def control_period_s(self) -> float:
+        return self.substeps * float(self.model.opt.timestep)
+
     def reset(self, seed: int | None = None) -> Observation:
         self.resets.append(seed)
         mujoco.mj_resetData(self.model, self.data)
@@ -143,6 +146,10 @@ class NonMujocoRollout:
     @property
     def camera_models(self) -> dict[str, str]:
         return {}  # nothing MuJoCo renders here
+
+    @property
+    def control_period_s(self) -> float:
+        return 0.05
 
     def reset(self, seed: int | None = None) -> Observation:
         self.resets += 1
@@ -252,14 +259,14 @@ def test_a_joint_missing_from_the_scene_fails_at_connect(
     assert not hal.connected
 
 
-def test_idle_step_advances_the_rendered_frame(
+def test_a_tick_without_an_action_advances_the_rendered_frame(
     fake_arm: RobotDescription, arm_env: Callable[..., MujocoArmRollout]
 ) -> None:
     env = arm_env()
     hal = _attached(fake_arm, env)
     before, start = _frame(hal), hal.read_state()
     for _ in range(5):
-        assert hal.idle_step()
+        assert hal.tick(None)
     after, later = _frame(hal), hal.read_state()
     assert np.abs(after.astype(int) - before.astype(int)).mean() > 0.5, "the frame froze"
     assert not np.allclose(later.positions, start.positions)  # the arm swung under gravity
@@ -268,14 +275,14 @@ def test_idle_step_advances_the_rendered_frame(
     assert all(not a.any() for a in env.actions)  # no hold of its own: zeros
 
 
-def test_idle_step_resets_a_finished_episode_then_steps_zero(
+def test_a_hold_tick_resets_a_finished_episode_then_steps_zero(
     fake_arm: RobotDescription, arm_env: Callable[..., MujocoArmRollout]
 ) -> None:
     env = arm_env(horizon=2)
     hal = _attached(fake_arm, env)
     hal.send_action([0.5, 0.5])
-    assert hal.idle_step() and hal.episode_done and len(env.resets) == 1
-    assert hal.idle_step()
+    assert hal.tick(None) and hal.episode_done and len(env.resets) == 1
+    assert hal.tick(None)
     assert len(env.resets) == 2 and env.resets[-1] == 0
     assert not hal.episode_done  # one step into the new episode
     assert len(env.actions) == 3 and not env.actions[-1].any()
@@ -294,50 +301,38 @@ def test_send_action_resets_a_finished_episode_first(
     np.testing.assert_allclose(env.actions[-1], [0.2, 0.2])
 
 
-def test_estop_stops_idle_steps_and_actions(
+def test_estop_stops_ticks_and_actions(
     fake_arm: RobotDescription, arm_env: Callable[..., MujocoArmRollout]
 ) -> None:
     env = arm_env()
     hal = _attached(fake_arm, env)
-    hal.idle_step()
+    hal.tick(None)
     frame = _frame(hal)
     hal.estop()
     assert hal.estopped
-    assert not hal.idle_step()
+    assert not hal.tick(None)
     with pytest.raises(EStopLatched):
         hal.send_action([0.0, 0.0])
     np.testing.assert_array_equal(_frame(hal), frame)
     assert len(env.actions) == 1
     hal.release_estop()
-    assert hal.idle_step() and len(env.actions) == 2
+    assert hal.tick(None) and len(env.actions) == 2
 
 
-def test_send_action_stamps_even_when_it_rejects(
+def test_a_tick_with_an_action_steps_it_and_keeps_it_commanded(
     fake_arm: RobotDescription, arm_env: Callable[..., MujocoArmRollout]
 ) -> None:
     env = arm_env()
     hal = _attached(fake_arm, env)
-    assert hal.last_action_ns == 0
+    assert hal.control_period_s == pytest.approx(10 * 0.005)
+    assert hal.tick([0.4, -0.1])
     with pytest.raises(ActionRejected, match="expected 2"):
-        hal.send_action([0.1, 0.2, 0.3])
-    first = hal.last_action_ns
-    assert first > 0
-    with pytest.raises(ActionRejected, match="finite"):
-        hal.send_action([0.1, float("nan")])
-    assert hal.last_action_ns >= first and not env.actions
-
-
-def test_idle_step_leaves_the_commanded_action_alone(
-    fake_arm: RobotDescription, arm_env: Callable[..., MujocoArmRollout]
-) -> None:
-    hal = _attached(fake_arm, arm_env())
-    hal.send_action([0.4, -0.1])
-    stamp, commanded = hal.last_action_ns, hal.last_env_action
+        hal.tick([0.1, 0.2, 0.3])
+    assert len(env.actions) == 1  # the refused tick did not step
     for _ in range(3):
-        hal.idle_step()
-    assert hal.last_action_ns == stamp
-    np.testing.assert_array_equal(hal.last_env_action, commanded)
-    np.testing.assert_allclose(commanded, [0.4, -0.1])
+        hal.tick(None)
+    np.testing.assert_allclose(hal.last_env_action, [0.4, -0.1])
+    assert len(env.actions) == 4
 
 
 # -- the non-MuJoCo path -----------------------------------------------------------------
@@ -364,11 +359,11 @@ def test_non_mujoco_positions_come_from_the_observation(
     assert len(warnings) == (1 if reported in (1, 4) else 0)
 
 
-def test_non_mujoco_idle_step_advances_the_scene(fake_arm: RobotDescription) -> None:
+def test_non_mujoco_hold_tick_advances_the_scene(fake_arm: RobotDescription) -> None:
     env = NonMujocoRollout()
     hal = _attached(fake_arm, env)
     assert hal.mujoco_handles() is None
-    assert hal.idle_step()
+    assert hal.tick(None)
     assert env.actions[-1].shape == (3,) and not env.actions[-1].any()
     assert _frame(hal)[0, 0, 0] == 1
     np.testing.assert_array_equal(hal.read_state().positions, [2.0, 3.0])
@@ -381,17 +376,3 @@ def test_connect_without_an_action_width_names_the_backend(fake_arm: RobotDescri
     override = _attached(fake_arm, NonMujocoRollout(action_dim=None), env_action_dim=4)
     assert override.action_dim == 4
     override.send_action([0.0, 1.0, 2.0, 3.0])
-
-
-# -- the idle predicate ------------------------------------------------------------------
-
-HOLD_NS = 200_000_000
-
-
-def test_should_idle_step_waits_out_the_hold() -> None:
-    last = 5_000_000_000
-    assert should_idle_step(123, 0, HOLD_NS)  # never commanded
-    assert not should_idle_step(last, last, HOLD_NS)
-    assert not should_idle_step(last + HOLD_NS - 1, last, HOLD_NS)
-    assert should_idle_step(last + HOLD_NS, last, HOLD_NS)
-    assert should_idle_step(last + 10 * HOLD_NS, last, HOLD_NS)

@@ -6,17 +6,19 @@ Parameters (all read at configure):
   ``sim_env_yaml`` scene names. A ``manifest_path`` runs that file as it reads (not the
   repository's manifest of the same id); a scene naming another robot is refused;
 - ``hal_mode`` (``sim`` | ``real``), ``sim_env_yaml`` (a deploy-scene file, ``""`` for none);
-- ``viewer_enabled`` (bool), ``camera_publish_rate_hz`` (float) and ``joint_state_rate_hz``
-  (float) within :data:`RATE_RANGE_HZ`, ``idle_hold_ms`` (float) within
-  :data:`IDLE_HOLD_RANGE_MS`.
+- ``viewer_enabled`` (bool); ``joint_state_rate_hz`` (float) within :data:`RATE_RANGE_HZ`;
+  ``camera_publish_rate_hz`` (float) within it too, or 0 for each sensor's own ``rate_hz``.
 
 Transitions:
 
 - configure → load the robot and the scene file once, then ``build_hal`` with both (a bad
   manifest, scene or mode fails here with one message);
-- activate → connect the HAL, publish ``/joint_states``, ``/clock`` and the latched
-  ``/openral/action_spec``, subscribe ``/openral/safe_action``, offer the E-stop services and
-  start the :class:`~openral_bridge.SimSensorBridge`;
+- activate → connect the HAL; a simulated one gets its control loop
+  (:class:`~openral_bridge.control_loop.ControlLoop`), which steps once before anything is
+  published and then once per control period, publishing ``/clock`` after each step; then
+  publish ``/joint_states`` and the latched ``/openral/action_spec`` (stamped in simulated
+  time), subscribe ``/openral/safe_action``, offer the E-stop services and start the
+  :class:`~openral_bridge.SimSensorBridge`;
 - deactivate → stop all of that (the HAL stays connected and holds still);
 - cleanup / shutdown / error → also disconnect and drop the HAL; shutdown also sets the
   ``shutdown_event`` the owner passed, so a process can end when told to over ROS.
@@ -28,13 +30,15 @@ is answered ``success=false`` with a throttled warning, never raised into the ex
 The command on ``/openral/safe_action`` (``std_msgs/Float64MultiArray``) is ``data`` = one
 value per HAL action slot, in the order and meaning ``/openral/action_spec`` announces
 (``sensor_msgs/JointState``: ``name`` = slot names, ``position`` = the hold action when
-activated). An action of the wrong width or with a non-finite value is refused with a
-warning and changes nothing. Run it on a single-threaded executor only.
+activated). An action of the wrong width or with a non-finite value, or one sent while the
+E-stop is latched, is refused where it arrives with a warning and changes nothing. On a
+simulated robot a valid action waits for the next control tick (a newer one replaces it and
+is counted as superseded); on a real one it goes to the HAL at once. Run it on a
+single-threaded executor only.
 """
 
 from __future__ import annotations
 
-import math
 import threading
 from collections.abc import Callable
 from pathlib import Path
@@ -42,6 +46,7 @@ from typing import Any
 
 import numpy as np
 from openral_bridge import ros_messages
+from openral_bridge.control_loop import ControlLoop
 from openral_bridge.sim_sensor_bridge import SimSensorBridge, TopicInfo
 from openral_bridge.topics import (
     ACTION_SPEC,
@@ -55,9 +60,10 @@ from openral_core import LoadedRobot, open_robot, open_robot_by_id
 from openral_core.errors import OpenralError
 from openral_core.loader import load_scene
 from openral_core.models import DeployScene, RobotDescription
-from openral_hal.errors import HalError, NotConnected
-from openral_hal.factory import build_hal
+from openral_hal.errors import EStopLatched, HalError, NotConnected
+from openral_hal.factory import build_hal, can_tick
 from openral_hal.protocol import RobotHal
+from openral_mujoco.action import validated_action
 from openral_sim.scene import scene_robot
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.parameter import Parameter
@@ -67,35 +73,13 @@ from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 
 from openral_nodes.lifecycle_guard import guard_change_state
+from openral_nodes.node_parameters import BOUNDS, PARAMETERS, check_rates
 from openral_nodes.runtime import LATCHED
 
 NODE_NAME = "openral_manifest_node"
 WARN_EVERY_S = 2.0
 """At most one warning per this many seconds for a stream of refused actions or
 lifecycle transitions [s]."""
-
-PARAMETERS: dict[str, Any] = {
-    "robot_id": "",
-    "manifest_path": "",
-    "hal_mode": "sim",
-    "sim_env_yaml": "",
-    "viewer_enabled": True,
-    "camera_publish_rate_hz": 10.0,
-    "joint_state_rate_hz": 50.0,
-    "idle_hold_ms": 200.0,
-}
-"""Every parameter and its default."""
-
-RATE_RANGE_HZ = (0.1, 1000.0)
-"""Accepted ``camera_publish_rate_hz`` and ``joint_state_rate_hz``, inclusive [Hz]."""
-IDLE_HOLD_RANGE_MS = (0.0, 60_000.0)
-"""Accepted ``idle_hold_ms``, inclusive [ms]."""
-BOUNDS: dict[str, tuple[tuple[float, float], str]] = {
-    "camera_publish_rate_hz": (RATE_RANGE_HZ, "Hz"),
-    "joint_state_rate_hz": (RATE_RANGE_HZ, "Hz"),
-    "idle_hold_ms": (IDLE_HOLD_RANGE_MS, "ms"),
-}
-"""Range and unit of each bounded parameter, checked at configure."""
 
 Result = TransitionCallbackReturn
 """Transition outcome (a pybind enum, typed Any; hence the ``-> Any`` of the callbacks)."""
@@ -140,10 +124,13 @@ class ManifestLifecycleNode(LifecycleNode):
         self.description: RobotDescription | None = None
         self.hal: RobotHal | None = None
         self.bridge: SimSensorBridge | None = None
+        self.loop: ControlLoop | None = None
+        """The control loop of a simulated HAL while active (None for a real one)."""
         self.log_boot_errors = log_boot_errors
         self.boot_error: str | None = None
         """Why the last configure failed (None after a successful one)."""
-        self.actions_applied = 0
+        self.actions_accepted = 0
+        """Valid actions taken (handed to the control loop, or to a real HAL)."""
         self.actions_refused = 0
         self._entities: list[tuple[str, Any]] = []
         self._state_rate_hz = 0.0
@@ -186,14 +173,15 @@ class ManifestLifecycleNode(LifecycleNode):
                 self._log().error(f"activate failed: {text}")
             return Result.FAILURE
         self._state_rate_hz = float(self._param("joint_state_rate_hz"))
+        self._start_loop(hal)
         self._create_entities()
+        camera_rate = float(self._param("camera_publish_rate_hz"))
         self.bridge = SimSensorBridge(
             self,
             hal,
             hal.description,
             viewer_enabled=bool(self._param("viewer_enabled")),
-            camera_rate_hz=float(self._param("camera_publish_rate_hz")),
-            idle_hold_ms=float(self._param("idle_hold_ms")),
+            camera_rate_hz=camera_rate or None,
         )
         self.bridge.setup()
         super().on_activate(state)
@@ -237,9 +225,10 @@ class ManifestLifecycleNode(LifecycleNode):
             return []
         rows = [
             TopicInfo(JOINT_STATES, "sensor_msgs/msg/JointState", self._state_rate_hz),
-            TopicInfo(CLOCK, "rosgraph_msgs/msg/Clock", self._state_rate_hz),
             TopicInfo(ACTION_SPEC, "sensor_msgs/msg/JointState", None),
         ]
+        if self.loop is not None:
+            rows.insert(1, TopicInfo(CLOCK, "rosgraph_msgs/msg/Clock", 1.0 / self.loop.period_s))
         return rows + (self.bridge.topics() if self.bridge else [])
 
     def action_layout(self) -> tuple[tuple[str, ...], list[float]]:
@@ -257,12 +246,7 @@ class ManifestLifecycleNode(LifecycleNode):
         return self.get_parameter(name).value
 
     def _check_rates(self) -> None:
-        for name, ((low, high), unit) in BOUNDS.items():
-            value = float(self._param(name))
-            if not (math.isfinite(value) and low <= value <= high):
-                raise ValueError(
-                    f"parameter {name} must be within {low:g}-{high:g} {unit}, got {value:g}"
-                )
+        check_rates({name: self._param(name) for name in BOUNDS})
 
     def _hal(self) -> RobotHal:
         if self.hal is None:
@@ -299,18 +283,25 @@ class ManifestLifecycleNode(LifecycleNode):
         self.description = self.hal = None
         return Result.FAILURE
 
+    def _start_loop(self, hal: RobotHal) -> None:
+        """A simulated HAL's control loop: it steps once now, so every message after this
+        carries a simulated time > 0."""
+        self._clock_pub = self.create_publisher(Clock, CLOCK, 10)
+        self._entities = [("publisher", self._clock_pub)]
+        if can_tick(hal):
+            self.loop = ControlLoop(self, hal, on_tick=self._publish_clock)
+            self.loop.start()
+
     def _create_entities(self) -> None:
         spec = self.create_publisher(JointState, ACTION_SPEC, LATCHED)
         names, hold = self.action_layout()
         spec_msg = JointState(name=list(names), position=hold)
-        spec_msg.header.stamp = self.get_clock().now().to_msg()
+        spec_msg.header.stamp = self._stamp(self._hal().read_state().sim_time_s)
         spec.publish(spec_msg)
         self._joint_pub = self.create_publisher(JointState, JOINT_STATES, 10)
-        self._clock_pub = self.create_publisher(Clock, CLOCK, 10)
-        self._entities = [
+        self._entities += [
             ("publisher", spec),
             ("publisher", self._joint_pub),
-            ("publisher", self._clock_pub),
             (
                 "subscription",
                 self.create_subscription(Float64MultiArray, SAFE_ACTION, self._on_safe_action, 10),
@@ -321,31 +312,44 @@ class ManifestLifecycleNode(LifecycleNode):
         ]
         self._publish_state()
 
+    def _stamp(self, sim_time_s: float | None) -> Any:
+        """Simulated time as a header stamp; the node clock for a HAL without one."""
+        if sim_time_s is None:
+            return self.get_clock().now().to_msg()
+        return ros_messages.stamp(sim_time_s)
+
     def _publish_state(self) -> None:
         sample = self._hal().read_state()
-        sim_time = sample.sim_time_s
-        stamp_msg = (
-            ros_messages.stamp(sim_time)
-            if sim_time is not None
-            else self.get_clock().now().to_msg()
-        )
         self._joint_pub.publish(
             ros_messages.joint_state_msg(
-                sample.names, sample.positions, sample.velocities, sample.efforts, stamp_msg
+                sample.names,
+                sample.positions,
+                sample.velocities,
+                sample.efforts,
+                self._stamp(sample.sim_time_s),
             )
         )
+
+    def _publish_clock(self) -> None:
+        sim_time = self._hal().read_state().sim_time_s
         if sim_time is not None:
-            self._clock_pub.publish(Clock(clock=stamp_msg))
+            self._clock_pub.publish(Clock(clock=ros_messages.stamp(sim_time)))
 
     def _on_safe_action(self, msg: Any) -> None:
-        values = np.asarray(msg.data, dtype=np.float64)
+        hal = self._hal()
         try:
-            self._hal().send_action(values)
+            values = validated_action(np.asarray(msg.data, dtype=np.float64), hal.action_names)
+            if self.loop is None:
+                hal.send_action(values)
+            elif hal.estopped:
+                raise EStopLatched("E-stop is latched; call release_estop before sending actions")
+            else:
+                self.loop.offer(values)
         except HalError as error:
             self.actions_refused += 1
             self._log().warning(f"action refused: {error}", throttle_duration_sec=WARN_EVERY_S)
             return
-        self.actions_applied += 1
+        self.actions_accepted += 1
 
     def _on_estop(self, request: Any, response: Any) -> Any:
         self._hal().estop()
@@ -360,6 +364,9 @@ class ManifestLifecycleNode(LifecycleNode):
         return response
 
     def _stop(self) -> None:
+        if self.loop is not None:
+            self.loop.stop()
+            self.loop = None
         if self.bridge is not None:
             self.bridge.teardown()
             self.bridge = None

@@ -23,7 +23,7 @@ from openral_sim.scene import build_scene, check_scene_robot
 
 from openral_hal.errors import ConfigurationError
 from openral_hal.mujoco_arm import MujocoArmHAL
-from openral_hal.protocol import IdleSteppable, RobotHal
+from openral_hal.protocol import RobotHal, Tickable
 from openral_hal.sim_attached import SimAttachedHAL
 
 
@@ -51,9 +51,9 @@ def register_real_driver(name: str, factory: RealDriver) -> None:
     REAL_DRIVERS[name] = factory
 
 
-def can_idle_step(hal: RobotHal) -> TypeGuard[IdleSteppable]:
-    """True only for a simulated HAL that can idle-step (a real one never does)."""
-    return isinstance(hal, IdleSteppable) and not hal.is_real
+def can_tick(hal: RobotHal) -> TypeGuard[Tickable]:
+    """True only for a simulated HAL a control loop may advance (a real one never is)."""
+    return isinstance(hal, Tickable) and not hal.is_real
 
 
 def build_hal(
@@ -121,12 +121,12 @@ def _real_hal(description: RobotDescription, transport: str | None) -> RobotHal:
 
 
 def _conforming_real_hal(hal: object, driver: str) -> RobotHal:
-    """``hal`` when it is a RobotHal, is real and cannot idle-step."""
+    """``hal`` when it is a RobotHal, is real and cannot be ticked."""
     if not isinstance(hal, RobotHal):
         raise ConfigurationError(f"{driver} does not implement openral_hal.protocol.RobotHal")
-    if isinstance(hal, IdleSteppable):
+    if isinstance(hal, Tickable):
         raise ConfigurationError(
-            f"{driver} can idle_step; a real HAL must never be stepped by the idle stepper"
+            f"{driver} has tick(); a real HAL must never be stepped by the control loop"
         )
     if hal.is_real is not True:
         raise ConfigurationError(f"{driver} reports is_real={hal.is_real!r}; a real HAL is real")

@@ -24,6 +24,10 @@ from openral_mujoco.state import FloatArray, JointStateSample
 from openral_hal.errors import HalError, NotConnected
 from openral_hal.protocol import EStopLatch
 
+CONTROL_PERIOD_S = 0.02
+"""Control period of the robot alone under a control loop (50 Hz), rounded to whole
+physics steps [s]."""
+
 
 class MujocoArmHAL(EStopLatch):
     """A robot simulated in its own MuJoCo model, driven in manifest units.
@@ -198,6 +202,26 @@ class MujocoArmHAL(EStopLatch):
         self._refuse_when_estopped()
         driver.command(action, data)
 
+    @property
+    def control_period_s(self) -> float:
+        """:data:`CONTROL_PERIOD_S` rounded to whole physics steps (at least one) [s]."""
+        return self._control_steps() * float(self.mujoco_handles()[0].opt.timestep)
+
+    def tick(self, action: object | None) -> bool:
+        """Apply ``action`` (None: keep the targets in force) and advance one control period.
+
+        Returns:
+            True when physics advanced; False (nothing done) while E-stopped.
+
+        Raises:
+            ActionRejected: ``action`` is malformed; nothing is changed.
+        """
+        if self._estopped:
+            return False
+        if action is not None:
+            self.send_action(action)
+        return self.step(self._control_steps())
+
     def step(self, n: int = 1) -> bool:
         """Advance physics ``n`` steps; returns False (and does nothing) while E-stopped.
 
@@ -221,6 +245,10 @@ class MujocoArmHAL(EStopLatch):
         """Targets ← the current pose, so nothing jumps when the E-stop is released."""
         _, data, driver = self._handles()
         driver.hold_current_pose(data)
+
+    def _control_steps(self) -> int:
+        timestep = float(self.mujoco_handles()[0].opt.timestep)
+        return max(1, round(CONTROL_PERIOD_S / timestep))
 
     def _handles(self) -> tuple[mujoco.MjModel, mujoco.MjData, JointDriver]:
         if self._model is None or self._data is None or self._driver is None:

@@ -5,7 +5,7 @@ spec's slots, and latches an E-stop. Capabilities are separate Protocols, checke
 ``isinstance`` (all are ``runtime_checkable``), never with ``getattr``:
 
 * :class:`CameraHal` renders the manifest's RGB sensors;
-* :class:`IdleSteppable` can be advanced with its hold action between commands (simulated
+* :class:`Tickable` is advanced by a control loop, one control period per tick (simulated
   HALs only; a real HAL never is);
 * :class:`MujocoBacked` exposes the live MuJoCo model and data.
 """
@@ -29,7 +29,7 @@ class RobotHal(Protocol):
 
     @property
     def is_real(self) -> bool:
-        """True for real hardware (never idle-stepped, never attached to a scene)."""
+        """True for real hardware (never ticked by a control loop, never attached to a scene)."""
         ...
 
     @property
@@ -101,16 +101,22 @@ class CameraHal(RobotHal, Protocol):
 
 
 @runtime_checkable
-class IdleSteppable(RobotHal, Protocol):
-    """A simulated HAL that can be advanced with its hold action while nobody commands it."""
+class Tickable(RobotHal, Protocol):
+    """A simulated HAL that a control loop advances in fixed control periods (a real HAL
+    never is: its hardware keeps time)."""
 
     @property
-    def last_action_ns(self) -> int:
-        """``time.monotonic_ns()`` of the last :meth:`send_action` call (0: never)."""
+    def control_period_s(self) -> float:
+        """Simulated time one :meth:`tick` advances [s]."""
         ...
 
-    def idle_step(self) -> bool:
-        """Advance one control period holding; False (nothing done) while E-stopped."""
+    def tick(self, action: object | None) -> bool:
+        """Apply ``action`` (None: hold what is commanded now) and advance one control
+        period; False (nothing done) while E-stopped.
+
+        Raises:
+            ActionRejected: ``action`` is malformed; nothing is changed.
+        """
         ...
 
 

@@ -7,8 +7,8 @@ manifest's contract (:class:`~openral_sim.rollout.ManifestRollout`): then the ac
 value per manifest joint and the joint state is the scene's own, in manifest units. Another
 backend (robosuite) keeps its controller's action; its joint state is read from the MuJoCo
 data by joint name (or from ``obs["joint_positions"]`` for a non-MuJoCo backend).
-Between skills the sensor bridge keeps the scene alive with :meth:`SimAttachedHAL.idle_step`,
-which exists only on this simulated HAL.
+The deploy control loop advances the scene one step per control period with
+:meth:`SimAttachedHAL.tick`, which exists only on simulated HALs.
 """
 
 from __future__ import annotations
@@ -73,8 +73,6 @@ class SimAttachedHAL(EStopLatch):
         self.env_reset_seed = env_reset_seed
         self.env_action_dim = env_action_dim
         self.joint_names = tuple(j.name for j in description.joints)
-        self.last_action_ns = 0
-        """``time.monotonic_ns()`` of the last :meth:`send_action` call (0: never)."""
         self._mjcf_names = tuple(robot.tables.joint_name_map[n] for n in self.joint_names)
         self._rgb = tuple(s.name for s in description.sensors if isinstance(s, RgbSensor))
         self._action_dim: int | None = None
@@ -232,14 +230,10 @@ class SimAttachedHAL(EStopLatch):
     def send_action(self, action: object) -> None:
         """Step the scene with ``action`` (``action_dim`` values).
 
-        The call is time-stamped before anything else, so even a rejected action keeps the
-        idle stepper off the scene.
-
         Raises:
             ActionRejected: Wrong type, width, or a non-finite value; nothing is changed.
             EStopLatched: The E-stop is latched.
         """
-        self.last_action_ns = time.monotonic_ns()
         self._require_obs()
         values = validated_action(action, self._action_names)
         self._refuse_when_estopped()
@@ -255,19 +249,28 @@ class SimAttachedHAL(EStopLatch):
         """
         return np.array(action, dtype=np.float64)
 
-    def idle_step(self) -> bool:
-        """Advance the scene one step with :meth:`hold_action` while no skill is commanding.
+    @property
+    def control_period_s(self) -> float:
+        """Simulated time one scene step advances [s]."""
+        return self.env.control_period_s
 
-        Keeps physics and cameras live between skills: a robot still moving towards its last
-        target gets there, objects settle, time advances. The commanded action and
-        :attr:`last_action_ns` are left as they were.
+    def tick(self, action: object | None) -> bool:
+        """One scene step: with ``action`` (see :meth:`send_action`), or with
+        :meth:`hold_action` when None (the targets in force on a position-controlled scene,
+        the backend's hold on a delta controller); the commanded action is kept.
 
         Returns:
             True when the scene stepped; False (nothing done) while E-stopped.
+
+        Raises:
+            ActionRejected: ``action`` is malformed; nothing is changed.
         """
         self._require_obs()
         if self._estopped:
             return False
+        if action is not None:
+            self.send_action(action)
+            return True
         self._reset_if_done()
         self._step(self.hold_action())
         return True

@@ -86,6 +86,7 @@ class RobosuiteRollout:
         _check_names(env_name, robot, controller)
         self._cameras = dict(cameras)
         self._names = tuple(self._cameras)
+        self._control_period_s = 1.0 / control_freq_hz
         options: dict[str, Any] = {"control_freq": control_freq_hz, "seed": seed}
         if horizon is not None:
             options["horizon"] = horizon
@@ -97,6 +98,11 @@ class RobosuiteRollout:
         self._flip = robosuite.macros.IMAGE_CONVENTION == "opengl"
 
     # -- SimRollout ------------------------------------------------------------------------
+
+    @property
+    def control_period_s(self) -> float:
+        """Simulated time one step advances: 1 / ``control_freq_hz`` [s]."""
+        return self._control_period_s
 
     @property
     def action_dim(self) -> int:

@@ -42,6 +42,11 @@ class SimRollout(Protocol):
         ...
 
     @property
+    def control_period_s(self) -> float:
+        """Simulated time one ``step`` advances [s]."""
+        ...
+
+    @property
     def camera_models(self) -> Mapping[str, str]:
         """Camera name in ``obs["images"]`` → the MJCF camera of ``mujoco_handles()``'s model
         that renders it (empty for a non-MuJoCo backend)."""
