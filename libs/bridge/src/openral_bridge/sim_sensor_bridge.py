@@ -1,38 +1,47 @@
-"""SimSensorBridge: publish what a simulated scene's sensors see, and keep the scene alive.
+"""SimSensorBridge: publish what a simulated scene's sensors see.
 
 One bridge serves every robot; what it publishes follows the manifest and what the HAL
 can do:
 
 - each manifest RGB sensor the scene renders → ``sensor_msgs/Image`` (rgb8) on
   ``/openral/cameras/<name>/image`` and ``sensor_msgs/CameraInfo`` on
-  ``/openral/cameras/<name>/camera_info`` at ``camera_rate_hz``, frame id from the manifest;
-- an idle-step timer at the same rate, only for a HAL that can idle-step (never a real
-  one), advancing the scene while no action has arrived for ``idle_hold_ms``;
+  ``/openral/cameras/<name>/camera_info``, frame id from the manifest, at the sensor's own
+  ``rate_hz`` (one timer per sensor), or at ``camera_rate_hz`` for every sensor when given;
 - the MuJoCo passive viewer when enabled and a display exists.
 
-Header stamps are simulation time (MuJoCo ``data.time``; the node publishes ``/clock``),
-so a frame's stamp says which physics state it shows; a HAL without simulation time
-stamps with the node clock. Depth and lidar sensors are not rendered by the scenes yet
-and are reported, not published.
+A native scene renders a camera only when its frame is due, off the control path: the
+sensor's timer (on the node's single-threaded executor, so never during a control tick)
+snapshots the live state and a :class:`~openral_bridge.frame_renderer.FrameRenderer`
+thread renders and publishes it; a camera still busy with its previous frame is skipped and
+counted (:attr:`SimSensorBridge.frames_skipped`). While the bridge serves its cameras the
+scene's ``reset``/``step`` render nothing. A backend without MuJoCo handles, or one that
+renders inside its own step (robosuite), publishes the last observation's frames
+(``read_images()``) instead, on the executor thread.
 
-The bridge runs on the node's single-threaded executor: its timers never run at the same
-time as the node's ``/openral/safe_action`` callback, which is the whole hand-off rule.
+Header stamps are simulation time (MuJoCo ``data.time``; the node publishes ``/clock``):
+a rendered frame carries its snapshot's time, so the stamp says which physics state it
+shows; a HAL without simulation time stamps with the node clock. Depth and lidar sensors
+are not rendered by the scenes yet and are reported, not published.
 """
 
 from __future__ import annotations
 
-import time
+import threading
 from dataclasses import dataclass
+from functools import partial
 from typing import TYPE_CHECKING, Any
 
 import mujoco
+import numpy as np
+import numpy.typing as npt
 from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
-from openral_hal.factory import can_idle_step
-from openral_hal.protocol import CameraHal, IdleSteppable, MujocoBacked, RobotHal
+from openral_hal.protocol import CameraHal, MujocoBacked, RobotHal
+from openral_hal.sim_attached import SimAttachedHAL
 from openral_mujoco.display import has_display
+from openral_sim.native_scene import NativeScene
 
 from openral_bridge import ros_messages
-from openral_bridge.idle import should_idle_step
+from openral_bridge.frame_renderer import FrameRenderer
 from openral_bridge.topics import camera_image, camera_info
 
 if TYPE_CHECKING:
@@ -51,8 +60,21 @@ class TopicInfo:
     rate_hz: float | None
 
 
+@dataclass
+class _Camera:
+    """One published RGB sensor: its manifest entry, rate [Hz], fovy [deg], publishers."""
+
+    sensor: RgbSensor
+    rate_hz: float
+    fovy_deg: float | None
+    image_pub: Any
+    info_pub: Any | None
+    timer: Any = None
+    published: int = 0
+
+
 class SimSensorBridge:
-    """Camera publishers, idle stepper and viewer of one simulated HAL on one node."""
+    """Camera publishers and viewer of one simulated HAL on one node."""
 
     def __init__(
         self,
@@ -61,49 +83,40 @@ class SimSensorBridge:
         description: RobotDescription,
         *,
         viewer_enabled: bool = True,
-        camera_rate_hz: float = 10.0,
+        camera_rate_hz: float | None = None,
         viewer_sync_rate_hz: float = 30.0,
-        idle_hold_ms: float = 200.0,
     ) -> None:
         """Nothing is created until :meth:`setup`.
 
         Args:
             node: The rclpy node that owns the publishers and timers.
-            hal: A connected HAL; images need :class:`CameraHal`, idle stepping a simulated
-                :class:`IdleSteppable`, the viewer :class:`MujocoBacked`.
-            description: The robot's manifest (sensors, frame ids).
+            hal: A connected HAL; images need :class:`CameraHal`, the viewer
+                :class:`MujocoBacked`.
+            description: The robot's manifest (sensors, rates, frame ids).
             viewer_enabled: Open the MuJoCo passive viewer when a display exists.
-            camera_rate_hz: Camera publish rate, also the idle-step rate [Hz].
+            camera_rate_hz: Publish rate of every camera [Hz]; None: each sensor's
+                ``rate_hz``.
             viewer_sync_rate_hz: How often the viewer is synchronised [Hz].
-            idle_hold_ms: Quiet time after an action before idle stepping resumes [ms].
 
         Raises:
-            ValueError: A rate that is not positive or a negative hold.
+            ValueError: A rate that is not positive.
         """
         rates = {"camera_rate_hz": camera_rate_hz, "viewer_sync_rate_hz": viewer_sync_rate_hz}
         for label, rate in rates.items():
-            if not rate > 0:
+            if rate is not None and not rate > 0:
                 raise ValueError(f"{label} must be > 0 Hz, got {rate}")
-        if idle_hold_ms < 0:
-            raise ValueError(f"idle_hold_ms must be >= 0 ms, got {idle_hold_ms}")
         self.node = node
         self.hal = hal
         self.description = description
         self.viewer_enabled = viewer_enabled
         self.camera_rate_hz = camera_rate_hz
         self.viewer_sync_rate_hz = viewer_sync_rate_hz
-        self.idle_hold_ns = int(idle_hold_ms * 1e6)
-        self.idle_steps = 0
-        """Scene steps taken by the idle stepper since :meth:`setup`."""
-        self.frames_published = 0
-        """Camera ticks that published at least one image since :meth:`setup`."""
-        self._cameras: dict[str, tuple[RgbSensor, float | None]] = {}
-        self._publishers: list[Any] = []
-        self._image_pubs: dict[str, tuple[Any, Any | None]] = {}
-        self._camera_timer: Any = None
+        self._cameras: dict[str, _Camera] = {}
+        self._count_lock = threading.Lock()
         self._camera_hal: CameraHal | None = None
-        self._stepper: IdleSteppable | None = None
-        self._idle_timer: Any = None
+        self._scene: NativeScene | None = None
+        self._scene_rendered_observations = True
+        self._frames: FrameRenderer | None = None
         self._viewer: Any = None
         self._viewer_timer: Any = None
 
@@ -112,47 +125,67 @@ class SimSensorBridge:
     @property
     def active(self) -> bool:
         """True between :meth:`setup` and :meth:`teardown`."""
-        return bool(self._publishers or self._idle_timer or self._viewer)
+        return bool(self._cameras or self._viewer)
 
     @property
-    def idle_stepping(self) -> bool:
-        """True while the idle-step timer exists (set up and not disabled by a fault)."""
-        return self._idle_timer is not None
+    def camera_rates(self) -> dict[str, float]:
+        """Publish rate of each published camera, by sensor name [Hz]."""
+        return {name: camera.rate_hz for name, camera in self._cameras.items()}
+
+    @property
+    def frames_published(self) -> int:
+        """Image messages published since :meth:`setup`, all cameras together."""
+        return sum(self.published_counts().values())
+
+    def published_counts(self) -> dict[str, int]:
+        """Image messages published since :meth:`setup`, by sensor name."""
+        with self._count_lock:
+            return {name: camera.published for name, camera in self._cameras.items()}
+
+    @property
+    def frames_skipped(self) -> int:
+        """Due frames not rendered because that camera's previous frame was in flight."""
+        return sum(self._frames.skipped.values()) if self._frames else 0
 
     def setup(self) -> None:
         """Create the publishers and timers the manifest and HAL allow, and publish once."""
         self.teardown()
-        self.idle_steps = self.frames_published = 0
-        self._setup_idle_stepper()  # first: on a shared tick the step runs before the publish
         self._setup_cameras()
         self._setup_viewer()
         self._report_unrendered()
 
     def teardown(self) -> None:
-        """Destroy every timer and publisher and close the viewer (idempotent)."""
-        for timer in (self._camera_timer, self._idle_timer, self._viewer_timer):
-            if timer is not None:
-                self.node.destroy_timer(timer)
-        self._camera_timer = self._idle_timer = self._viewer_timer = None
-        for publisher in self._publishers:
-            self.node.destroy_publisher(publisher)
-        self._publishers.clear()
-        self._image_pubs.clear()
+        """Stop the render thread, destroy every timer and publisher and close the viewer
+        (idempotent)."""
+        self._stop_camera_timers()
+        if self._frames is not None:
+            frames, self._frames = self._frames, None
+            if not frames.stop():
+                self._log().warning("the camera render thread did not stop within its timeout")
+        if self._scene is not None:
+            self._scene.render_observations = self._scene_rendered_observations
+            self._scene = None
+        for camera in self._cameras.values():
+            for publisher in (camera.image_pub, camera.info_pub):
+                if publisher is not None:
+                    self.node.destroy_publisher(publisher)
         self._cameras.clear()
-        self._camera_hal = self._stepper = None
+        self._camera_hal = None
+        if self._viewer_timer is not None:
+            self.node.destroy_timer(self._viewer_timer)
+            self._viewer_timer = None
         if self._viewer is not None:
             viewer, self._viewer = self._viewer, None
             viewer.close()
 
     def topics(self) -> list[TopicInfo]:
-        """What the bridge publishes now."""
-        rate = self.camera_rate_hz
+        """What the bridge publishes now, each camera at its own rate."""
         rows = []
-        for name, (_, info_pub) in self._image_pubs.items():
-            rows.append(TopicInfo(camera_image(name), "sensor_msgs/msg/Image", rate))
-            if info_pub is not None:
+        for name, camera in self._cameras.items():
+            rows.append(TopicInfo(camera_image(name), "sensor_msgs/msg/Image", camera.rate_hz))
+            if camera.info_pub is not None:
                 info = camera_info(name)
-                rows.append(TopicInfo(info, "sensor_msgs/msg/CameraInfo", rate))
+                rows.append(TopicInfo(info, "sensor_msgs/msg/CameraInfo", camera.rate_hz))
         return rows
 
     # -- cameras ---------------------------------------------------------------------------
@@ -161,47 +194,106 @@ class SimSensorBridge:
         hal = self.hal
         if not isinstance(hal, CameraHal):
             return
+        scene = self._native_scene()
+        rendered = set(scene.camera_names) if scene else set(hal.read_images())
+        for sensor in self.description.sensors:
+            if isinstance(sensor, RgbSensor) and sensor.name in rendered:
+                self._add_camera(hal, sensor)
+        if not self._cameras:
+            return
+        self._camera_hal = hal
+        if scene is not None:
+            self._start_renderer(scene)
+        for name, camera in self._cameras.items():
+            camera.timer = self.node.create_timer(1.0 / camera.rate_hz, partial(self._due, name))
+        for name in self._cameras:
+            self._due(name)
+
+    def _add_camera(self, hal: CameraHal, sensor: RgbSensor) -> None:
         from sensor_msgs.msg import CameraInfo, Image
 
-        rendered = hal.read_images()
-        for sensor in self.description.sensors:
-            if not isinstance(sensor, RgbSensor) or sensor.name not in rendered:
-                continue
-            fovy = self._fovy_deg(hal, sensor)
-            self._cameras[sensor.name] = (sensor, fovy)
-            image = self.node.create_publisher(Image, camera_image(sensor.name), IMAGE_QUEUE_DEPTH)
-            self._publishers.append(image)
-            info = None
-            if fovy is not None:
-                topic = camera_info(sensor.name)
-                info = self.node.create_publisher(CameraInfo, topic, IMAGE_QUEUE_DEPTH)
-                self._publishers.append(info)
-            self._image_pubs[sensor.name] = (image, info)
-        if self._image_pubs:
-            self._camera_hal = hal
-            self._publish_images()
-            self._camera_timer = self.node.create_timer(
-                1.0 / self.camera_rate_hz, self._publish_images
-            )
+        fovy = self._fovy_deg(hal, sensor)
+        image = self.node.create_publisher(Image, camera_image(sensor.name), IMAGE_QUEUE_DEPTH)
+        info = None
+        if fovy is not None:
+            topic = camera_info(sensor.name)
+            info = self.node.create_publisher(CameraInfo, topic, IMAGE_QUEUE_DEPTH)
+        rate = self.camera_rate_hz if self.camera_rate_hz is not None else sensor.rate_hz
+        self._cameras[sensor.name] = _Camera(sensor, float(rate), fovy, image, info)
 
-    def _publish_images(self) -> None:
+    def _native_scene(self) -> NativeScene | None:
+        """The native scene behind the HAL (it renders on demand), else None."""
+        hal = self.hal
+        if isinstance(hal, SimAttachedHAL) and isinstance(hal.env, NativeScene):
+            return hal.env
+        return None
+
+    def _start_renderer(self, scene: NativeScene) -> None:
+        """Render this scene's cameras on a thread of their own; the scene stops rendering
+        into its observations until :meth:`teardown`."""
+
+        def render(
+            renderer: mujoco.Renderer, data: mujoco.MjData, sensor: str
+        ) -> npt.NDArray[np.uint8]:
+            return scene.render_cameras(data, (sensor,), renderer)[sensor]
+
+        model, live = scene.mujoco_handles()
+        self._frames = FrameRenderer(
+            model, live, tuple(self._cameras), scene.image_size, render, self._publish
+        )
+        self._frames.start()
+        self._scene = scene
+        self._scene_rendered_observations = scene.render_observations
+        scene.render_observations = False
+
+    def _due(self, name: str) -> None:
+        """A camera's timer: request a rendered frame, or publish the last observed one."""
+        frames = self._frames
+        if frames is not None:
+            if frames.error is not None:
+                self._camera_failed(frames.error)
+            else:
+                frames.request(name)
+            return
         if self._camera_hal is None:
             return
-        images = self._camera_hal.read_images()
-        stamp = ros_messages.stamp(self._sim_time_s())
-        published = False
-        for name, (image_pub, info_pub) in self._image_pubs.items():
-            image = images.get(name)
-            if image is None:
-                continue
-            sensor, fovy = self._cameras[name]
-            image_pub.publish(ros_messages.image_msg(image, stamp, sensor.frame_id))
-            if info_pub is not None and fovy is not None:
-                height, width = image.shape[:2]
-                info = ros_messages.camera_info_msg(width, height, fovy, stamp, sensor.frame_id)
-                info_pub.publish(info)
-            published = True
-        self.frames_published += int(published)
+        image = self._camera_hal.read_images().get(name)
+        if image is not None:
+            self._publish(name, image, self._sim_time_s())
+
+    def _publish(self, name: str, image: npt.NDArray[np.uint8], sim_time_s: float) -> None:
+        """Publish one frame and its camera info (executor or render thread)."""
+        camera = self._cameras.get(name)
+        if camera is None:
+            return
+        stamp = ros_messages.stamp(sim_time_s)
+        frame_id = camera.sensor.frame_id
+        camera.image_pub.publish(ros_messages.image_msg(image, stamp, frame_id))
+        if camera.info_pub is not None and camera.fovy_deg is not None:
+            height, width = image.shape[:2]
+            info = ros_messages.camera_info_msg(width, height, camera.fovy_deg, stamp, frame_id)
+            camera.info_pub.publish(info)
+        with self._count_lock:
+            camera.published += 1
+
+    def _camera_failed(self, error: BaseException) -> None:
+        """Report a render thread that stopped, once, and publish no more frames (the
+        publishers stay until :meth:`teardown`)."""
+        self._log().error(
+            f"camera rendering stopped ({type(error).__name__}: {error}); "
+            "the robot keeps running without camera images"
+        )
+        self._stop_camera_timers()
+        self._camera_hal = None
+        if self._frames is not None:
+            frames, self._frames = self._frames, None
+            frames.stop()
+
+    def _stop_camera_timers(self) -> None:
+        for camera in self._cameras.values():
+            if camera.timer is not None:
+                self.node.destroy_timer(camera.timer)
+                camera.timer = None
 
     def _sim_time_s(self) -> float:
         sim_time = self.hal.read_state().sim_time_s
@@ -224,29 +316,6 @@ class SimSensorBridge:
 
     def _handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
         return self.hal.mujoco_handles() if isinstance(self.hal, MujocoBacked) else None
-
-    # -- idle stepper ----------------------------------------------------------------------
-
-    def _setup_idle_stepper(self) -> None:
-        if can_idle_step(self.hal):
-            self._stepper = self.hal
-            self._idle_timer = self.node.create_timer(1.0 / self.camera_rate_hz, self._idle_tick)
-
-    def _idle_tick(self) -> None:
-        stepper = self._stepper
-        if stepper is None:
-            return
-        if not should_idle_step(time.monotonic_ns(), stepper.last_action_ns, self.idle_hold_ns):
-            return
-        try:
-            stepped = stepper.idle_step()
-        except Exception as error:  # one report, then the stepper is off for good
-            self._log().error(f"idle stepping disabled after {type(error).__name__}: {error}")
-            if self._idle_timer is not None:
-                self.node.destroy_timer(self._idle_timer)
-                self._idle_timer = None
-            return
-        self.idle_steps += int(bool(stepped))
 
     # -- viewer ----------------------------------------------------------------------------
 
@@ -295,7 +364,7 @@ class SimSensorBridge:
             f"{s.name} ({s.kind})"
             for s in self.description.sensors
             if isinstance(s, DepthSensor | LidarSensor)
-            or (isinstance(s, RgbSensor) and s.name not in self._image_pubs)
+            or (isinstance(s, RgbSensor) and s.name not in self._cameras)
         ]
         if skipped:
             self._log().info(

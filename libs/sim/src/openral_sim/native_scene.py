@@ -11,12 +11,19 @@ The robot is driven by the same :class:`~openral_mujoco.joint_driver.JointDriver
 gripper commands of their write mode), clamped to the manifest's limits and slewed by its
 velocity limits; the joint state is read in the same units. Only the addresses differ: the
 robot's joints are found in the composed model by name.
+
+Cameras render on demand. With ``render_observations`` (the default, what ``openral sim
+run`` and the tests read) every ``reset``/``step`` renders each camera into
+``obs["images"]``; without it they render nothing and ``obs["images"]`` is empty, and a
+caller renders the frames it needs with :meth:`NativeScene.render_cameras`, on any thread,
+from any ``MjData`` of this model (``deploy sim`` renders snapshots on a thread of its own).
 """
 
 from __future__ import annotations
 
 import math
 import time
+from collections.abc import Iterable
 
 import mujoco
 import numpy as np
@@ -41,8 +48,14 @@ class NativeScene:
     """A MuJoCo scene composed from a loaded robot and a deploy-scene file (a SimRollout
     whose action and joint state follow the manifest's contract)."""
 
-    def __init__(self, scene: DeployScene, robot: LoadedRobot):
+    def __init__(self, scene: DeployScene, robot: LoadedRobot, *, render_observations: bool = True):
         """Compose ``scene`` around ``robot`` (both as loaded, so errors point into them).
+
+        Args:
+            scene: The loaded deploy-scene file.
+            robot: The loaded robot it names.
+            render_observations: Render every camera into ``obs["images"]`` on each
+                ``reset``/``step`` (False: leave it empty; see :meth:`render_cameras`).
 
         Raises:
             ManifestError: At the field of the scene file or manifest that cannot be built:
@@ -77,6 +90,9 @@ class NativeScene:
         options = scene.scene.options
         self.substeps = physics_steps_per_control(scene, self.model.opt.timestep)
         self.horizon = options.horizon if options and options.horizon else None
+        self.render_observations = render_observations
+        """Whether ``reset``/``step`` render the cameras into ``obs["images"]``; may be
+        changed at any time (the next observation follows it)."""
         self._renderer: mujoco.Renderer | None = None
         self._steps = 0
 
@@ -86,6 +102,11 @@ class NativeScene:
     def action_dim(self) -> int:
         """One value per manifest joint."""
         return len(self.wiring.joint_names)
+
+    @property
+    def control_period_s(self) -> float:
+        """Simulated time one step advances: ``substeps`` physics steps [s]."""
+        return self.substeps * float(self.model.opt.timestep)
 
     @property
     def action_names(self) -> tuple[str, ...]:
@@ -99,8 +120,14 @@ class NativeScene:
 
     @property
     def camera_names(self) -> tuple[str, ...]:
-        """Manifest sensor names rendered into ``obs["images"]``."""
+        """Manifest sensor names this scene renders (into ``obs["images"]`` while
+        :attr:`render_observations`, else by :meth:`render_cameras`)."""
         return tuple(self._sensors)
+
+    @property
+    def image_size(self) -> tuple[int, int]:
+        """(height, width) of every camera frame [px]: the scene's ``observation`` size."""
+        return self._height, self._width
 
     @property
     def camera_models(self) -> dict[str, str]:
@@ -156,6 +183,47 @@ class NativeScene:
         """The scene's live (model, data)."""
         return self.model, self.data
 
+    def render_cameras(
+        self,
+        data: mujoco.MjData,
+        sensors: Iterable[str] | None = None,
+        renderer: mujoco.Renderer | None = None,
+    ) -> dict[str, npt.NDArray[np.uint8]]:
+        """Render the cameras of ``sensors`` (default: all) as ``data`` places them.
+
+        ``data`` must belong to this scene's model and hold the kinematics the cameras see
+        (``xpos``/``xmat``, camera and light poses: after ``mj_step``, ``mj_forward`` or
+        ``mj_kinematics`` + ``mj_camlight``); it is only read. The live :attr:`data` is one
+        choice; a copy is another.
+
+        Args:
+            data: MjData of :attr:`model`.
+            sensors: Manifest sensor names among :attr:`camera_names`.
+            renderer: A renderer of :attr:`model` at :attr:`image_size`, created on the
+                calling thread (an EGL context is current on one thread); None uses the
+                scene's own, which then belongs to the thread that first used it.
+
+        Returns:
+            One H x W x 3 uint8 frame (a fresh array) per sensor, by sensor name.
+
+        Raises:
+            KeyError: A sensor this scene does not render.
+        """
+        names = self.camera_names if sensors is None else tuple(sensors)
+        unknown = [name for name in names if name not in self._sensors]
+        if unknown:
+            raise KeyError(f"the scene renders no camera {unknown}; it has {self.camera_names}")
+        if renderer is None and names:
+            if self._renderer is None:
+                self._renderer = mujoco.Renderer(self.model, self._height, self._width)
+            renderer = self._renderer
+        images: dict[str, npt.NDArray[np.uint8]] = {}
+        for name in names:
+            assert renderer is not None
+            renderer.update_scene(data, camera=self._sensors[name])
+            images[name] = renderer.render().copy()
+        return images
+
     def close(self) -> None:
         """Free the offscreen renderer."""
         if self._renderer is not None:
@@ -165,13 +233,7 @@ class NativeScene:
     # -- internals -------------------------------------------------------------------------
 
     def _observe(self) -> Observation:
-        if self._sensors and self._renderer is None:
-            self._renderer = mujoco.Renderer(self.model, self._height, self._width)
-        images: dict[str, npt.NDArray[np.uint8]] = {}
-        for sensor, camera in self._sensors.items():
-            assert self._renderer is not None
-            self._renderer.update_scene(self.data, camera=camera)
-            images[sensor] = self._renderer.render().copy()
+        images = self.render_cameras(self.data) if self.render_observations else {}
         return {"images": images, "time": float(self.data.time)}
 
     def _hold_base_where_it_is(self) -> None:
