@@ -23,6 +23,7 @@ from openral_nodes.manifest_node import ManifestLifecycleNode
 from openral_nodes.runtime import LATCHED, Spinner, claim_domain_id
 from rclpy.context import Context
 from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, Image, JointState
 
 from tests.conftest import REPO
@@ -110,6 +111,7 @@ def info_topic(camera: str) -> str:
 
 PROBE_TOPICS: dict[str, Any] = {
     "/joint_states": JointState,
+    "/clock": Clock,
     ACTION_SPEC: JointState,
     **{image_topic(c): Image for c in CAMERAS},
     **{info_topic(c): CameraInfo for c in CAMERAS},

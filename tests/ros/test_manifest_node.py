@@ -15,12 +15,16 @@ import numpy as np
 from openral_bridge.topics import ACTION_SPEC, ESTOP, RELEASE_ESTOP, SAFE_ACTION
 from openral_core.models import RgbSensor
 from openral_mujoco.png import encode_png
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 
 from tests.ros.ros_helpers import (
     CAMERAS,
     FRANKA_SCENE,
+    PROBE_TOPICS,
     WAIT_S,
     Deployed,
     image_topic,
@@ -35,7 +39,8 @@ RATE_WINDOW_S = 3.0
 
 
 def stamp_s(msg: Any) -> float:
-    return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+    stamp = msg.clock if isinstance(msg, Clock) else msg.header.stamp
+    return float(stamp.sec + stamp.nanosec * 1e-9)
 
 
 def frame(msg: Any) -> np.ndarray:
@@ -232,3 +237,32 @@ def test_sim_run_and_deploy_show_the_same_frames_for_the_same_seed(
         )
         expected = (tmp_path / f"{camera}_{step:04d}.png").read_bytes()
         assert encode_png(frame(first)) == expected, f"{camera} frame of step {step} differs"
+
+
+def test_no_message_carries_a_zero_stamp(deployed: Deployed) -> None:
+    """The loop steps before anything is published: the first 100 messages of every topic
+    (action_spec and /clock too) are stamped in simulated time above zero."""
+    probe = deployed.probe
+    for topic in PROBE_TOPICS:
+        probe.wait_count(topic, 1)
+    for topic, received in probe.messages.items():
+        stamps = [stamp_s(r.msg) for r in received[:100]]
+        assert stamps and min(stamps) > 0.0, f"{topic}: a zero stamp among {stamps[:5]}"
+
+
+def test_a_use_sim_time_node_reads_the_time_of_the_stamps(deployed: Deployed) -> None:
+    reader = Node(
+        "sim_time_reader",
+        context=deployed.probe.node.context,
+        parameter_overrides=[Parameter("use_sim_time", value=True)],  # type: ignore[no-untyped-call]
+    )
+    deployed.spinner.add_node(reader)
+    try:
+        wait_until(lambda: reader.get_clock().now().nanoseconds > 0, what="/clock to arrive")
+        deployed.probe.wait_count("/joint_states", 2, start=time.monotonic())
+        now_s = reader.get_clock().now().nanoseconds / 1e9
+        latest_s = stamp_s(deployed.probe.latest("/joint_states"))
+        assert abs(now_s - latest_s) < 0.25, (now_s, latest_s)  # a few 50 ms control periods
+    finally:
+        deployed.spinner.remove_node(reader)
+        reader.destroy_node()
