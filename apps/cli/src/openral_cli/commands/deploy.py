@@ -23,8 +23,6 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from openral_core.errors import OpenralError
-from rich import box
-from rich.table import Table
 
 from openral_cli.console import out
 from openral_cli.ros_available import require_ros
@@ -148,6 +146,8 @@ def _shut_down(node: ManifestLifecycleNode, stop: threading.Event) -> str:
 def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
     """What the graph offers: published topics in a table (fits 80 columns), then inputs."""
     from openral_bridge.topics import ESTOP, RELEASE_ESTOP, SAFE_ACTION
+    from rich import box
+    from rich.table import Table
 
     names, _ = node.action_layout()
     robot = node.description.name if node.description is not None else "?"

@@ -29,7 +29,6 @@ from openral_core import (
 from openral_core.errors import OpenralError
 from openral_core.models import LimitedJoint
 from openral_core.registry import MANIFEST_NAME
-from rich.table import Table
 
 from openral_cli.console import err, highlighted, line, out, styled
 
@@ -39,6 +38,8 @@ app = typer.Typer(help="Inspect and validate robot manifests.", no_args_is_help=
 @app.command("list")
 def list_robots() -> None:
     """Table of every robot: id, joints, grippers, cameras, floating base."""
+    from rich.table import Table
+
     table = Table(title="robots/")
     table.add_column("id", no_wrap=True)
     for column in ("joints", "grippers"):
@@ -82,6 +83,8 @@ def _short_uri(uri: str) -> str:
 @app.command("show")
 def show(robot_id: Annotated[str, typer.Argument(help="Robot id (folder under robots/).")]) -> None:
     """The resolved HAL wiring, VLA slot table and joint-name map of one robot."""
+    from rich.table import Table
+
     robot = load_robot_by_id(robot_id)
     tables = robot_tables(robot)
     header = line((robot.display_name, "bold"), f" ({robot.name}) — {manifest_path(robot_id)}")
@@ -113,6 +116,8 @@ def show(robot_id: Annotated[str, typer.Argument(help="Robot id (folder under ro
 
 
 def _print_sim_summary(mjcf_uri: str, robot: RobotDescription) -> None:
+    from rich.table import Table
+
     wiring = robot_tables(robot).hal_wiring
     assert wiring is not None
     out.print(
@@ -217,6 +222,7 @@ def check(
     """
     from openral_mujoco.mjcf_uri import robot_model_file
     from openral_mujoco.model_check import check_robot, compile_robot_model
+    from rich.table import Table
 
     files = _named_manifests(targets, all_robots, "check")
     summary = Table(title="robot check")

@@ -20,7 +20,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
-from rich.table import Table
 
 from openral_cli.console import err, out
 from openral_cli.ros_available import require_ros
@@ -94,6 +93,7 @@ def topics(
     from openral_core.errors import escaped
     from openral_nodes.topic_graph import graph_topics
     from openral_nodes.topic_probe import measure_rates
+    from rich.table import Table
 
     with _probe_node(domain_id) as node:
         time.sleep(wait)

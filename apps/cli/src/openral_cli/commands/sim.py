@@ -18,7 +18,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.table import Table
 
 from openral_cli.console import out, progress
 
@@ -63,6 +62,7 @@ def run(
     from openral_core.loader import load_scene
     from openral_hal.factory import HalMode, build_hal
     from openral_sim.scene import scene_robot
+    from rich.table import Table
 
     if motion not in MOTIONS:
         raise typer.BadParameter("expected 'sway' or 'hold'", param_hint="--motion")
