@@ -13,6 +13,7 @@ import pytest
 from openral_nodes.runtime import Spinner, claim_domain_id, ros_session
 from sensor_msgs.msg import Image, JointState
 
+from benchmarks.real_time import manifest_with_rates
 from tests.ros.ros_helpers import CAMERAS, FRANKA_SCENE, Probe, image_topic
 
 OPENRAL = Path(sys.executable).parent / "openral"
@@ -88,3 +89,21 @@ def test_a_scene_that_fails_at_configure_exits_1_with_one_line(tmp_path: Path) -
     assert len(lines) == 1, err
     assert lines[0].startswith("error: configure failed:")
     assert "'nosuch' is not a camera sensor" in lines[0] and "agentview, wrist" in lines[0]
+
+
+def test_each_camera_runs_at_its_manifest_rate_unless_camera_rate_overrides(
+    tmp_path: Path,
+) -> None:
+    """--manifest runs a manifest outside robots/ (here the Panda's, cameras at 15 and 5 Hz);
+    the printed interfaces show each sensor's own rate, and --camera-rate replaces them all."""
+    manifest = manifest_with_rates(tmp_path, {"agentview": 15.0, "wrist": 5.0})
+    for extra, rates in (([], ("15 Hz", "5 Hz")), (["--camera-rate", "7"], ("7 Hz", "7 Hz"))):
+        process = deploy(
+            "--config", str(FRANKA_SCENE), "--manifest", str(manifest), "--duration", "1",
+            *extra, domain=claim_domain_id(),
+        )  # fmt: skip
+        out, err = process.communicate(timeout=EXIT_WAIT_S)
+        assert process.returncode == 0, err
+        rows = {line.split()[0]: line for line in out.splitlines() if "cameras/" in line}
+        assert rates[0] in rows["/openral/cameras/agentview/image"], out
+        assert rates[1] in rows["/openral/cameras/wrist/image"], out

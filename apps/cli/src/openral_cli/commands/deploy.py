@@ -42,9 +42,21 @@ def sim(
         bool, typer.Option("--no-viewer", help="Never open the MuJoCo viewer.")
     ] = False,
     camera_rate: Annotated[
-        float,
-        typer.Option("--camera-rate", min=0.1, max=1000.0, help="Camera and idle-step rate [Hz]."),
-    ] = 10.0,
+        float | None,
+        typer.Option(
+            "--camera-rate",
+            min=0.1,
+            max=1000.0,
+            help="Publish every camera at this rate [Hz] (default: each sensor's rate_hz).",
+        ),
+    ] = None,
+    manifest: Annotated[
+        Path | None,
+        typer.Option(
+            "--manifest",
+            help="Run the robot from this manifest file (default: robots/<robot_id>/robot.yaml).",
+        ),
+    ] = None,
     joint_state_rate: Annotated[
         float,
         typer.Option("--joint-state-rate", min=0.1, max=1000.0, help="/joint_states rate [Hz]."),
@@ -62,6 +74,8 @@ def sim(
 ) -> None:
     """Bring SCENE's robot up as a ROS 2 graph: joint states, cameras, actions, E-stop."""
     _require_file(config)
+    if manifest is not None:
+        _require_file(manifest, "manifest", "robots/franka_panda/robot.yaml")
     require_ros()
     from openral_nodes.runtime import ros_session, spin_until
     from rclpy.executors import SingleThreadedExecutor
@@ -70,9 +84,11 @@ def sim(
         "sim_env_yaml": str(config.resolve()),
         "hal_mode": "sim",
         "viewer_enabled": not no_viewer,
-        "camera_publish_rate_hz": float(camera_rate),
+        "camera_publish_rate_hz": float(camera_rate or 0.0),  # 0: each sensor's own rate
         "joint_state_rate_hz": float(joint_state_rate),
     }
+    if manifest is not None:
+        parameters["manifest_path"] = str(manifest.resolve())
     stop = threading.Event()
     with ros_session(domain_id=domain_id) as context:
         node = _make_node(context, parameters, stop)
@@ -95,13 +111,12 @@ def sim(
     out.print(stopped, soft_wrap=False, highlight=True)
 
 
-def _require_file(config: Path) -> None:
-    """A missing scene file is reported before any ROS work starts (the node reads it)."""
-    if not config.is_file():
-        raise OpenralError(
-            f"{config}: no such scene file; expected a deploy-scene YAML such as "
-            "robots/franka_panda/scenes/tabletop.yaml"
-        )
+def _require_file(
+    file: Path, what: str = "scene", example: str = "robots/franka_panda/scenes/tabletop.yaml"
+) -> None:
+    """A missing file is reported before any ROS work starts (the node reads it)."""
+    if not file.is_file():
+        raise OpenralError(f"{file}: no such {what} file; expected a YAML file such as {example}")
 
 
 def _make_node(
