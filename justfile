@@ -66,6 +66,10 @@ bench-hal *ARGS:
 bench-scene *ARGS:
     python -m benchmarks.scene_step {{ARGS}}
 
-# deploy sim start-up (first state, first frames), camera rate and CPU; writes benchmarks/results/deploy_startup.json.
+# deploy sim start-up (median of 5: first state, first frames), camera rate and CPU; writes benchmarks/results/deploy_startup.json.
 bench-deploy *ARGS:
     python -m benchmarks.deploy_startup {{ARGS}}
+
+# deploy sim's camera path: CPU against a bare MuJoCo loop per image size, highest camera rate sustained; writes benchmarks/results/camera_path.json.
+bench-camera *ARGS:
+    python -m benchmarks.camera_path {{ARGS}}
