@@ -73,3 +73,7 @@ bench-deploy *ARGS:
 # deploy sim's camera path: CPU against a bare MuJoCo loop per image size, highest camera rate sustained; writes benchmarks/results/camera_path.json.
 bench-camera *ARGS:
     python -m benchmarks.camera_path {{ARGS}}
+
+# deploy sim against the wall clock: simulated/wall time, /joint_states and per-camera rates idle, under rskill at 10 and 40 Hz and a flood; writes benchmarks/results/real_time.json.
+bench-realtime *ARGS:
+    python -m benchmarks.real_time {{ARGS}}

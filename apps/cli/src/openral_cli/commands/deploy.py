@@ -51,11 +51,7 @@ def sim(
         ),
     ] = None,
     manifest: Annotated[
-        Path | None,
-        typer.Option(
-            "--manifest",
-            help="Run the robot from this manifest file (default: robots/<robot_id>/robot.yaml).",
-        ),
+        Path | None, typer.Option("--manifest", help="Manifest file (default: the scene's robot).")
     ] = None,
     joint_state_rate: Annotated[
         float,
@@ -73,22 +69,11 @@ def sim(
     ] = None,
 ) -> None:
     """Bring SCENE's robot up as a ROS 2 graph: joint states, cameras, actions, E-stop."""
-    _require_file(config)
-    if manifest is not None:
-        _require_file(manifest, "manifest", "robots/franka_panda/robot.yaml")
+    parameters = _node_parameters(config, manifest, not no_viewer, camera_rate, joint_state_rate)
     require_ros()
     from openral_nodes.runtime import ros_session, spin_until
     from rclpy.executors import SingleThreadedExecutor
 
-    parameters: dict[str, Any] = {
-        "sim_env_yaml": str(config.resolve()),
-        "hal_mode": "sim",
-        "viewer_enabled": not no_viewer,
-        "camera_publish_rate_hz": float(camera_rate or 0.0),  # 0: each sensor's own rate
-        "joint_state_rate_hz": float(joint_state_rate),
-    }
-    if manifest is not None:
-        parameters["manifest_path"] = str(manifest.resolve())
     stop = threading.Event()
     with ros_session(domain_id=domain_id) as context:
         node = _make_node(context, parameters, stop)
@@ -109,6 +94,28 @@ def sim(
                 signal.signal(sig, handler)
     stopped = f"stopped ({reason}) after {time.monotonic() - started:.1f} s; clean shutdown"
     out.print(stopped, soft_wrap=False, highlight=True)
+
+
+def _node_parameters(
+    config: Path,
+    manifest: Path | None,
+    viewer: bool,
+    camera_rate: float | None,
+    joint_state_rate: float,
+) -> dict[str, Any]:
+    """The manifest node's parameters from the command line (files checked first)."""
+    _require_file(config)
+    parameters: dict[str, Any] = {
+        "sim_env_yaml": str(config.resolve()),
+        "hal_mode": "sim",
+        "viewer_enabled": viewer,
+        "camera_publish_rate_hz": float(camera_rate or 0.0),  # 0: each sensor's own rate
+        "joint_state_rate_hz": float(joint_state_rate),
+    }
+    if manifest is not None:
+        _require_file(manifest, "manifest", "robots/franka_panda/robot.yaml")
+        parameters["manifest_path"] = str(manifest.resolve())
+    return parameters
 
 
 def _require_file(
