@@ -64,7 +64,8 @@ from openral_hal.errors import EStopLatched, HalError, NotConnected
 from openral_hal.factory import build_hal, can_tick
 from openral_hal.protocol import RobotHal
 from openral_mujoco.action import validated_action
-from openral_sim.scene import scene_robot
+from openral_sim.rollout import SimRollout
+from openral_sim.scene import build_scene, scene_robot
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
@@ -83,6 +84,12 @@ lifecycle transitions [s]."""
 
 Result = TransitionCallbackReturn
 """Transition outcome (a pybind enum, typed Any; hence the ``-> Any`` of the callbacks)."""
+
+
+def _on_demand(scene: DeployScene, robot: LoadedRobot) -> SimRollout:
+    """The scene backend without images in its observations: the sensor bridge renders each
+    camera when its frame is due."""
+    return build_scene(scene, robot, render_observations=False)
 
 
 class ManifestLifecycleNode(LifecycleNode):
@@ -145,7 +152,9 @@ class ManifestLifecycleNode(LifecycleNode):
         try:
             self._check_rates()
             robot, scene = self._load()
-            self.hal = build_hal(robot, mode=str(self._param("hal_mode")), scene=scene)
+            self.hal = build_hal(
+                robot, mode=str(self._param("hal_mode")), scene=scene, env_builder=_on_demand
+            )
             self.description = robot.description
         except (OpenralError, ValueError) as error:
             return self._fail_configure(str(error))

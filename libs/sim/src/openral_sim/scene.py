@@ -51,8 +51,13 @@ def check_scene_robot(scene: DeployScene, robot: LoadedRobot) -> None:
         raise error_at(scene, ("robot_id",), message)
 
 
-def build_scene(scene: DeployScene, robot: LoadedRobot) -> SimRollout:
+def build_scene(
+    scene: DeployScene, robot: LoadedRobot, *, render_observations: bool = True
+) -> SimRollout:
     """The backend ``scene`` names, built for ``robot``; reads no file but the robot's model.
+
+    ``render_observations=False`` builds a native scene that renders nothing into its
+    observations (``deploy sim`` renders frames on demand instead); robosuite renders its own.
 
     Raises:
         ManifestError: The scene is for another robot or cannot be built for this one;
@@ -69,7 +74,7 @@ def build_scene(scene: DeployScene, robot: LoadedRobot) -> SimRollout:
         return build_robosuite_rollout(scene, robot.description)
     from openral_sim.native_scene import NativeScene
 
-    return NativeScene(scene, robot)
+    return NativeScene(scene, robot, render_observations=render_observations)
 
 
 def build_sim_env_from_yaml(path: str | Path, robot_id_fallback: str | None = None) -> SimRollout:
