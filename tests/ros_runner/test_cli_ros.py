@@ -155,3 +155,13 @@ def test_echo_streams_until_ctrl_c_then_exits_0(ros: RosHarness) -> None:
     assert process.returncode == 0, stderr
     assert "Traceback" not in stderr
     assert sum(line.startswith("name: [panda_joint1") for line in lines) >= 2
+
+
+def test_topics_on_an_empty_graph_keeps_looking_for_late_peers_then_says_so() -> None:
+    from openral_cli.commands.ros import LATE_DISCOVERY_S
+    from openral_nodes.runtime import claim_domain_id
+
+    empty = claim_domain_id()
+    result = runner.invoke(app, ["ros", "topics", "--wait", "0", "--domain-id", str(empty)])
+    assert result.exit_code == 0
+    assert f"no topics on ROS_DOMAIN_ID={empty} after {LATE_DISCOVERY_S:.1f} s" in result.output

@@ -74,6 +74,12 @@ def _quiet_ctrl_c() -> Iterator[None]:
         raise typer.Exit(0) from None
 
 
+LATE_DISCOVERY_S = 3.0
+"""How much longer ``topics`` looks when the graph is still empty after ``--wait``: FastDDS
+announces a participant again every 3 s, so a peer that missed the first announcement
+(a loaded machine) shows up within that [s]."""
+
+
 @app.command("topics")
 def topics(
     wait: Annotated[
@@ -98,10 +104,15 @@ def topics(
     with _probe_node(domain_id) as node:
         time.sleep(wait)
         infos = graph_topics(node, include_hidden=all_topics)
+        waited = wait
+        while not infos and waited < wait + LATE_DISCOVERY_S:  # a peer missed our announcement
+            time.sleep(0.1)
+            waited += 0.1
+            infos = graph_topics(node, include_hidden=all_topics)
         rates = measure_rates(node, infos, window) if rate else {}
         domain = node.context.get_domain_id()
     if not infos:
-        err.print(f"no topics on ROS_DOMAIN_ID={domain} after {wait:g} s", highlight=True)
+        err.print(f"no topics on ROS_DOMAIN_ID={domain} after {waited:.1f} s", highlight=True)
         return
     table = Table(title=f"ROS_DOMAIN_ID={domain}")
     table.add_column("topic", no_wrap=True)
