@@ -193,6 +193,8 @@ class ManifestLifecycleNode(LifecycleNode):
             camera_rate_hz=camera_rate or None,
         )
         self.bridge.setup()
+        if self.loop is not None:  # the pace is judged from here on, not over the start-up
+            self.loop.watch.restart()
         super().on_activate(state)
         return Result.SUCCESS
 
