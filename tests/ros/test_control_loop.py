@@ -51,13 +51,13 @@ def node(ros_context: Context) -> Iterator[Node]:
     node.destroy_node()
 
 
-def _loop(node: Node, hal: CountingHal, ticked: list[int] | None = None) -> ControlLoop:
-    on_tick = None if ticked is None else (lambda: ticked.append(1))
+def _loop(node: Node, hal: CountingHal, ticked: list[float | None] | None = None) -> ControlLoop:
+    on_tick = None if ticked is None else (lambda sim_time: ticked.append(sim_time))
     return ControlLoop(node, hal, on_tick=on_tick)  # type: ignore[arg-type]
 
 
 def test_the_newest_action_wins_and_the_replaced_ones_are_counted(node: Node) -> None:
-    hal, ticked = CountingHal(), []
+    hal, ticked = CountingHal(), list[float | None]()
     loop = _loop(node, hal, ticked)
     for value in (1.0, 2.0, 3.0):
         loop.offer(np.array([value]))
@@ -65,6 +65,7 @@ def test_the_newest_action_wins_and_the_replaced_ones_are_counted(node: Node) ->
     loop.tick()  # nothing new: hold
     assert [None if a is None else a.tolist() for a in hal.given] == [[3.0], None]
     assert (loop.superseded, loop.applied, loop.ticks, len(ticked)) == (2, 1, 2, 2)
+    assert ticked == pytest.approx([0.02, 0.04])  # each tick's simulated time, handed on
 
 
 def test_a_failing_tick_is_counted_and_the_loop_goes_on(node: Node) -> None:

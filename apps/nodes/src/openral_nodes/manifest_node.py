@@ -341,8 +341,7 @@ class ManifestLifecycleNode(LifecycleNode):
             )
         )
 
-    def _publish_clock(self) -> None:
-        sim_time = self._hal().read_state().sim_time_s
+    def _publish_clock(self, sim_time: float | None) -> None:
         if sim_time is not None:
             self._clock_pub.publish(Clock(clock=ros_messages.stamp(sim_time)))
 

@@ -45,15 +45,15 @@ class ControlLoop:
     """Steps one :class:`Tickable` HAL once per control period on a node's timer."""
 
     def __init__(
-        self, node: Node, hal: Tickable, on_tick: Callable[[], None] | None = None
+        self, node: Node, hal: Tickable, on_tick: Callable[[float | None], None] | None = None
     ) -> None:
         """Nothing runs until :meth:`start`.
 
         Args:
             node: The node that owns the timer (and whose logger reports).
             hal: A connected simulated HAL.
-            on_tick: Called after every tick that advanced the scene (e.g. to publish
-                ``/clock``).
+            on_tick: Called after every tick that advanced the scene with its simulated
+                time [s] (None for a HAL without one), e.g. to publish ``/clock``.
         """
         self.node = node
         self.hal = hal
@@ -112,14 +112,13 @@ class ControlLoop:
             return
         self.ticks += 1
         self.applied += int(action is not None)
-        if self.on_tick is not None:
-            self.on_tick()
-        self._check_pace()
-
-    def _check_pace(self) -> None:
         sim_time = self.hal.read_state().sim_time_s
-        if sim_time is None:
-            return
+        if self.on_tick is not None:
+            self.on_tick(sim_time)
+        if sim_time is not None:
+            self._check_pace(sim_time)
+
+    def _check_pace(self, sim_time: float) -> None:
         factor = self.watch.update(time.monotonic(), sim_time)
         if factor is not None:
             self._log().warning(
