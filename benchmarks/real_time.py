@@ -18,9 +18,7 @@ written to ``benchmarks/results/real_time.json``.
 from __future__ import annotations
 
 import argparse
-import os
 import subprocess
-import sys
 import tempfile
 import threading
 import time
@@ -36,12 +34,18 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float64MultiArray
 
+from benchmarks.deploy_launch import (
+    DEFAULT_SCENE,
+    OPENRAL,
+    REPO,
+    Launch,
+    camera_topic,
+    deploy_env,
+    received_rate,
+)
 from benchmarks.results_file import write_results
 
-REPO = Path(__file__).resolve().parent.parent
-SCENE = REPO / "robots" / "franka_panda" / "scenes" / "tabletop.yaml"
 MANIFEST = REPO / "robots" / "franka_panda" / "robot.yaml"
-OPENRAL = Path(sys.executable).parent / "openral"
 STATE_HZ = 50.0
 TARGETS = {"real_time": 0.01, "state_rate": 0.02, "camera_rate": 0.05}
 """Largest relative error of simulated-over-wall time, /joint_states rate, camera rates."""
@@ -73,7 +77,7 @@ class Recorder:
 
     def __init__(self, node: Node, cameras: list[str]) -> None:
         topics: dict[str, Any] = {"/clock": Clock, "/joint_states": JointState}
-        topics |= {f"/openral/cameras/{c}/image": Image for c in cameras}
+        topics |= {camera_topic(c): Image for c in cameras}
         self.samples: dict[str, list[Sample]] = {t: [] for t in topics}
         self._lock = threading.Lock()
         for topic, kind in topics.items():
@@ -93,12 +97,9 @@ def measure(samples: dict[str, list[Sample]]) -> dict[str, float]:
     """Simulated seconds per wall second (from /clock and /joint_states) and rates [Hz]."""
     result: dict[str, float] = {}
     for topic, rows in samples.items():
-        if len(rows) < 2:
-            result[f"{topic} rate"] = 0.0
-            continue
-        wall = rows[-1][0] - rows[0][0]
-        result[f"{topic} rate"] = (len(rows) - 1) / wall
-        if topic in ("/clock", "/joint_states"):
+        result[f"{topic} rate"] = received_rate([wall for wall, _ in rows])
+        if topic in ("/clock", "/joint_states") and len(rows) > 1:
+            wall = rows[-1][0] - rows[0][0]
             result[f"{topic} real time"] = (rows[-1][1] - rows[0][1]) / wall
     return result
 
@@ -117,7 +118,7 @@ def flood(node: Node, seconds: float, hold: list[float]) -> int:
 def run_phases(args: argparse.Namespace, console: Console) -> list[dict[str, Any]]:
     """Launch deploy sim, run every phase, stop it; one result row per phase."""
     domain = claim_domain_id()
-    env = {**os.environ, "MUJOCO_GL": "egl", "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+    env = deploy_env()
     rows = []
     with tempfile.TemporaryDirectory() as folder, ros_session(domain_id=domain) as context:
         rates = {"agentview": args.rates[0], "wrist": args.rates[1]}
@@ -126,19 +127,24 @@ def run_phases(args: argparse.Namespace, console: Console) -> list[dict[str, Any
         recorder = Recorder(node, list(rates))
         spinner = Spinner(context).start()
         spinner.add_node(node)
-        deploy = subprocess.Popen(
-            [str(OPENRAL), "deploy", "sim", "--config", str(SCENE), "--manifest", str(manifest),
-             "--no-viewer", "--domain-id", str(domain)],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env,
-        )  # fmt: skip
+        command = [
+            str(OPENRAL), "deploy", "sim", "--config", str(DEFAULT_SCENE),
+            "--manifest", str(manifest), "--no-viewer", "--domain-id", str(domain),
+        ]  # fmt: skip
+        launched = time.monotonic()
+        deploy = Launch(
+            subprocess.Popen(
+                command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env, text=True
+            ),
+            launched,
+        )
         try:
             time.sleep(args.warmup)
             for phase in ("idle", "rskill 10 Hz", "rskill 40 Hz", "flood"):
                 console.print(f"{phase} …")
                 rows.append(_phase(phase, args, recorder, node, domain, env) | {"phase": phase})
         finally:
-            deploy.send_signal(2)
-            deploy.wait(30)
+            deploy.stop()
             spinner.stop()
             node.destroy_node()  # type: ignore[no-untyped-call]
     for row in rows:
@@ -193,10 +199,7 @@ def table_of(rows: list[dict[str, Any]]) -> Table:
             cell(row.get("/clock real time", 0.0), 1.0, TARGETS["real_time"]),
             cell(row.get("/joint_states real time", 0.0), 1.0, TARGETS["real_time"]),
             cell(row["/joint_states rate"], STATE_HZ, TARGETS["state_rate"]),
-            *(
-                cell(row[f"/openral/cameras/{n}/image rate"], r, TARGETS["camera_rate"])
-                for n, r in cameras
-            ),
+            *(cell(row[f"{camera_topic(n)} rate"], r, TARGETS["camera_rate"]) for n, r in cameras),
         )
     return table
 
