@@ -27,18 +27,8 @@ from openral_hal.sim_attached import SimAttachedHAL
 from openral_mujoco.state import FloatArray, JointStateSample
 from openral_sim.rollout import Observation, SimRollout, StepResult
 
-ARM_YAML = """\
-schema_version: "0.1"
-name: fake_arm
-display_name: Fake arm
-base: fixed
-joints:
-  - {name: joint1, type: revolute, position_limits: [-3.0, 3.0],
-     velocity_limit: 5.0, effort_limit: 10.0}
-  - {name: joint2, type: revolute, position_limits: [-3.0, 3.0],
-     velocity_limit: 5.0, effort_limit: 10.0}
-sensors: []
-"""
+from tests.sim_attach.fake_arm import NO_SENSORS, write_fake_arm
+
 SCENE_YAML = """\
 schema_version: "0.1"
 robot_id: {robot}
@@ -146,10 +136,7 @@ class StillRollout:
 
 @pytest.fixture
 def arm(tmp_path: Path) -> LoadedRobot:
-    path = tmp_path / "fake_arm" / "robot.yaml"
-    path.parent.mkdir()
-    path.write_text(ARM_YAML)
-    return open_robot(path)
+    return open_robot(write_fake_arm(tmp_path, NO_SENSORS))
 
 
 def scene_for(tmp_path: Path, robot: str) -> DeployScene:

@@ -29,20 +29,7 @@ from openral_hal.errors import ActionRejected, ConfigurationError, EStopLatched
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_sim.rollout import Observation, SimRollout, StepResult
 
-FAKE_ARM_YAML = """\
-schema_version: "0.1"
-name: fake_arm
-display_name: Fake arm
-base: fixed
-joints:
-  - {name: joint1, type: revolute, position_limits: [-3.0, 3.0],
-     velocity_limit: 5.0, effort_limit: 10.0}
-  - {name: joint2, type: revolute, position_limits: [-3.0, 3.0],
-     velocity_limit: 5.0, effort_limit: 10.0}
-sensors:
-  - {name: agentview, kind: rgb, width: 32, height: 32, rate_hz: 10.0, frame_id: agentview_optical}
-  - {name: wrist, kind: rgb, width: 32, height: 32, rate_hz: 10.0, frame_id: wrist_optical}
-"""
+from tests.sim_attach.fake_arm import write_fake_arm
 
 ARM_XML = """\
 <mujoco>
@@ -175,10 +162,7 @@ class NonMujocoRollout:
 
 @pytest.fixture
 def fake_arm(tmp_path: Path) -> RobotDescription:
-    path = tmp_path / "fake_arm" / "robot.yaml"
-    path.parent.mkdir()
-    path.write_text(FAKE_ARM_YAML)
-    return load_robot(path)
+    return load_robot(write_fake_arm(tmp_path))
 
 
 @pytest.fixture
