@@ -352,7 +352,7 @@ class ManifestLifecycleNode(LifecycleNode):
             if self.loop is None:
                 hal.send_action(values)
             elif hal.estopped:
-                raise EStopLatched("E-stop is latched; call release_estop before sending actions")
+                raise EStopLatched()
             else:
                 self.loop.offer(values)
         except HalError as error:

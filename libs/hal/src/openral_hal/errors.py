@@ -21,6 +21,11 @@ class NotConnected(HalError):
 class EStopLatched(HalError):
     """An action was sent while the E-stop is latched; call ``release_estop()`` first."""
 
+    def __init__(
+        self, message: str = "E-stop is latched; call release_estop() before sending actions"
+    ) -> None:
+        super().__init__(message)
+
 
 class ConfigurationError(HalError):
     """A HAL cannot be built or connected as configured (mode, scene, driver or action width)."""

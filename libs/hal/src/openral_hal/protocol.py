@@ -158,4 +158,4 @@ class EStopLatch:
     def _refuse_when_estopped(self) -> None:
         """Raise EStopLatched while latched."""
         if self._estopped:
-            raise EStopLatched("E-stop is latched; call release_estop() before sending actions")
+            raise EStopLatched()
