@@ -28,7 +28,7 @@ import sys
 import tempfile
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from functools import partial
 from pathlib import Path
@@ -42,6 +42,9 @@ REPO = Path(__file__).resolve().parent.parent
 DEFAULT_SCENE = REPO / "robots" / "franka_panda" / "scenes" / "tabletop.yaml"
 OPENRAL = Path(sys.executable).parent / "openral"
 PYCACHE = Path(tempfile.gettempdir()) / "openral-bench-pycache"
+MODEL_CACHE = Path(tempfile.gettempdir()) / "openral-bench-models"
+"""Compiled-model cache of the launched commands (``OPENRAL_MODEL_CACHE``), unless the shell
+names one: the benchmarks neither depend on nor fill the user's."""
 """Bytecode cache of launched commands when the shell disables writing bytecode."""
 PROFILE_VARIABLE = "FASTRTPS_DEFAULT_PROFILES_FILE"
 WATCHER_PROFILE = Path(tempfile.gettempdir()) / "openral-bench-watcher.xml"
@@ -156,6 +159,7 @@ def deploy_env(**extra: str) -> dict[str, str]:
         del env[PROFILE_VARIABLE]
     if env.pop("PYTHONDONTWRITEBYTECODE", None) is not None or sys.dont_write_bytecode:
         env["PYTHONPYCACHEPREFIX"] = str(PYCACHE)
+    env.setdefault("OPENRAL_MODEL_CACHE", str(MODEL_CACHE))
     return {**env, **extra}
 
 
@@ -223,10 +227,11 @@ class Launch:
 
 @contextmanager
 def watched_deploy(
-    scene: Path, cameras: list[str], *options: str
+    scene: Path, cameras: list[str], *options: str, env: Mapping[str, str] | None = None
 ) -> Iterator[tuple[Launch, Watcher]]:
     """Launch ``openral deploy sim`` on a fresh domain with a :class:`Watcher` on it; stop it
-    (SIGINT) when the block ends. ``options`` are extra command-line options."""
+    (SIGINT) when the block ends. ``options`` are extra command-line options, ``env`` extra
+    environment variables."""
     domain = claim_domain_id()
     if PROFILE_VARIABLE not in os.environ:  # a profile of the user's own is left alone
         WATCHER_PROFILE.write_text(WATCHER_PROFILE_XML)
@@ -242,7 +247,11 @@ def watched_deploy(
         time.sleep(WATCHER_SETTLE_S)
         launched = time.monotonic()
         process = subprocess.Popen(
-            command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=deploy_env(), text=True
+            command,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            env=deploy_env(**(env or {})),
+            text=True,
         )
         watcher.pid = process.pid
         launch = Launch(process, launched)

@@ -5,7 +5,11 @@ own and watches it from this process (:mod:`benchmarks.deploy_launch`): the time
 ``Popen`` to the first ``/joint_states`` and to the first image of every camera, then the
 camera rate over a sustained window (arrival times at the subscriber) and the deploy
 process's CPU use over the same window (``/proc``; 100 % = one core). One untimed launch
-first fills the bytecode cache (see :mod:`benchmarks.deploy_launch`). Run with
+first fills the bytecode cache and the compiled-model cache (see
+:mod:`benchmarks.deploy_launch` and :mod:`openral_mujoco.model_cache`); the timed runs then
+start as a user's second launch of an unchanged scene does. ``--cold-runs`` more launches
+each start with an empty model cache, as the first launch after changing the robot's model,
+manifest or scene does; they are reported beside the target rows. Run with
 ``just bench-deploy``; the table (median and worst of the runs) is printed and written to
 ``benchmarks/results/deploy_startup.json``.
 """
@@ -15,6 +19,7 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
+import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -44,9 +49,14 @@ Run = dict[str, Any]
 """One launch's measures, as ``one_run`` returns them and the JSON stores them."""
 
 
-def one_run(scene: Path, cameras: list[str], window_s: float, rate_hz: float) -> Run:
-    """Launch, wait for every first message, measure a window, stop with SIGINT."""
-    with watched_deploy(scene, cameras, "--camera-rate", str(rate_hz)) as (launch, watcher):
+def one_run(
+    scene: Path, cameras: list[str], window_s: float, rate_hz: float, model_cache: str = ""
+) -> Run:
+    """Launch, wait for every first message, measure a window, stop with SIGINT; with
+    ``model_cache``, the launch's compiled-model cache is that folder."""
+    env = {"OPENRAL_MODEL_CACHE": model_cache} if model_cache else None
+    options = ("--camera-rate", str(rate_hz))
+    with watched_deploy(scene, cameras, *options, env=env) as (launch, watcher):
         booted = watcher.wait(lambda: all(watcher.arrivals.values()), BOOT_TIMEOUT_S)
         if not booted:
             raise RuntimeError(f"no first message on every topic within {BOOT_TIMEOUT_S} s")
@@ -79,17 +89,27 @@ def parse_args() -> argparse.Namespace:
     parser.add_argument("--runs", type=int, default=5, help="launches to time")
     parser.add_argument("--window", type=float, default=10.0, help="rate/CPU window [s]")
     parser.add_argument("--camera-rate", type=float, default=10.0, help="camera rate [Hz]")
+    parser.add_argument(
+        "--cold-runs", type=int, default=3, help="launches with an empty model cache"
+    )
     return parser.parse_args()
 
 
-def time_runs(args: argparse.Namespace, cameras: list[str], console: Console) -> list[Run]:
-    """One untimed warm-up launch, then ``args.runs`` measured ones, announcing each."""
+def time_runs(
+    args: argparse.Namespace, cameras: list[str], console: Console
+) -> tuple[list[Run], list[Run]]:
+    """One untimed warm-up launch, ``args.runs`` measured ones, then ``args.cold_runs`` each
+    with an empty model cache, announcing each."""
     console.print(f"warm-up launch (not timed): {warm_up(args.scene):.1f} s")
-    runs = []
+    runs, cold = [], []
     for index in range(args.runs):
         console.print(f"run {index + 1}/{args.runs} …")
         runs.append(one_run(args.scene, cameras, args.window, args.camera_rate))
-    return runs
+    for index in range(args.cold_runs):
+        console.print(f"run {index + 1}/{args.cold_runs} with an empty model cache …")
+        with tempfile.TemporaryDirectory(prefix="openral-bench-cold-") as folder:
+            cold.append(one_run(args.scene, cameras, args.window, args.camera_rate, folder))
+    return runs, cold
 
 
 def _target_row(table: Table, label: str, values: list[float], target: float, unit: str) -> None:
@@ -104,15 +124,16 @@ def _target_row(table: Table, label: str, values: list[float], target: float, un
     )
 
 
-def _startup_rows(table: Table, runs: list[Run], cameras: list[str]) -> None:
-    """Launch to the first joint state, to every camera's first frame, to each camera's,
-    and to the printed ``running`` line."""
-    states = [r["first_state_s"] for r in runs]
-    _target_row(table, "launch → first /joint_states", states, TARGETS["first_state_s"], "s")
-    frames = [r["first_frames_s"] for r in runs]
-    _target_row(
-        table, "launch → first frame of every camera", frames, TARGETS["first_frames_s"], "s"
-    )
+def _startup_rows(table: Table, runs: list[Run], cold: list[Run], cameras: list[str]) -> None:
+    """Launch to the first joint state and to every camera's first frame (also with an empty
+    model cache), to each camera's, and to the printed ``running`` line."""
+    labels = {"first_state_s": "/joint_states", "first_frames_s": "frame of every camera"}
+    for key, label in labels.items():
+        _target_row(table, f"launch → first {label}", [r[key] for r in runs], TARGETS[key], "s")
+        if cold:
+            values = [r[key] for r in cold]
+            row = (f"{statistics.median(values):.2f} s", f"{max(values):.2f} s", "")
+            table.add_row(f"  with an empty model cache ({len(cold)} runs)", *row)
     for camera in cameras:
         firsts = [r["first_frame_s"][camera_topic(camera)] for r in runs]
         row = (f"{statistics.median(firsts):.2f} s", f"{max(firsts):.2f} s", "")
@@ -145,7 +166,10 @@ def _streaming_rows(
 
 
 def results_table(
-    args: argparse.Namespace, cameras: list[str], runs: list[Run], load: tuple[float, ...]
+    args: argparse.Namespace,
+    cameras: list[str],
+    runs: tuple[list[Run], list[Run]],
+    load: tuple[float, ...],
 ) -> Table:
     """The printed summary: start-up rows, then streaming rows, median and worst of the runs."""
     table = Table(
@@ -155,8 +179,8 @@ def results_table(
     )
     for column in ("measure", "median", "worst", "target"):
         table.add_column(column, justify="left" if column == "measure" else "right")
-    _startup_rows(table, runs, cameras)
-    _streaming_rows(table, runs, cameras, args)
+    _startup_rows(table, runs[0], runs[1], cameras)
+    _streaming_rows(table, runs[0], cameras, args)
     return table
 
 
@@ -166,7 +190,9 @@ def bytecode_note() -> str:
     return f"cached in {prefix}" if prefix else "the usual __pycache__ folders"
 
 
-def save_results(args: argparse.Namespace, runs: list[Run], load: tuple[float, ...]) -> Path:
+def save_results(
+    args: argparse.Namespace, runs: tuple[list[Run], list[Run]], load: tuple[float, ...]
+) -> Path:
     """Write the settings, targets and every run to ``benchmarks/results/deploy_startup.json``."""
     scene = args.scene.relative_to(REPO) if args.scene.is_relative_to(REPO) else args.scene
     return write_results(
@@ -179,13 +205,17 @@ def save_results(args: argparse.Namespace, runs: list[Run], load: tuple[float, .
             "load_average_before": load,
             "bytecode": bytecode_note(),
             "targets": TARGETS,
-            "medians": {
-                key: statistics.median(r[key] for r in runs)
-                for key in ("first_state_s", "first_frames_s", "cpu_to_first_state_s", "active_s")
-            },
-            "runs": runs,
+            "medians": _medians(runs[0]),
+            "cold_medians": _medians(runs[1]) if runs[1] else None,
+            "runs": runs[0],
+            "cold_runs": runs[1],
         },
     )
+
+
+def _medians(runs: list[Run]) -> dict[str, float]:
+    keys = ("first_state_s", "first_frames_s", "cpu_to_first_state_s", "active_s")
+    return {key: statistics.median(r[key] for r in runs) for key in keys}
 
 
 def main() -> int:
@@ -201,7 +231,7 @@ def main() -> int:
         "Times from Popen (includes interpreter start-up); rates from arrival times at a "
         f"subscriber in this process; CPU: 100 % = one core. Written to {path}."
     )
-    return 0 if all(r["exit_code"] == 0 for r in runs) else 1
+    return 0 if all(r["exit_code"] == 0 for r in runs[0] + runs[1]) else 1
 
 
 if __name__ == "__main__":

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import atexit
 import os
+import shutil
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
@@ -10,6 +13,12 @@ import pytest
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # before any test module imports mujoco
 from openral_core.paths import repo_root
+
+# The suite (and every process it starts) keeps compiled models in a folder of its own,
+# never reading or filling the user's cache (openral_mujoco.model_cache).
+_MODEL_CACHE = tempfile.mkdtemp(prefix="openral-test-models-")
+os.environ["OPENRAL_MODEL_CACHE"] = _MODEL_CACHE
+atexit.register(shutil.rmtree, _MODEL_CACHE, ignore_errors=True)
 
 REPO = repo_root()
 ROBOTS = REPO / "robots"

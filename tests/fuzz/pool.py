@@ -63,6 +63,7 @@ class _Worker:
         """Start the process and wait until it has warmed up."""
         command = [sys.executable, "-m", "tests.fuzz.worker", "--log", str(self.log)]
         env = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
+        env["OPENRAL_MODEL_CACHE"] = "off"  # every case is new: caching would only write
         self.process = subprocess.Popen(
             command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=env, cwd=Path.cwd()
         )

@@ -117,9 +117,10 @@ class _Model:
 class _Walk:
     """Reads a model and its includes in document order, checking includes before opening."""
 
-    def __init__(self, confinement: Confinement, seen: set[str]) -> None:
+    def __init__(self, confinement: Confinement, seen: set[str], files: list[Path]) -> None:
         self.confinement = confinement
         self.seen = seen
+        self.files = files
 
     def model(self, main: Path) -> _Model:
         found = _Model(main)
@@ -131,6 +132,7 @@ class _Walk:
         if real in self.seen:
             return  # MuJoCo refuses a file included twice; nothing new to check
         self.seen.add(real)
+        self.files.append(Path(real))
         if len(self.seen) > MAX_XML_FILES:
             raise MjcfConfinementError(
                 f"{xml}: the model reads more than {MAX_XML_FILES} XML files; refusing it"
@@ -169,23 +171,36 @@ class _Walk:
     def _include(self, ref: _Ref, found: _Model) -> None:
         here = ref.include_dir or found.main.parent
         places = _check_ref(ref, ref.value, [found.main.parent, here], self.confinement)
+        self.files += places  # a file appearing at an earlier place would be read instead
         opened = next((place for place in places if place.is_file()), None)
         if opened is not None:  # else MuJoCo reports the missing file itself
             self._read(opened, found, opened.parent)
 
 
-def check_mjcf_files(main: Path, confinement: Confinement) -> None:
+def check_mjcf_files(main: Path, confinement: Confinement) -> tuple[Path, ...]:
     """Refuse ``main`` when a file it makes MuJoCo open lies outside ``confinement``.
+
+    Returns:
+        Every XML file the model reads (real paths) and every place MuJoCo may look for a
+        file it names, existing or not, each once.
 
     Raises:
         MjcfConfinementError: A reference leaves the confinement, or XML that cannot be read
             safely (not well-formed, a document type declaration, too large or too many files).
     """
-    _check_model(main, confinement, set())
+    files: list[Path] = []
+    _check_model(main, confinement, set(), files)
+    return tuple(dict.fromkeys(files))
 
 
-def _check_model(main: Path, confinement: Confinement, seen: set[str]) -> None:
-    found = _Walk(confinement, seen).model(main)
+def mjcf_files(main: Path) -> tuple[Path, ...]:
+    """What :func:`check_mjcf_files` returns, wherever the files lie (only unsafe XML, a
+    drive or resource path and a non-regular file are refused)."""
+    return check_mjcf_files(main, Confinement(Path(os.sep), "anywhere"))
+
+
+def _check_model(main: Path, confinement: Confinement, seen: set[str], files: list[Path]) -> None:
+    found = _Walk(confinement, seen, files).model(main)
     base = main.parent
     for refs in found.dirs.values():
         for ref in refs:
@@ -204,13 +219,13 @@ def _check_model(main: Path, confinement: Confinement, seen: set[str]) -> None:
         folders = [_join(base, d) for d in dirs]
         if ref.include_dir is not None:
             folders.append(ref.include_dir)
-        _check_ref(ref, value, folders, confinement)
+        files += _check_ref(ref, value, folders, confinement)
     for ref in found.submodels:
         folders = [base] if ref.include_dir is None else [base, ref.include_dir]
         places = _check_ref(ref, ref.value, folders, confinement)
         opened = next((place for place in places if place.is_file()), None)
         if opened is not None:
-            _check_model(opened, confinement, seen)
+            _check_model(opened, confinement, seen, files)
 
 
 def _dir_values(found: _Model, attribute: str) -> list[str]:

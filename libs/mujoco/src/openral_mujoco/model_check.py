@@ -13,6 +13,7 @@ from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescri
 from openral_core.tables import HalWiring, hal_wiring
 
 from openral_mujoco.mjcf_model import actuator_joints, root_is_free
+from openral_mujoco.model_cache import cached_model, mjcf_fingerprint
 
 
 @dataclass(frozen=True)
@@ -64,15 +65,21 @@ def require_agreement(description: RobotDescription, model: mujoco.MjModel) -> N
 
 
 def compile_robot_model(description: RobotDescription, path: Path) -> mujoco.MjModel:
-    """Compile the robot's MJCF at ``path``.
+    """Compile the robot's MJCF at ``path`` (or load it from :mod:`~openral_mujoco.model_cache`
+    when neither it nor any file it reads has changed).
 
     Raises:
         ManifestError: At ``sim.mjcf_uri`` when MuJoCo cannot load the file.
     """
-    try:
-        return mujoco.MjModel.from_xml_path(str(path))
-    except ValueError as error:  # MuJoCo's parser and compiler report this way
-        raise unloadable_model(description, path, error) from None
+
+    def build() -> mujoco.MjModel:
+        try:
+            return mujoco.MjModel.from_xml_path(str(path))
+        except ValueError as error:  # MuJoCo's parser and compiler report this way
+            raise unloadable_model(description, path, error) from None
+
+    fingerprint = mjcf_fingerprint(path)
+    return cached_model(None if fingerprint is None else ("robot", fingerprint), build)
 
 
 def unloadable_model(description: RobotDescription, path: Path, error: Exception) -> ManifestError:

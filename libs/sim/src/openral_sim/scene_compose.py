@@ -7,6 +7,8 @@ Every fault is reported at its field of the scene file or the manifest.
 
 from __future__ import annotations
 
+import functools
+import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,7 +19,12 @@ import numpy.typing as npt
 from openral_core.located import error_at
 from openral_core.models import DeployScene, NativeAssets, RobotDescription, SceneObject
 from openral_mujoco.mjcf_uri import robot_model_file
-from openral_mujoco.model_check import require_agreement, unloadable_model
+from openral_mujoco.model_cache import cached_model, code_digest, mjcf_fingerprint
+from openral_mujoco.model_check import (
+    compile_robot_model,
+    require_agreement,
+    unloadable_model,
+)
 
 from openral_sim.scene_cameras import add_fixed_cameras, add_mounted_cameras, rotate_about_z
 from openral_sim.scene_checks import check_object_names, check_weld
@@ -30,20 +37,16 @@ PHYSICS_OPTIONS = tuple(key for key in dir(mujoco.MjSpec().option) if not key.st
 """Every ``<option>`` of MjSpec (timestep, integrator, solver, tolerances, gravity, flags…)."""
 
 
-def robot_spec(robot: RobotDescription, folder: Path) -> tuple[mujoco.MjSpec, mujoco.MjModel]:
-    """The robot's own model as a spec to attach, and compiled, checked against its manifest.
+def robot_spec(robot: RobotDescription, path: Path) -> mujoco.MjSpec:
+    """The robot's own model at ``path`` as a spec to attach.
 
     Raises:
-        ManifestError: At ``sim.mjcf_uri`` or at every manifest field the model contradicts.
+        ManifestError: At ``sim.mjcf_uri`` when MuJoCo cannot read the file.
     """
-    path = robot_model_file(robot, folder)
     try:
-        child = mujoco.MjSpec.from_file(str(path))
-        child_model = child.copy().compile()  # before attach: no compile after it
+        return mujoco.MjSpec.from_file(str(path))
     except ValueError as error:
         raise unloadable_model(robot, path, error) from None
-    require_agreement(robot, child_model)
-    return child, child_model
 
 
 @dataclass(frozen=True)
@@ -58,20 +61,52 @@ class ComposedScene:
 def compose(
     scene: DeployScene, robot: RobotDescription, folder: Path, cameras: dict[str, str]
 ) -> ComposedScene:
-    """Compose and compile ``scene`` around ``robot`` (manifest in ``folder``).
+    """Compose and compile ``scene`` around ``robot`` (manifest in ``folder``), after checking
+    the manifest against its model; both compiled models come from
+    :mod:`~openral_mujoco.model_cache` when nothing they are made of has changed.
 
     Raises:
         ManifestError: At the scene file's or manifest's field that cannot be built.
     """
     assert robot.sim is not None
     check_weld(scene, robot)
-    child, child_model = robot_spec(robot, folder)
-    check_object_names(scene, child_model)
+    path = robot_model_file(robot, folder)
+    robot_model = compile_robot_model(robot, path)
+    require_agreement(robot, robot_model)
+    check_object_names(scene, robot_model)
+    fingerprint = mjcf_fingerprint(path)
+    parts = None
+    if fingerprint is not None:
+        inputs = (scene.model_dump_json(), robot.model_dump_json(), json.dumps(cameras))
+        parts = ("scene", fingerprint, _composer_digest(), *inputs)
+    model = cached_model(parts, lambda: _compile(scene, robot, path, robot_model, cameras))
+    return ComposedScene(model, robot_model)
+
+
+@functools.cache
+def _composer_digest() -> str:
+    """Digest of the code a composed scene depends on (this package and the MuJoCo layer)."""
+    import openral_mujoco
+
+    import openral_sim
+
+    return code_digest(openral_sim, openral_mujoco)
+
+
+def _compile(
+    scene: DeployScene,
+    robot: RobotDescription,
+    path: Path,
+    child_model: mujoco.MjModel,
+    cameras: dict[str, str],
+) -> mujoco.MjModel:
+    """Build the scene's spec (see the module doc) and compile it."""
+    assert robot.sim is not None
+    child = robot_spec(robot, path)
     spec = _scene_spec(scene, robot, child)
     pose = scene.base_pose
     base = np.asarray(pose.position_m if pose and pose.position_m else [0.0, 0.0, 0.0])
     yaw = math.radians(pose.yaw_deg if pose and pose.yaw_deg else 0.0)
-    options = scene.scene.options
     own_floor = any(g.type == mujoco.mjtGeom.mjGEOM_PLANE for g in child.geoms)  # no 2nd
     floor_z = 0.0
     if scene.scene.assets is NativeAssets.floor:  # the model brings a table: floor under it
@@ -79,21 +114,8 @@ def compose(
     own_sky = any(t.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX for t in child.textures)
     _add_world(spec, floor_z=None if own_floor else floor_z, sky=not own_sky)
     if scene.scene.assets is NativeAssets.tabletop:
-        table_h = (
-            options.table_height_m
-            if options and options.table_height_m is not None
-            else DEFAULT_TABLE_HEIGHT_M
-        )
-        _add_table(spec, base, yaw, table_h)
-        fixed = robot.sim.floating_base is False
-        if fixed and base[2] > 0.05:
-            spec.worldbody.add_geom(
-                name="scene_pedestal",
-                type=mujoco.mjtGeom.mjGEOM_CYLINDER,
-                size=[0.09, base[2] / 2, 0],
-                pos=[base[0], base[1], base[2] / 2],
-                rgba=[0.3, 0.3, 0.32, 1],
-            )
+        _add_tabletop(spec, scene, base, yaw, fixed=robot.sim.floating_base is False)
+    options = scene.scene.options
     for obj in options.objects if options and options.objects else []:
         _add_object(spec, obj)
     frame = spec.worldbody.add_frame(pos=base.tolist(), quat=yaw_quat(yaw).tolist())
@@ -104,10 +126,31 @@ def compose(
         _add_base_weld(spec, child_model, robot)
     add_fixed_cameras(spec, robot, cameras, base + rotate_about_z(yaw, center), yaw, radius)
     try:
-        return ComposedScene(spec.compile(), child_model)
+        return spec.compile()
     except ValueError as error:
         message = f"scene {scene.scene.id!r} for {robot.name!r} does not compile: {error}"
         raise error_at(scene, ("scene",), message) from None
+
+
+def _add_tabletop(
+    spec: mujoco.MjSpec, scene: DeployScene, base: np.ndarray, yaw: float, *, fixed: bool
+) -> None:
+    """The table, and a pedestal under a fixed base raised above the floor."""
+    options = scene.scene.options
+    table_h = (
+        options.table_height_m
+        if options and options.table_height_m is not None
+        else DEFAULT_TABLE_HEIGHT_M
+    )
+    _add_table(spec, base, yaw, table_h)
+    if fixed and base[2] > 0.05:
+        spec.worldbody.add_geom(
+            name="scene_pedestal",
+            type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+            size=[0.09, base[2] / 2, 0],
+            pos=[base[0], base[1], base[2] / 2],
+            rgba=[0.3, 0.3, 0.32, 1],
+        )
 
 
 def _scene_spec(scene: DeployScene, robot: RobotDescription, child: mujoco.MjSpec) -> mujoco.MjSpec:
