@@ -30,18 +30,19 @@ import numpy as np
 import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
 from openral_core.located import error_at
-from openral_core.models import DeployScene, NativeAssets
+from openral_core.models import DeployScene, DepthSensor, NativeAssets
 from openral_core.tables import HalWiring
 from openral_mujoco.errors import HalError
 from openral_mujoco.joint_driver import JointDriver
 from openral_mujoco.robot_addresses import locate_robot
 from openral_mujoco.state import FloatArray, JointStateSample
 
+from openral_sim.depth_cloud import DepthCamera, DepthFrame
 from openral_sim.rollout import Observation, StepResult
 from openral_sim.scene_cameras import camera_sensors
 from openral_sim.scene_checks import physics_steps_per_control
 from openral_sim.scene_compose import BASE_WELD, compose, yaw_quat
-from openral_sim.scene_geometry import root_body
+from openral_sim.scene_geometry import robot_bodies, root_body
 
 
 class NativeScene:
@@ -74,8 +75,8 @@ class NativeScene:
         if wiring is None:
             raise error_at(scene, ("robot_id",), f"robot {robot.name!r} has no sim block")
         self.wiring: HalWiring = wiring
-        self._sensors = camera_sensors(scene, description)
-        composed = compose(scene, description, robot.folder, self._sensors)
+        cameras = camera_sensors(scene, description)
+        composed = compose(scene, description, robot.folder, cameras)
         self.model = composed.model
         self.data = mujoco.MjData(self.model)
         try:
@@ -84,6 +85,15 @@ class NativeScene:
             raise error_at(description, ("joints",), str(error)) from None
         self.driver = JointDriver(description, wiring, self.model, addresses)
         self._root_body = root_body(self.model, description)
+        depth = {s.name: s for s in description.sensors if isinstance(s, DepthSensor)}
+        self._sensors = {name: cam for name, cam in cameras.items() if name not in depth}
+        robot_ids = robot_bodies(self.model, description)
+        self.depth_cameras = {
+            name: DepthCamera(self.model, depth[name], cam, robot_ids, self._root_body)
+            for name, cam in cameras.items()
+            if name in depth
+        }
+        """The depth sensors the scene file names, by sensor name (see :meth:`depth_frame`)."""
         self._root_qpos = int(self.model.jnt_qposadr[self.model.body_jntadr[self._root_body]])
         self._width = scene.scene.observation.width
         self._height = scene.scene.observation.height
@@ -123,6 +133,32 @@ class NativeScene:
         """Manifest sensor names this scene renders (into ``obs["images"]`` while
         :attr:`render_observations`, else by :meth:`render_cameras`)."""
         return tuple(self._sensors)
+
+    @property
+    def base_frame(self) -> str:
+        """MJCF name of the robot's root body, the frame depth clouds are given in."""
+        return mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._root_body) or ""
+
+    def depth_frame(
+        self, name: str, data: mujoco.MjData, renderer: mujoco.Renderer | None = None
+    ) -> DepthFrame:
+        """Depth image and self-filtered cloud of depth sensor ``name`` as ``data`` places
+        the scene (read only, kinematics current as for :meth:`render_cameras`).
+
+        Args:
+            name: A key of :attr:`depth_cameras`.
+            data: MjData of :attr:`model`.
+            renderer: A renderer of :attr:`model` at the sensor's (height, width), created on
+                the calling thread; None makes one for this frame.
+
+        Raises:
+            KeyError: A sensor this scene does not render.
+        """
+        camera = self.depth_cameras[name]
+        if renderer is not None:
+            return camera.frame(renderer, data)
+        with mujoco.Renderer(self.model, camera.height, camera.width) as own:
+            return camera.frame(own, data)
 
     @property
     def image_size(self) -> tuple[int, int]:

@@ -17,7 +17,13 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 from openral_core.located import error_at
-from openral_core.models import DeployScene, NativeAssets, RobotDescription, SceneObject
+from openral_core.models import (
+    DeployScene,
+    DepthSensor,
+    NativeAssets,
+    RobotDescription,
+    SceneObject,
+)
 from openral_mujoco.mjcf_uri import robot_model_file
 from openral_mujoco.model_cache import cached_model, code_digest, mjcf_fingerprint
 from openral_mujoco.model_check import (
@@ -163,8 +169,10 @@ def _scene_spec(scene: DeployScene, robot: RobotDescription, child: mujoco.MjSpe
         setattr(spec.option, key, getattr(child.option, key))
     spec.compiler.degree = False
     width, height = scene.scene.observation.width, scene.scene.observation.height
-    spec.visual.global_.offwidth = max(width, 640)
-    spec.visual.global_.offheight = max(height, 480)
+    depth = [s for s in robot.sensors if isinstance(s, DepthSensor)]
+    depth = [s for s in depth if s.name in scene.scene.cameras]  # each at its own size
+    spec.visual.global_.offwidth = max([width, 640, *(s.width for s in depth)])
+    spec.visual.global_.offheight = max([height, 480, *(s.height for s in depth)])
     spec.visual.quality.shadowsize = 0
     spec.visual.quality.offsamples = 0
     return spec

@@ -58,3 +58,15 @@ def robot_extent(model: mujoco.MjModel, robot: RobotDescription) -> tuple[np.nda
         points = points - data.xpos[root_body(model, robot)] * np.array([1, 1, 0])
     low, high = points.min(axis=0), points.max(axis=0)
     return (low + high) / 2, max(0.2, float(np.linalg.norm(high - low)) / 2)
+
+
+def robot_bodies(model: mujoco.MjModel, robot: RobotDescription) -> frozenset[int]:
+    """Every body of the robot in ``model``: the whole tree under each world child that
+    carries a manifest joint (both arms of a bimanual robot; not a table or prop its file
+    brings), the bodies its own sensors must not see."""
+    roots = set()
+    for mjcf_name in joint_name_map(robot).values():
+        joint = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, mjcf_name)
+        if joint >= 0:
+            roots.add(int(model.body_rootid[model.jnt_bodyid[joint]]))
+    return frozenset(int(b) for b in np.flatnonzero(np.isin(model.body_rootid, list(roots))))
