@@ -8,14 +8,21 @@ tabletop's 5 cm red cube sits in front of it.
 
 from __future__ import annotations
 
+import struct
+import zlib
+from collections.abc import Iterator
+from pathlib import Path
+
 import mujoco
 import numpy as np
 import numpy.typing as npt
 import pytest
+from openral_cli.main import app
 from openral_core import open_robot
 from openral_core.loader import load_scene
 from openral_sim.depth_cloud import near_any
 from openral_sim.native_scene import NativeScene
+from typer.testing import CliRunner
 
 from tests.conftest import ROBOTS
 
@@ -29,7 +36,8 @@ VISIBLE = np.array([1, 1, 1, 0, 0, 0], dtype=np.uint8)
 
 
 @pytest.fixture(scope="module")
-def scene(tmp_path_factory: pytest.TempPathFactory) -> NativeScene:
+def files(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """(manifest, scene file): franka with a depth camera, the tabletop seen by it."""
     folder = tmp_path_factory.mktemp("depth") / "franka_panda"
     folder.mkdir()
     text = (ROBOTS / "franka_panda" / "robot.yaml").read_text()
@@ -38,9 +46,16 @@ def scene(tmp_path_factory: pytest.TempPathFactory) -> NativeScene:
     scene_text = scene_text.replace("cameras: [agentview, wrist]", "cameras: [front_depth]")
     scene_text = scene_text.replace("    objects:\n", "    objects:\n" + PROBE)
     (folder / "tabletop.yaml").write_text(scene_text)
-    env = NativeScene(load_scene(folder / "tabletop.yaml"), open_robot(folder / "robot.yaml"))
+    return folder / "robot.yaml", folder / "tabletop.yaml"
+
+
+@pytest.fixture(scope="module")
+def scene(files: tuple[Path, Path]) -> Iterator[NativeScene]:
+    manifest, scene_file = files
+    env = NativeScene(load_scene(scene_file), open_robot(manifest))
     env.reset(0)
-    return env
+    yield env
+    env.close()
 
 
 def _to_base(env: NativeScene, world: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
@@ -103,7 +118,8 @@ def test_a_cube_appears_where_it_is(scene: NativeScene) -> None:
 
 def test_the_cloud_never_shows_the_robot(scene: NativeScene) -> None:
     camera = scene.depth_cameras["front_depth"]
-    _, geoms = camera.render(mujoco.Renderer(scene.model, camera.height, camera.width), scene.data)
+    with mujoco.Renderer(scene.model, camera.height, camera.width) as renderer:
+        _, geoms = camera.render(renderer, scene.data)
     robot_pixels = (geoms >= 0) & camera.robot_geoms[np.maximum(geoms, 0)]
     assert robot_pixels.mean() > 0.05, "the arm should fill part of the view"
     points = scene.depth_frame("front_depth", scene.data).points
@@ -155,3 +171,43 @@ def _closest_robot_surface(
             gap = mujoco.mj_geomDistance(model, data, probe, int(geom), 0.05, None)
             closest = min(closest, gap + 0.0005)
     return closest
+
+
+def test_sim_run_writes_depth_in_millimetres_and_clouds(
+    files: tuple[Path, Path], tmp_path: Path
+) -> None:
+    manifest, scene_file = files
+    command = ["sim", "run", "--config", str(scene_file), "--manifest", str(manifest)]
+    command += ["--steps", "2", "--motion", "hold", "--out", str(tmp_path)]
+    result = CliRunner().invoke(app, command)
+    assert result.exit_code == 0, result.output
+    assert "front_depth" in result.output
+    millimetres = _read_png16(tmp_path / "front_depth_0001.depth.png")
+    points = np.load(tmp_path / "front_depth_0001.points.npy")
+    env = NativeScene(load_scene(scene_file), open_robot(manifest))  # the same two steps
+    try:
+        env.reset(0)
+        for _ in range(2):
+            env.step(env.hold_action())
+        frame = env.depth_frame("front_depth", env.data)
+    finally:
+        env.close()
+    expected = np.rint(np.nan_to_num(frame.depth_m.astype(np.float64)) * 1000)
+    np.testing.assert_array_equal(millimetres, expected)  # 0 where there is no reading
+    np.testing.assert_array_equal(points, frame.points)
+
+
+def _read_png16(path: Path) -> npt.NDArray[np.float64]:
+    """A 16-bit greyscale PNG written unfiltered, decoded with zlib alone."""
+    data = path.read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    width, height, bits, colour = struct.unpack(">IIBB", data[16:26])
+    assert (bits, colour) == (16, 0)
+    chunks, offset = b"", 8
+    while offset < len(data):
+        (length,) = struct.unpack(">I", data[offset : offset + 4])
+        if data[offset + 4 : offset + 8] == b"IDAT":
+            chunks += data[offset + 8 : offset + 8 + length]
+        offset += 12 + length
+    rows = np.frombuffer(zlib.decompress(chunks), np.uint8).reshape(height, 1 + 2 * width)
+    return rows[:, 1:].copy().view(">u2").astype(np.float64)

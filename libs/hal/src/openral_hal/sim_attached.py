@@ -27,6 +27,7 @@ from openral_mujoco.action import validated_action
 from openral_mujoco.mjcf_model import is_scalar_joint
 from openral_mujoco.name_resolution import resolve_joint_names
 from openral_mujoco.state import FloatArray, JointStateSample
+from openral_sim.native_scene import NativeScene
 from openral_sim.rollout import (
     HoldingRollout,
     ManifestRollout,
@@ -347,3 +348,10 @@ class SimAttachedHAL(EStopLatch):
                 self._warned_width = True
             values = np.concatenate([values, np.zeros(max(0, count - values.size))])[:count]
         return values
+
+
+def native_scene(hal: object) -> NativeScene | None:
+    """The native scene behind ``hal`` (it renders cameras and depth on demand), else None."""
+    if isinstance(hal, SimAttachedHAL) and isinstance(hal.env, NativeScene):
+        return hal.env
+    return None

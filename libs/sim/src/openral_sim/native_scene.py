@@ -104,6 +104,7 @@ class NativeScene:
         """Whether ``reset``/``step`` render the cameras into ``obs["images"]``; may be
         changed at any time (the next observation follows it)."""
         self._renderer: mujoco.Renderer | None = None
+        self._depth_renderers: dict[str, mujoco.Renderer] = {}
         self._steps = 0
 
     # -- SimRollout ------------------------------------------------------------------------
@@ -149,16 +150,19 @@ class NativeScene:
             name: A key of :attr:`depth_cameras`.
             data: MjData of :attr:`model`.
             renderer: A renderer of :attr:`model` at the sensor's (height, width), created on
-                the calling thread; None makes one for this frame.
+                the calling thread; None uses the scene's own for this sensor (made on first
+                use, on the thread that first uses it).
 
         Raises:
             KeyError: A sensor this scene does not render.
         """
         camera = self.depth_cameras[name]
-        if renderer is not None:
-            return camera.frame(renderer, data)
-        with mujoco.Renderer(self.model, camera.height, camera.width) as own:
-            return camera.frame(own, data)
+        if renderer is None:
+            renderer = self._depth_renderers.get(name)
+            if renderer is None:
+                renderer = mujoco.Renderer(self.model, camera.height, camera.width)
+                self._depth_renderers[name] = renderer
+        return camera.frame(renderer, data)
 
     @property
     def image_size(self) -> tuple[int, int]:
@@ -261,10 +265,13 @@ class NativeScene:
         return images
 
     def close(self) -> None:
-        """Free the offscreen renderer."""
+        """Free the offscreen renderers."""
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
+        for renderer in self._depth_renderers.values():
+            renderer.close()
+        self._depth_renderers.clear()
 
     # -- internals -------------------------------------------------------------------------
 

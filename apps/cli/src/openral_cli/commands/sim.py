@@ -5,7 +5,11 @@ Example::
     openral sim run --config robots/franka_panda/scenes/tabletop.yaml --steps 50 --out o/
 
 ``joint_states.jsonl`` holds one line per step: ``{"step", "time", "positions"}`` with the
-positions keyed by the manifest's joint names, as ``/joint_states`` names them.
+positions keyed by the manifest's joint names, as ``/joint_states`` names them. Each step
+also writes every camera's frame (``<sensor>_<step>.png``) and, on a native scene, every
+depth sensor's image (``<sensor>_<step>.depth.png``, 16-bit, millimetres, 0 = no reading)
+and self-filtered cloud (``<sensor>_<step>.points.npy``, N x 3 float32 in the robot's base
+frame, metres).
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ class Recording:
 
     records: list[dict[str, object]] = field(default_factory=list)
     cameras: list[str] = field(default_factory=list)
+    depth: list[str] = field(default_factory=list)
 
 
 @app.command("run")
@@ -49,6 +54,9 @@ def run(
     robot: Annotated[
         str | None, typer.Option("--robot", help="Robot id when the scene names none.")
     ] = None,
+    manifest: Annotated[
+        Path | None, typer.Option("--manifest", help="Manifest file (default: the scene's robot).")
+    ] = None,
     motion: Annotated[
         str, typer.Option("--motion", help="'sway' (a slow joint-space sine) or 'hold'.")
     ] = "sway",
@@ -59,15 +67,20 @@ def run(
     SimAttachedHAL that ``build_hal`` attaches, from the hold action of its backend. The
     scene file and the robot's manifest are each read once.
     """
+    from openral_core import open_robot
     from openral_core.loader import load_scene
     from openral_hal.factory import HalMode, build_hal
-    from openral_sim.scene import scene_robot
+    from openral_sim.scene import check_scene_robot, scene_robot
     from rich.table import Table
 
     if motion not in MOTIONS:
         raise typer.BadParameter("expected 'sway' or 'hold'", param_hint="--motion")
     scene = load_scene(config)
-    loaded = scene_robot(scene, robot)
+    if manifest is not None:
+        loaded = open_robot(manifest)
+        check_scene_robot(scene, loaded)
+    else:
+        loaded = scene_robot(scene, robot)
     hal = build_hal(loaded, mode=HalMode.SIM, scene=scene)
     hal.connect()
     try:
@@ -82,11 +95,11 @@ def run(
         lines = "".join(json.dumps(record) + "\n" for record in seen.records)
         (out_dir / "joint_states.jsonl").write_text(lines)
     table = Table(title=f"sim run: {config}")
-    for column in ("robot", "backend", "steps", "cameras", "output"):
+    for column in ("robot", "backend", "steps", "cameras", "depth", "output"):
         table.add_column(column)
-    cameras = ", ".join(seen.cameras)
+    cameras, depth = ", ".join(seen.cameras), ", ".join(seen.depth) or "-"
     backend = scene.scene.backend.value
-    table.add_row(loaded.name, backend, str(steps), cameras, str(out_dir or "-"))
+    table.add_row(loaded.name, backend, str(steps), cameras, depth, str(out_dir or "-"))
     out.print(table, soft_wrap=False)  # centred title, as this command always printed it
 
 
@@ -115,5 +128,23 @@ def _drive(
         if out_dir:
             for camera, image in images.items():
                 write_png(out_dir / f"{camera}_{step:04d}.png", image)
+        seen.depth = _record_depth(hal, out_dir, step)
         advance()
     return seen
+
+
+def _record_depth(hal: RobotHal, out_dir: Path | None, step: int) -> list[str]:
+    """Render each depth sensor of a native scene; write its image and cloud to ``out_dir``;
+    the sensors' names."""
+    import numpy as np
+    from openral_hal.sim_attached import native_scene
+    from openral_mujoco.png import encode_depth_png
+
+    scene = native_scene(hal)
+    if scene is None or not out_dir:
+        return list(scene.depth_cameras) if scene else []
+    for name in scene.depth_cameras:
+        frame = scene.depth_frame(name, scene.data)
+        (out_dir / f"{name}_{step:04d}.depth.png").write_bytes(encode_depth_png(frame.depth_m))
+        np.save(out_dir / f"{name}_{step:04d}.points.npy", frame.points)
+    return list(scene.depth_cameras)
