@@ -13,6 +13,8 @@ from typing import Any
 import numpy as np
 from openral_core.errors import escaped
 
+from openral_nodes import topic_codec
+
 MAX_ITEMS = 16
 """Sequences longer than this are summarised (numbers) or truncated (strings, messages)."""
 
@@ -23,8 +25,62 @@ def is_message(value: object) -> bool:
 
 
 def format_message(msg: Any, *, max_items: int = MAX_ITEMS) -> str:
-    """Multi-line, YAML-like text of ``msg``."""
-    return "\n".join(_lines(msg, 0, max_items))
+    """Multi-line, YAML-like text of ``msg``; a point cloud, a laser scan and a depth image
+    start with a line that says what they hold (:func:`sensor_summary`)."""
+    summary = sensor_summary(msg)
+    lines = _lines(msg, 0, max_items)
+    return "\n".join([f"# {summary}", *lines] if summary else lines)
+
+
+def sensor_summary(msg: Any) -> str | None:
+    """One line on a ``PointCloud2`` (point count, bounds), ``LaserScan`` (finite range span,
+    beams without a return) or depth ``Image`` (range, pixels without a reading); None for
+    any other message. A malformed one says so."""
+    kind = type(msg).__name__ if type(msg).__module__.startswith("sensor_msgs.") else ""
+    try:
+        if kind == "PointCloud2":
+            return _cloud_summary(topic_codec.cloud_points(msg))
+        if kind == "LaserScan":
+            return _scan_summary(np.asarray(msg.ranges, dtype=np.float64))
+        if kind == "Image" and msg.encoding in topic_codec.DEPTH_ENCODINGS:
+            return _depth_summary(topic_codec.depth_metres(msg))
+    except topic_codec.ImageEncodingError as error:
+        return str(error)
+    return None
+
+
+def _cloud_summary(points: np.ndarray[Any, Any]) -> str:
+    finite = points[np.isfinite(points).all(axis=1)]
+    if not len(finite):
+        return f"{len(points)} points, none finite"
+    low, high = finite.min(axis=0), finite.max(axis=0)
+    bounds = ", ".join(
+        f"{axis} [{format_value(float(a))}, {format_value(float(b))}]"
+        for axis, a, b in zip("xyz", low, high, strict=True)
+    )
+    return f"{len(points)} points, {bounds} m"
+
+
+def _scan_summary(ranges: np.ndarray[Any, Any]) -> str:
+    finite = ranges[np.isfinite(ranges)]
+    span = (
+        f"range {format_value(float(finite.min()))} to {format_value(float(finite.max()))} m"
+        if finite.size
+        else "no finite range"
+    )
+    far, near = int(np.sum(ranges == np.inf)), int(np.sum(ranges == -np.inf))
+    return f"{ranges.size} beams, {span}, {far} without a return (+inf), {near} too close (-inf)"
+
+
+def _depth_summary(depth: np.ndarray[Any, Any]) -> str:
+    seen = depth[np.isfinite(depth)]
+    span = (
+        f"depth {format_value(float(seen.min()))} to {format_value(float(seen.max()))} m"
+        if seen.size
+        else "no reading"
+    )
+    height, width = depth.shape
+    return f"{width}x{height} depth image, {span}, {depth.size - seen.size} pixels without one"
 
 
 def _lines(msg: Any, indent: int, max_items: int) -> list[str]:

@@ -172,11 +172,13 @@ def snapshot(
     timeout: Timeout = 5.0,
     domain_id: DomainId = None,
 ) -> None:
-    """Save one frame of an Image topic (rgb8, bgr8 or mono8) as PNG."""
+    """Save one frame of an Image topic (rgb8, bgr8 or mono8) as PNG; a depth image (32FC1
+    or 16UC1) is colour-mapped, near warm and far cool, no reading black."""
     require_ros()
     from openral_core.errors import OpenralError, escaped
     from openral_mujoco.png import write_png
-    from openral_nodes.topic_codec import image_to_rgb
+    from openral_nodes.topic_codec import DEPTH_ENCODINGS, depth_colours, depth_metres, image_to_rgb
+    from openral_nodes.topic_format import sensor_summary
     from openral_nodes.topic_graph import wait_for_topic
     from openral_nodes.topic_probe import subscribe
 
@@ -189,10 +191,13 @@ def snapshot(
             )
         with subscribe(node, info) as inbox:
             msg = inbox.get(timeout)
-    rgb = image_to_rgb(msg)
+    depth = msg.encoding in DEPTH_ENCODINGS
+    rgb = depth_colours(depth_metres(msg)) if depth else image_to_rgb(msg)
     out_file.parent.mkdir(parents=True, exist_ok=True)
     write_png(out_file, rgb)
+    what = f"{sensor_summary(msg)}, colour-mapped" if depth else f"{msg.encoding}"
     out.print(
-        f"wrote {out_file} ({rgb.shape[1]}x{rgb.shape[0]} {msg.encoding}, "
-        f"frame {msg.header.frame_id or '-'}) from {info.name}"
+        f"wrote {out_file} ({rgb.shape[1]}x{rgb.shape[0]} {what}, "
+        f"frame {escaped(msg.header.frame_id) or '-'}) from {info.name}",
+        markup=False,
     )
