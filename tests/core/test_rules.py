@@ -79,6 +79,14 @@ def test_mock_arm_passes_every_rule(write_manifest: ManifestWriter) -> None:
             "sensors[1]",
             "duplicate VLA slot 'hand'",
         ),
+        (
+            (
+                "frame_id: overhead_optical,",
+                "frame_id: overhead_optical, mount_position_m: [0, 0, 1],",
+            ),
+            "sensors[0].mount_position_m",
+            "mount_position_m is a position on mount_body",
+        ),
     ],
     ids=[
         "duplicate-joint",
@@ -91,6 +99,7 @@ def test_mock_arm_passes_every_rule(write_manifest: ManifestWriter) -> None:
         "actuator-map-key",
         "duplicate-vla-slot",
         "vla-slot-collides-with-sensor-name",
+        "mount-position-without-mount-body",
     ],
 )
 def test_rule_violation_is_reported(
@@ -153,3 +162,69 @@ def test_an_issue_is_always_one_printable_line() -> None:
 
     issue = Issue(Path("f.yaml"), 3, 4, "a\u2028b", "does not compile: Error: x\nElement 'y'")
     assert issue.format() == "f.yaml:3:4: a\\u2028b: does not compile: Error: x; Element 'y'"
+
+
+MOBILE_BASE = """mobile_base:
+  mjcf_uri: robosuite:bases/omron_mobile_base.xml
+  mount_body: support
+  drive: holonomic
+  joints: {x: joint_mobile_forward, y: joint_mobile_side, yaw: joint_mobile_yaw}
+  actuators: {x: actuator_mobile_forward, y: actuator_mobile_side, yaw: actuator_mobile_yaw}
+  max_linear_velocity_m_s: 0.5
+  max_angular_velocity_rad_s: 1.0
+  max_linear_acceleration_m_s2: 1.0
+  max_angular_acceleration_rad_s2: 2.0
+joints:
+"""
+
+
+def _only_issue(path: Path) -> str:
+    """The one located line a manifest that breaks one rule is refused with."""
+    with pytest.raises(ManifestError) as info:
+        load_robot(path)
+    (issue,) = info.value.issues
+    line = issue.format()
+    assert "\n" not in line
+    return line
+
+
+def test_a_mobile_robot_without_a_mobile_base_is_refused_at_base(
+    write_manifest: ManifestWriter,
+) -> None:
+    path = write_manifest(("base: fixed", "base: mobile"))
+    assert _only_issue(path) == (
+        f"{path}:6:1: base: a mobile robot needs a mobile_base (its wheeled drive), or "
+        "sim.floating_base: true for a legged one"
+    )
+
+
+def test_a_mobile_base_on_a_fixed_robot_is_refused_at_the_mobile_base(
+    write_manifest: ManifestWriter,
+) -> None:
+    path = write_manifest(("joints:\n", MOBILE_BASE))
+    assert _only_issue(path) == (
+        f"{path}:7:1: mobile_base: a mobile_base needs base: mobile (base is 'fixed')"
+    )
+
+
+def test_a_mobile_robot_with_its_mobile_base_passes(write_manifest: ManifestWriter) -> None:
+    robot = load_robot(write_manifest(("base: fixed", "base: mobile"), ("joints:\n", MOBILE_BASE)))
+    assert robot.mobile_base is not None
+    assert (robot.mobile_base.odom_frame, robot.mobile_base.base_frame) == ("odom", "base_link")
+    assert robot.mobile_base.command_timeout_s == 0.5
+
+
+def test_a_legged_robot_is_mobile_without_a_mobile_base_and_cannot_ride_one(
+    write_manifest: ManifestWriter,
+) -> None:
+    legged = (
+        ("base: fixed", "base: mobile"),
+        ("joint_qpos_addr:", "floating_base: true\n  joint_qpos_addr:"),
+    )
+    assert load_robot(write_manifest(*legged)).base.value == "mobile"
+    findings = _findings(write_manifest(*legged, ("joints:\n", MOBILE_BASE)))
+    assert findings == {
+        "mobile_base": (
+            "a floating-base model cannot ride a mobile_base (the base carries its root body)"
+        )
+    }

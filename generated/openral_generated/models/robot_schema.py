@@ -12,7 +12,7 @@ from . import sim_schema
 
 class Base(StrEnum):
     """
-    How the robot stands: `fixed` is bolted to the world (or to a table); `mobile` drives around (odometry and cmd_vel apply).
+    How the robot stands: `fixed` is bolted to the world (or to a table); `mobile` drives around (odometry and cmd_vel apply): on a wheeled base described by `mobile_base`, or, with `sim.floating_base`, on its own legs.
     """
 
     fixed = "fixed"
@@ -129,6 +129,11 @@ class MountAxis(Enum):
     field_z_1 = "-z"
 
 
+MountPositionMItem = TypeAliasType(
+    "MountPositionMItem", Annotated[float, Field(ge=-10.0, le=10.0)]
+)
+
+
 class RgbSensor(OpenralModel):
     """
     A colour camera; optionally the input of a vision-language-action policy.
@@ -171,6 +176,13 @@ class RgbSensor(OpenralModel):
     mount_axis: MountAxis | None = None
     """
     Axis of `mount_body` the camera looks along. Absent: forward (+x) on a torso, head, pelvis or base body, and +z (the usual tool axis) on any other body. UR arms, for example, carry their tool along +y of wrist_3_link.
+    """
+    mount_position_m: Annotated[
+        list[MountPositionMItem] | None,
+        Field(examples=[[0.15, 0.0, 1.2]], max_length=3, min_length=3),
+    ] = None
+    """
+    Position in `mount_body`'s frame [m] x, y, z: of the camera (rgb and depth; absent: the default placement, see mount_axis) or of the site the scene creates for a lidar (absent: the body's origin). Needs `mount_body`.
     """
     fovy_deg: Annotated[float, Field(gt=0.0, lt=180.0)] = 45.0
     """
@@ -247,6 +259,13 @@ class DepthSensor(OpenralModel):
     """
     Axis of `mount_body` the camera looks along. Absent: forward (+x) on a torso, head, pelvis or base body, and +z (the usual tool axis) on any other body. UR arms, for example, carry their tool along +y of wrist_3_link.
     """
+    mount_position_m: Annotated[
+        list[MountPositionMItem] | None,
+        Field(examples=[[0.15, 0.0, 1.2]], max_length=3, min_length=3),
+    ] = None
+    """
+    Position in `mount_body`'s frame [m] x, y, z: of the camera (rgb and depth; absent: the default placement, see mount_axis) or of the site the scene creates for a lidar (absent: the body's origin). Needs `mount_body`.
+    """
     fovy_deg: Annotated[float, Field(gt=0.0, lt=180.0)] = 45.0
     """
     Vertical field of view [deg] of a camera the scene creates.
@@ -289,7 +308,7 @@ AngleRangeDegItem = TypeAliasType(
 
 class LidarSensor(OpenralModel):
     """
-    A planar lidar: rays cast from an MJCF site.
+    A planar lidar: rays cast from an MJCF site (one of the model's, or one the scene creates on `mount_body`).
     """
 
     model_config = ConfigDict(
@@ -307,7 +326,20 @@ class LidarSensor(OpenralModel):
     """
     site: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
     """
-    MJCF site the lidar's rays start from (lidar only).
+    MJCF site the lidar's rays start from (lidar only): a site of the robot's (or its mobile base's) model, or, with `mount_body`, the name of the site a native scene creates there.
+    """
+    mount_body: Annotated[
+        str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+    ] = None
+    """
+    MJCF body (native name, of the robot's or its mobile base's model) a native scene creates the lidar's `site` on, at `mount_position_m`, with the body's axes (the scan plane is the body's x-y plane), for a model that has no site where the lidar sits. Absent: `site` is a site of the model.
+    """
+    mount_position_m: Annotated[
+        list[MountPositionMItem] | None,
+        Field(examples=[[0.15, 0.0, 1.2]], max_length=3, min_length=3),
+    ] = None
+    """
+    Position in `mount_body`'s frame [m] x, y, z: of the camera (rgb and depth; absent: the default placement, see mount_axis) or of the site the scene creates for a lidar (absent: the body's origin). Needs `mount_body`.
     """
     width: Annotated[int, Field(ge=1, le=4096)]
     """
@@ -343,6 +375,147 @@ class LidarSensor(OpenralModel):
     ]
     """
     First and last ray angle [deg] of a lidar scan, counter-clockwise about the site's z axis.
+    """
+
+
+MountQuatWxyzItem = TypeAliasType(
+    "MountQuatWxyzItem", Annotated[float, Field(ge=-1.0, le=1.0)]
+)
+
+
+class DriveKind(StrEnum):
+    """
+    How a mobile base moves. `holonomic`: forward (x), sideways (y) and about the vertical (yaw) independently, as on mecanum or omni wheels; simulated by two slide joints and a hinge, each driven by a velocity actuator.
+    """
+
+    holonomic = "holonomic"
+
+
+class DriveAxes(OpenralModel):
+    """
+    One MJCF name per planar axis of a holonomic base.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    x: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
+    """
+    Forward, along the base frame's x axis.
+    """
+    y: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
+    """
+    Sideways, along the base frame's y axis (to the left).
+    """
+    yaw: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
+    """
+    About the vertical (counter-clockwise seen from above).
+    """
+
+
+class MobileBase(OpenralModel):
+    """
+    A wheeled base the robot rides on: driven by planar velocity commands (cmd_vel) and reporting odometry. It sits on the robot, not inside `sim`, because its kind, limits, command timeout and frame names are facts about the robot that a real base driver and the ROS graph share; its MJCF fields tell a native scene how to build it: the base's own model, with the robot's model (`sim.mjcf_uri`) attached to `mount_body`, whose joint addresses keep their meaning in the robot's model. Needs `base: mobile`.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    mjcf_uri: Annotated[
+        str,
+        Field(
+            examples=["robosuite:bases/omron_mobile_base.xml"],
+            pattern="^(file|pkg|robosuite):[A-Za-z0-9_./-]+$",
+        ),
+    ]
+    """
+    Where the base's MJCF model is found, resolved offline like `sim.mjcf_uri` (the same schemes `file:`, `pkg:` and `robosuite:`, and the same confinement: the model and every file it loads stay in the robot's folder or in the installed distribution).
+    """
+    mount_body: Annotated[
+        str, Field(examples=["support"], pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+    ]
+    """
+    Body of the base's model the robot's model is attached to: the robot's root bodies become its children.
+    """
+    mount_position_m: Annotated[
+        list[MountPositionMItem], Field(max_length=3, min_length=3)
+    ] = [0.0, 0.0, 0.0]
+    """
+    Position of the robot model's world frame in `mount_body`'s frame [m] x, y, z.
+    """
+    mount_quat_wxyz: Annotated[
+        list[MountQuatWxyzItem], Field(max_length=4, min_length=4)
+    ] = [1.0, 0.0, 0.0, 0.0]
+    """
+    Orientation of the robot model's world frame in `mount_body`'s frame, a quaternion w, x, y, z (normalised by MuJoCo; [1, 0, 0, 0] keeps the axes).
+    """
+    drive: DriveKind
+    """
+    How the base moves (see DriveKind).
+    """
+    joints: Annotated[
+        DriveAxes,
+        Field(
+            examples=[
+                {
+                    "x": "joint_mobile_forward",
+                    "y": "joint_mobile_side",
+                    "yaw": "joint_mobile_yaw",
+                }
+            ]
+        ),
+    ]
+    """
+    MJCF joints of the base's model (native names) that move it in the plane. A `holonomic` drive needs slide joints `x` and `y` followed by a hinge `yaw` about the vertical, all on the base's root body (a child of the world), so the slides move along the axes of the frame the base is placed in.
+    """
+    actuators: Annotated[
+        DriveAxes,
+        Field(
+            examples=[
+                {
+                    "x": "actuator_mobile_forward",
+                    "y": "actuator_mobile_side",
+                    "yaw": "actuator_mobile_yaw",
+                }
+            ]
+        ),
+    ]
+    """
+    MJCF velocity actuators of the base's model (native names), one driving each of `joints`: ctrl is the joint's velocity [m/s, rad/s].
+    """
+    max_linear_velocity_m_s: Annotated[float, Field(examples=[0.5], gt=0.0, le=10.0)]
+    """
+    Fastest planar speed of the base [m/s]: a command whose (vx, vy) is longer is scaled down to it, keeping its direction.
+    """
+    max_angular_velocity_rad_s: Annotated[float, Field(examples=[1.0], gt=0.0, le=20.0)]
+    """
+    Fastest turn about the vertical [rad/s]: a command's wz is clamped to it.
+    """
+    max_linear_acceleration_m_s2: Annotated[
+        float, Field(examples=[1.0], gt=0.0, le=50.0)
+    ]
+    """
+    Largest change of the planar velocity [m/s²]: the velocity in force moves towards the command by at most this much per second, speeding up and slowing down.
+    """
+    max_angular_acceleration_rad_s2: Annotated[
+        float, Field(examples=[2.0], gt=0.0, le=100.0)
+    ]
+    """
+    Largest change of the turn rate [rad/s²], as for max_linear_acceleration_m_s2.
+    """
+    command_timeout_s: Annotated[float, Field(gt=0.0, le=60.0)] = 0.5
+    """
+    Time [s] (simulated time in a scene) after the last velocity command at which the base is told to stop (it slows down at its acceleration limits), so a client that dies never leaves it driving.
+    """
+    odom_frame: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")] = "odom"
+    """
+    TF frame of the odometry (REP 105): fixed in the world, where the base's frame was when the scene was reset.
+    """
+    base_frame: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")] = (
+        "base_link"
+    )
+    """
+    TF frame of the base (REP 105), the child frame of the odometry: on the floor plane at the yaw joint's axis, turning with the base; velocity commands are given in it.
     """
 
 
@@ -385,7 +558,11 @@ class RobotDescription(OpenralModel):
     """
     base: Base
     """
-    How the robot stands: `fixed` is bolted to the world (or to a table); `mobile` drives around (odometry and cmd_vel apply).
+    How the robot stands: `fixed` is bolted to the world (or to a table); `mobile` drives around (odometry and cmd_vel apply): on a wheeled base described by `mobile_base`, or, with `sim.floating_base`, on its own legs.
+    """
+    mobile_base: MobileBase | None = None
+    """
+    The wheeled base the robot rides on (only with `base: mobile`); see MobileBase.
     """
     sim: sim_schema.SimDescription | None = None
     """

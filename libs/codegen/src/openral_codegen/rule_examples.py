@@ -21,6 +21,7 @@ from openral_core.schemas import SchemaName
 from openral_codegen.models import CodegenError
 
 ROBOT_FILE = "robots/franka_panda/robot.yaml"
+MOBILE_FILE = "robots/panda_mobile/robot.yaml"
 SCENE_FILE = "robots/franka_panda/scenes/tabletop.yaml"
 
 
@@ -97,6 +98,15 @@ RULE_BREAKS = (
         ROBOT_FILE,
         "observation.images.camera2",
         "observation.images.camera1",
+    ),
+    RuleBreak(SchemaName.ROBOT, 11, ROBOT_FILE, "base: fixed", "base: mobile"),
+    RuleBreak(SchemaName.ROBOT, 12, MOBILE_FILE, "base: mobile", "base: fixed"),
+    RuleBreak(
+        SchemaName.ROBOT,
+        13,
+        ROBOT_FILE,
+        "- name: agentview\n    kind: rgb\n",
+        "- name: agentview\n    kind: rgb\n    mount_position_m: [1.0, 0.0, 1.0]\n",
     ),
     RuleBreak(
         SchemaName.SCENE,

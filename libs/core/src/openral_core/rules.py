@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping, Sequence
 
 from openral_core.models import (
+    Base,
     DeployScene,
     LimitedJoint,
     RgbSensor,
@@ -51,6 +52,8 @@ def robot_findings(robot: RobotDescription, folder_name: str | None) -> list[Fin
         *_unique([(("sensors", i), vla_slot(s)) for i, s in rgb], "VLA slot"),
         *_limits_ordered(robot),
         *_sim_findings(robot),
+        *_base_findings(robot),
+        *_mount_findings(robot),
     ]
 
 
@@ -106,6 +109,37 @@ def _limits_ordered(robot: RobotDescription) -> Iterator[Finding]:
             yield (
                 ("joints", index, "position_limits"),
                 f"lower limit {limits[0]} must be below upper limit {limits[1]}",
+            )
+
+
+def _base_findings(robot: RobotDescription) -> Iterator[Finding]:
+    """Rules 11 and 12: ``base: mobile`` and ``mobile_base`` go together (a legged robot,
+    ``sim.floating_base``, is mobile without one and cannot ride one)."""
+    legged = robot.sim is not None and robot.sim.floating_base
+    if robot.base is Base.mobile and robot.mobile_base is None and not legged:
+        yield (
+            ("base",),
+            "a mobile robot needs a mobile_base (its wheeled drive), or sim.floating_base: "
+            "true for a legged one",
+        )
+    if robot.mobile_base is None:
+        return
+    if robot.base is not Base.mobile:
+        yield ("mobile_base",), f"a mobile_base needs base: mobile (base is {robot.base.value!r})"
+    if legged:
+        yield (
+            ("mobile_base",),
+            "a floating-base model cannot ride a mobile_base (the base carries its root body)",
+        )
+
+
+def _mount_findings(robot: RobotDescription) -> Iterator[Finding]:
+    """Rule 13: a sensor's mount_position_m is a position on its mount_body."""
+    for index, sensor in enumerate(robot.sensors):
+        if sensor.mount_position_m is not None and sensor.mount_body is None:
+            yield (
+                ("sensors", index, "mount_position_m"),
+                "mount_position_m is a position on mount_body; name the mount_body",
             )
 
 

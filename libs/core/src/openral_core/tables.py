@@ -1,6 +1,6 @@
 """Per-robot tables derived from a RobotDescription: the one place each derivation rule lives.
 
-Three tables are derived by ``just schema-export``, which writes them to
+Four tables are derived by ``just schema-export``, which writes them to
 ``generated/openral_generated/tables/<id>.json``: the runtime input of a repository robot
 (:mod:`openral_core.loaded` reads them; a robot without a committed file gets the same
 tables computed in memory by :func:`robot_tables`):
@@ -11,6 +11,8 @@ tables computed in memory by :func:`robot_tables`):
 * **VLA slots** — RGB sensor name → policy slot (suffix of ``vla_feature_key``, else the
   sensor's own name), in manifest order.
 * **Joint-name map** — canonical joint name → MJCF joint name.
+* **Mobile-base wiring** — a wheeled base's model, mount, drive joints and actuators,
+  limits and frames (None for a robot without ``mobile_base``).
 
 Each file also records its origin: the manifest's path and the SHA-256 of the validated
 manifest's canonical JSON (:func:`manifest_sha256`), so a table made from an earlier
@@ -26,7 +28,13 @@ from pathlib import Path
 from typing import Any
 
 from openral_core.located import source_file
-from openral_core.models import RgbSensor, RobotDescription, SimDescription, TorquePdControl
+from openral_core.models import (
+    MobileBase,
+    RgbSensor,
+    RobotDescription,
+    SimDescription,
+    TorquePdControl,
+)
 from openral_core.paths import repo_root
 
 FREE_JOINT_NQPOS = 7
@@ -86,6 +94,33 @@ class HalWiring:
 
 
 @dataclass(frozen=True)
+class MobileBaseWiring:
+    """A wheeled base, resolved for the simulation and the base drive (see MobileBase for
+    field meanings; the joint and actuator triples are in (x, y, yaw) order)."""
+
+    mjcf_uri: str
+    mount_body: str
+    mount_position_m: tuple[float, float, float]
+    mount_quat_wxyz: tuple[float, float, float, float]
+    drive: str
+    joints: tuple[str, str, str]
+    actuators: tuple[str, str, str]
+    max_linear_velocity_m_s: float
+    max_angular_velocity_rad_s: float
+    max_linear_acceleration_m_s2: float
+    max_angular_acceleration_rad_s2: float
+    command_timeout_s: float
+    odom_frame: str
+    base_frame: str
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> MobileBaseWiring:
+        """Inverse of ``dataclasses.asdict`` (the ``mobile_base`` of a tables JSON file)."""
+        tuples = ("mount_position_m", "mount_quat_wxyz", "joints", "actuators")
+        return cls(**{**data, **{key: tuple(data[key]) for key in tuples}})
+
+
+@dataclass(frozen=True)
 class VlaSlot:
     """One RGB sensor and the policy slot its frames are delivered under."""
 
@@ -106,6 +141,7 @@ class RobotTables:
     hal_wiring: HalWiring | None
     vla_slots: tuple[VlaSlot, ...]
     joint_name_map: dict[str, str]
+    mobile_base: MobileBaseWiring | None = None
 
     def to_json(self) -> str:
         """Deterministic JSON text (sorted keys, 2-space indent, trailing newline)."""
@@ -116,6 +152,7 @@ class RobotTables:
         """Inverse of :meth:`to_json`."""
         data = json.loads(text)
         wiring = data["hal_wiring"]
+        base = data.get("mobile_base")
         return cls(
             robot=data["robot"],
             manifest=data["manifest"],
@@ -123,6 +160,7 @@ class RobotTables:
             hal_wiring=None if wiring is None else HalWiring.from_dict(wiring),
             vla_slots=tuple(VlaSlot(**slot) for slot in data["vla_slots"]),
             joint_name_map=dict(data["joint_name_map"]),
+            mobile_base=None if base is None else MobileBaseWiring.from_dict(base),
         )
 
 
@@ -186,6 +224,31 @@ def hal_wiring(robot: RobotDescription) -> HalWiring | None:
     )
 
 
+def mobile_base_wiring(robot: RobotDescription) -> MobileBaseWiring | None:
+    """The robot's wheeled base with every default filled in, or None without one."""
+    base: MobileBase | None = robot.mobile_base
+    if base is None:
+        return None
+    x, y, z = base.mount_position_m
+    w, qx, qy, qz = base.mount_quat_wxyz
+    return MobileBaseWiring(
+        mjcf_uri=base.mjcf_uri,
+        mount_body=base.mount_body,
+        mount_position_m=(x, y, z),
+        mount_quat_wxyz=(w, qx, qy, qz),
+        drive=base.drive.value,
+        joints=(base.joints.x, base.joints.y, base.joints.yaw),
+        actuators=(base.actuators.x, base.actuators.y, base.actuators.yaw),
+        max_linear_velocity_m_s=base.max_linear_velocity_m_s,
+        max_angular_velocity_rad_s=base.max_angular_velocity_rad_s,
+        max_linear_acceleration_m_s2=base.max_linear_acceleration_m_s2,
+        max_angular_acceleration_rad_s2=base.max_angular_acceleration_rad_s2,
+        command_timeout_s=base.command_timeout_s,
+        odom_frame=base.odom_frame,
+        base_frame=base.base_frame,
+    )
+
+
 def manifest_sha256(robot: RobotDescription) -> str:
     """SHA-256 of the validated manifest's canonical JSON (sorted keys, defaults filled in):
     comments and formatting do not change it, any change of meaning does."""
@@ -219,6 +282,7 @@ def robot_tables(robot: RobotDescription, *, root: Path | None = None) -> RobotT
         hal_wiring=hal_wiring(robot),
         vla_slots=vla_slots(robot),
         joint_name_map=joint_name_map(robot),
+        mobile_base=mobile_base_wiring(robot),
     )
 
 

@@ -22,6 +22,22 @@ def is_position_servo(model: mujoco.MjModel, actuator: int) -> bool:
     return int(model.actuator_biastype[actuator]) == int(mujoco.mjtBias.mjBIAS_AFFINE)
 
 
+def is_velocity_servo(model: mujoco.MjModel, actuator: int) -> bool:
+    """The actuator's ctrl is a velocity target (force = kv·(ctrl - q̇), as ``<velocity>``
+    makes: fixed gain kv > 0, affine bias -kv·q̇, no activation dynamics)."""
+    kv = float(model.actuator_gainprm[actuator, 0])
+    bias = model.actuator_biasprm[actuator]
+    return (
+        int(model.actuator_dyntype[actuator]) == int(mujoco.mjtDyn.mjDYN_NONE)
+        and int(model.actuator_gaintype[actuator]) == int(mujoco.mjtGain.mjGAIN_FIXED)
+        and int(model.actuator_biastype[actuator]) == int(mujoco.mjtBias.mjBIAS_AFFINE)
+        and kv > 0
+        and float(bias[0]) == 0.0
+        and float(bias[1]) == 0.0
+        and float(bias[2]) == -kv
+    )
+
+
 def is_motor(model: mujoco.MjModel, actuator: int) -> bool:
     """The actuator's ctrl is a force or torque (no bias, as ``<motor>`` makes)."""
     return int(model.actuator_biastype[actuator]) == int(mujoco.mjtBias.mjBIAS_NONE)

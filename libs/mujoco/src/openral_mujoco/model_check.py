@@ -7,12 +7,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
-from openral_core.errors import ManifestError, parse_field
+from openral_core.errors import ManifestError, OpenralError, parse_field
 from openral_core.located import error_at, issue_at
 from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
-from openral_core.tables import HalWiring, hal_wiring
+from openral_core.tables import HalWiring, hal_wiring, mobile_base_wiring
 
-from openral_mujoco.mjcf_model import actuator_joints, root_is_free
+from openral_mujoco.mjcf_model import actuator_joints, is_velocity_servo, root_is_free
+from openral_mujoco.mobile_base import base_model_file, compile_base_model, drive_problems
 from openral_mujoco.model_cache import cached_model, mjcf_fingerprint
 
 
@@ -26,21 +27,45 @@ class CheckRow:
     ok: bool
 
 
-def check_robot(description: RobotDescription, model: mujoco.MjModel) -> list[CheckRow]:
-    """Every check of ``description`` against ``model``; a robot passes when all rows are ok."""
+def check_robot(
+    description: RobotDescription,
+    model: mujoco.MjModel,
+    base_model: mujoco.MjModel | None = None,
+) -> list[CheckRow]:
+    """Every check of ``description`` against ``model``; a robot passes when all rows are ok.
+
+    A robot with a ``mobile_base`` is also checked against its base's model (``base_model``,
+    else the one its ``mobile_base.mjcf_uri`` names): the mount body, a holonomic drive's
+    joints and velocity actuators; its sensors may name bodies and sites of either model.
+    """
     wiring = hal_wiring(description)
     if wiring is None:
         return [CheckRow("sim", "a sim block", "none", ok=False)]
-    return [
+    rows = [
         *_joint_rows(description, wiring, model),
         *_gripper_rows(wiring, model),
         *_keyframe_and_base_rows(wiring, model),
-        *_sensor_rows(description, model),
     ]
+    models = [model]
+    if description.mobile_base is not None:
+        if base_model is None:
+            try:
+                base_model = compile_base_model(description, base_model_file(description))
+            except OpenralError as error:
+                uri = description.mobile_base.mjcf_uri
+                return [*rows, CheckRow("mobile_base.mjcf_uri", uri, str(error), ok=False)]
+        rows += _mobile_base_rows(description, base_model)
+        models.append(base_model)
+    return rows + list(_sensor_rows(description, models))
 
 
-def require_agreement(description: RobotDescription, model: mujoco.MjModel) -> None:
-    """Refuse ``model`` for ``description`` unless every check of :func:`check_robot` passes.
+def require_agreement(
+    description: RobotDescription,
+    model: mujoco.MjModel,
+    base_model: mujoco.MjModel | None = None,
+) -> None:
+    """Refuse ``model`` (and ``base_model``, the robot's mobile base) for ``description``
+    unless every check of :func:`check_robot` passes.
 
     The HAL and the native scene call this before they use a model: a manifest whose
     addresses, actuators, base or cameras disagree with its model would drive the wrong
@@ -49,7 +74,7 @@ def require_agreement(description: RobotDescription, model: mujoco.MjModel) -> N
     Raises:
         ManifestError: One located issue per failed check.
     """
-    failed = [row for row in check_robot(description, model) if not row.ok]
+    failed = [row for row in check_robot(description, model, base_model) if not row.ok]
     if not failed:
         return
     issues = [
@@ -183,26 +208,51 @@ def _keyframe_and_base_rows(wiring: HalWiring, model: mujoco.MjModel) -> Iterato
     )
 
 
-def _sensor_rows(description: RobotDescription, model: mujoco.MjModel) -> Iterator[CheckRow]:
+def _mobile_base_rows(description: RobotDescription, model: mujoco.MjModel) -> Iterator[CheckRow]:
+    """The mount body, and a holonomic drive: its joints' layout and velocity actuators."""
+    wiring = mobile_base_wiring(description)
+    assert wiring is not None
+    yield _exists("mobile_base.mount_body", wiring.mount_body, mujoco.mjtObj.mjOBJ_BODY, [model])
+    layout = "slides x, y then hinge yaw about the vertical, on one child body of the world"
+    problems = drive_problems(model, wiring)
+    for field, problem in problems:
+        yield CheckRow(field, layout, problem, ok=False)
+    if not problems:
+        yield CheckRow("mobile_base.joints", layout, "found", ok=True)
+    for axis, name, joint in zip(("x", "y", "yaw"), wiring.actuators, wiring.joints, strict=True):
+        expected = f"{name}: a velocity actuator of {joint}"
+        actuator = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+        jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
+        if actuator < 0:
+            actual, ok = "no such actuator", False
+        elif jid < 0 or actuator_joints(model, actuator) != (jid,):
+            actual, ok = "it drives another joint", False
+        else:
+            ok = is_velocity_servo(model, actuator)
+            actual = "found" if ok else "not a velocity servo (kv·(ctrl - q̇))"
+        yield CheckRow(f"mobile_base.actuators.{axis}", expected, actual, ok=ok)
+
+
+def _sensor_rows(description: RobotDescription, models: list[mujoco.MjModel]) -> Iterator[CheckRow]:
+    """Cameras, mount bodies and sites, each found in one of ``models`` (the robot's, its
+    base's); a lidar with a mount body gets its site from the scene."""
+    body, camera, site = (
+        mujoco.mjtObj.mjOBJ_BODY,
+        mujoco.mjtObj.mjOBJ_CAMERA,
+        mujoco.mjtObj.mjOBJ_SITE,
+    )
     for index, sensor in enumerate(description.sensors):
-        if isinstance(sensor, RgbSensor | DepthSensor):
-            if sensor.camera is not None:
-                yield _exists(
-                    f"sensors[{index}].camera", sensor.camera, mujoco.mjtObj.mjOBJ_CAMERA, model
-                )
-            if sensor.mount_body is not None:
-                yield _exists(
-                    f"sensors[{index}].mount_body",
-                    sensor.mount_body,
-                    mujoco.mjtObj.mjOBJ_BODY,
-                    model,
-                )
+        field = f"sensors[{index}]"
+        if isinstance(sensor, RgbSensor | DepthSensor) and sensor.camera is not None:
+            yield _exists(f"{field}.camera", sensor.camera, camera, models)
+        if sensor.mount_body is not None:
+            yield _exists(f"{field}.mount_body", sensor.mount_body, body, models)
         elif isinstance(sensor, LidarSensor):
-            yield _exists(f"sensors[{index}].site", sensor.site, mujoco.mjtObj.mjOBJ_SITE, model)
+            yield _exists(f"{field}.site", sensor.site, site, models)
 
 
-def _exists(field: str, name: str, kind: mujoco.mjtObj, model: mujoco.MjModel) -> CheckRow:
-    found = mujoco.mj_name2id(model, kind, name) >= 0
+def _exists(field: str, name: str, kind: mujoco.mjtObj, models: list[mujoco.MjModel]) -> CheckRow:
+    found = any(mujoco.mj_name2id(model, kind, name) >= 0 for model in models)
     return CheckRow(field, name, "found" if found else "not in the model", ok=found)
 
 
