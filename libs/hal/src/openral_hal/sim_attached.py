@@ -8,7 +8,9 @@ value per manifest joint and the joint state is the scene's own, in manifest uni
 backend (robosuite) keeps its controller's action; its joint state is read from the MuJoCo
 data by joint name (or from ``obs["joint_positions"]`` for a non-MuJoCo backend).
 The deploy control loop advances the scene one step per control period with
-:meth:`SimAttachedHAL.tick`, which exists only on simulated HALs.
+:meth:`SimAttachedHAL.tick`, which exists only on simulated HALs. A robot on a mobile base
+in a native scene also takes base velocity commands (:meth:`SimAttachedHAL.command_base`,
+refused while E-stopped; the E-stop halts the base) and reports odometry.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from openral_mujoco.action import validated_action
 from openral_mujoco.mjcf_model import is_scalar_joint
 from openral_mujoco.name_resolution import resolve_joint_names
 from openral_mujoco.state import FloatArray, JointStateSample
+from openral_sim.base_drive import BaseCommand, BaseDrive, BaseOdometry
 from openral_sim.native_scene import NativeScene
 from openral_sim.rollout import (
     HoldingRollout,
@@ -276,7 +279,44 @@ class SimAttachedHAL(EStopLatch):
         self._step(self.hold_action())
         return True
 
+    # -- mobile base -----------------------------------------------------------------------
+
+    @property
+    def base(self) -> BaseDrive | None:
+        """The mobile base's drive (None: a robot without one, or not a native scene)."""
+        return self.env.base if isinstance(self.env, NativeScene) else None
+
+    def command_base(self, vx_m_s: float, vy_m_s: float, wz_rad_s: float) -> BaseCommand:
+        """Drive the mobile base at this base-frame velocity [m/s, m/s, rad/s], clamped to
+        the manifest's limits, until the next command or its ``command_timeout_s`` of
+        simulated time; the scene's steps apply it (:meth:`BaseDrive.command`).
+
+        Raises:
+            NotConnected: Before connect. EStopLatched: The E-stop is latched.
+            ConfigurationError: No mobile base. ActionRejected: A non-finite value.
+        """
+        self._require_obs()
+        self._refuse_when_estopped()
+        return self._require_base().command(vx_m_s, vy_m_s, wz_rad_s)
+
+    def base_odometry(self) -> BaseOdometry:
+        """The base's pose (odometry frame) and twist (base frame) now (errors as above)."""
+        self._require_obs()
+        return self._require_base().odometry()
+
+    def estop(self) -> None:
+        """Latch the E-stop: actions and base commands are refused, the base halts at once."""
+        super().estop()
+        if self.base is not None:
+            self.base.halt()
+
     # -- internals -------------------------------------------------------------------------
+
+    def _require_base(self) -> BaseDrive:
+        base = self.base
+        if base is None:
+            raise ConfigurationError(f"{self.description.name} has no mobile base in this scene")
+        return base
 
     def _on_release(self) -> None:
         """A native scene holds the pose the E-stop froze; nothing jumps on release."""

@@ -193,7 +193,8 @@ def drive_problems(model: mujoco.MjModel, wiring: MobileBaseWiring) -> list[tupl
         if jid < 0:
             problems.append((f"mobile_base.joints.{axis}", "no such joint"))
         elif int(model.jnt_type[jid]) != int(kind):
-            problems.append((f"mobile_base.joints.{axis}", f"not a {kind.name[7:].lower()}"))
+            found = mujoco.mjtJoint(int(model.jnt_type[jid])).name.removeprefix("mjJNT_")
+            problems.append((f"mobile_base.joints.{axis}", f"a {found.lower()} there"))
     if problems:
         return problems
     bodies = {int(model.jnt_bodyid[j]) for j in ids}

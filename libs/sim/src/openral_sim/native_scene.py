@@ -12,6 +12,12 @@ gripper commands of their write mode), clamped to the manifest's limits and slew
 velocity limits; the joint state is read in the same units. Only the addresses differ: the
 robot's joints are found in the composed model by name.
 
+A robot with a ``mobile_base`` rides its base (composed by :mod:`openral_sim.scene_base`);
+:attr:`NativeScene.base` (a :class:`~openral_sim.base_drive.BaseDrive`, None for a fixed
+robot) takes velocity commands and reads odometry, and :meth:`NativeScene.step` updates it
+every :data:`~openral_sim.base_drive.BASE_UPDATE_STEPS` physics steps. The base is no slot
+of the action: the arm's contract stays exactly the robot's own.
+
 Cameras render on demand. With ``render_observations`` (the default, what ``openral sim
 run`` and the tests read) every ``reset``/``step`` renders each camera into
 ``obs["images"]``; without it they render nothing and ``obs["images"]`` is empty, and a
@@ -37,6 +43,7 @@ from openral_mujoco.joint_driver import JointDriver
 from openral_mujoco.robot_addresses import locate_robot
 from openral_mujoco.state import FloatArray, JointStateSample
 
+from openral_sim.base_drive import BASE_UPDATE_STEPS, BaseDrive
 from openral_sim.depth_cloud import DepthCamera, DepthFrame
 from openral_sim.rollout import Observation, StepResult
 from openral_sim.scene_cameras import camera_sensors
@@ -84,6 +91,9 @@ class NativeScene:
         except HalError as error:
             raise error_at(description, ("joints",), str(error)) from None
         self.driver = JointDriver(description, wiring, self.model, addresses)
+        base = robot.tables.mobile_base
+        self.base = None if base is None else BaseDrive(base, self.model, self.data)
+        """The mobile base's drive and odometry (None for a robot without a mobile base)."""
         self._root_body = root_body(self.model, description)
         depth = {s.name: s for s in description.sensors if isinstance(s, DepthSensor)}
         self._sensors = {name: cam for name, cam in cameras.items() if name not in depth}
@@ -186,7 +196,9 @@ class NativeScene:
             self._place_floating_base()
         self._hold_base_where_it_is()
         self.driver.start(self.model, self.data)
-        self.driver.advance(self.model, self.data, self.wiring.settle_steps_default)
+        if self.base is not None:
+            self.base.reset()
+        self._advance(self.wiring.settle_steps_default)
         self._steps = 0
         return self._observe()
 
@@ -198,7 +210,7 @@ class NativeScene:
             SimulationDiverged: MuJoCo met a NaN/Inf state and reset it.
         """
         self.driver.command(action, self.data)
-        self.driver.advance(self.model, self.data, self.substeps)
+        self._advance(self.substeps)
         self._steps += 1
         truncated = self.horizon is not None and self._steps >= self.horizon
         return StepResult(self._observe(), truncated=truncated, info={"steps": self._steps})
@@ -278,6 +290,21 @@ class NativeScene:
     def _observe(self) -> Observation:
         images = self.render_cameras(self.data) if self.render_observations else {}
         return {"images": images, "time": float(self.data.time)}
+
+    def _advance(self, steps: int) -> None:
+        """``steps`` physics steps; a mobile base's drive is updated before every
+        :data:`BASE_UPDATE_STEPS` of them (the joint driver slews in chunks of that size
+        too, so chunking changes nothing of the arm's motion)."""
+        base = self.base
+        if base is None:
+            self.driver.advance(self.model, self.data, steps)
+            return
+        timestep = float(self.model.opt.timestep)
+        while steps > 0:
+            chunk = min(steps, BASE_UPDATE_STEPS)
+            base.update(chunk * timestep)
+            self.driver.advance(self.model, self.data, chunk)
+            steps -= chunk
 
     def _hold_base_where_it_is(self) -> None:
         """Aim the base weld (if any) at the root body's pose now: relpose is the world's

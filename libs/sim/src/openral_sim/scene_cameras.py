@@ -44,15 +44,17 @@ def camera_sensors(scene: DeployScene, robot: RobotDescription) -> dict[str, str
 
 
 def add_mounted_cameras(
-    child: mujoco.MjSpec, robot: RobotDescription, cameras: dict[str, str]
+    spec: mujoco.MjSpec, robot: RobotDescription, cameras: dict[str, str]
 ) -> None:
-    """A camera on each mounted sensor's body (the model was checked to have the body)."""
+    """A camera on each mounted sensor's body in ``spec`` (the robot's, and its mobile
+    base's, are attached to it and were checked to have the body), at ``mount_position_m``
+    when the manifest gives one."""
     for sensor in robot.sensors:
         if not isinstance(sensor, RgbSensor | DepthSensor) or sensor.name not in cameras:
             continue
         if sensor.camera is not None or sensor.mount_body is None:
             continue
-        body = child.body(sensor.mount_body)
+        body = spec.body(sensor.mount_body)
         assert body is not None, "require_agreement checks mount bodies before composing"
         forward = any(word in sensor.mount_body.lower() for word in FORWARD_LOOKING)
         axis = sensor.mount_axis.value if sensor.mount_axis is not None else None
@@ -61,6 +63,8 @@ def add_mounted_cameras(
             pos, xyaxes = [0.1, 0.0, 0.35], [0, -1, 0, 0.45, 0, 1]
         else:
             pos, xyaxes = looking_along(axis or "+z")
+        if sensor.mount_position_m is not None:
+            pos = list(sensor.mount_position_m)
         body.add_camera(
             name=cameras[sensor.name], pos=pos, xyaxes=xyaxes, fovy=sensor.fovy_deg or 60.0
         )

@@ -44,8 +44,9 @@ def physics_steps_per_control(scene: DeployScene, timestep_s: float) -> int:
     return int(steps)
 
 
-def check_object_names(scene: DeployScene, model: mujoco.MjModel) -> None:
-    """Refuse a scene object whose body or joint name the robot's model already uses."""
+def check_object_names(scene: DeployScene, *models: mujoco.MjModel | None) -> None:
+    """Refuse a scene object whose body or joint name one of ``models`` (the robot's, its
+    mobile base's; None is skipped) already uses."""
     options = scene.scene.options
     for index, obj in enumerate(options.objects or [] if options else []):
         for kind, name in (
@@ -53,7 +54,7 @@ def check_object_names(scene: DeployScene, model: mujoco.MjModel) -> None:
             (mujoco.mjtObj.mjOBJ_JOINT, f"scene_{obj.name}_joint"),
             (mujoco.mjtObj.mjOBJ_GEOM, f"scene_{obj.name}_geom"),
         ):
-            if mujoco.mj_name2id(model, kind, name) >= 0:
+            if any(m is not None and mujoco.mj_name2id(m, kind, name) >= 0 for m in models):
                 message = f"the robot's model already has an element named {name!r}; rename it"
                 raise error_at(scene, ("scene", "options", "objects", index, "name"), message)
 

@@ -1,6 +1,8 @@
 """How a native scene is composed with MjSpec: an empty world with the robot model's
-physics options, floor, lights and sky, an optional table and pedestal, the scene's objects,
-the robot attached at its base pose (welded if asked), and the cameras.
+physics options, floor, lights and sky, an optional table and pedestal, the scene's objects
+(loose, or fixed to the world with ``free: false``), the robot attached at its base pose
+(welded if asked; on its mobile base, see :mod:`openral_sim.scene_base`), the cameras and
+the lidar sites the manifest mounts on the robot's bodies.
 
 Every fault is reported at its field of the scene file or the manifest.
 """
@@ -24,14 +26,16 @@ from openral_core.models import (
     RobotDescription,
     SceneObject,
 )
-from openral_mujoco.mjcf_uri import robot_model_file
-from openral_mujoco.model_cache import cached_model, code_digest, mjcf_fingerprint
-from openral_mujoco.model_check import (
-    compile_robot_model,
-    require_agreement,
-    unloadable_model,
-)
+from openral_mujoco.model_cache import cached_model, code_digest
+from openral_mujoco.model_check import require_agreement, unloadable_model
 
+from openral_sim.scene_base import (
+    RobotModels,
+    add_lidar_sites,
+    attach_robot,
+    robot_models,
+    robot_offset,
+)
 from openral_sim.scene_cameras import add_fixed_cameras, add_mounted_cameras, rotate_about_z
 from openral_sim.scene_checks import check_object_names, check_weld
 from openral_sim.scene_geometry import lowest_static_point, robot_extent, root_body
@@ -68,25 +72,25 @@ def compose(
     scene: DeployScene, robot: RobotDescription, folder: Path, cameras: dict[str, str]
 ) -> ComposedScene:
     """Compose and compile ``scene`` around ``robot`` (manifest in ``folder``), after checking
-    the manifest against its model; both compiled models come from
-    :mod:`~openral_mujoco.model_cache` when nothing they are made of has changed.
+    the manifest against its model (and its mobile base's); the compiled models come from
+    :mod:`~openral_mujoco.model_cache` when nothing they are made of has changed (every
+    file of the robot's and the base's MJCF is part of the scene's key).
 
     Raises:
         ManifestError: At the scene file's or manifest's field that cannot be built.
     """
     assert robot.sim is not None
     check_weld(scene, robot)
-    path = robot_model_file(robot, folder)
-    robot_model = compile_robot_model(robot, path)
-    require_agreement(robot, robot_model)
-    check_object_names(scene, robot_model)
-    fingerprint = mjcf_fingerprint(path)
+    models = robot_models(robot, folder)
+    require_agreement(robot, models.model, models.base_model)
+    check_object_names(scene, models.model, models.base_model)
+    fingerprints = models.fingerprints()
     parts = None
-    if fingerprint is not None:
+    if fingerprints is not None:
         inputs = (scene.model_dump_json(), robot.model_dump_json(), json.dumps(cameras))
-        parts = ("scene", fingerprint, _composer_digest(), *inputs)
-    model = cached_model(parts, lambda: _compile(scene, robot, path, robot_model, cameras))
-    return ComposedScene(model, robot_model)
+        parts = ("scene", *fingerprints, _composer_digest(), *inputs)
+    model = cached_model(parts, lambda: _compile(scene, robot, models, cameras))
+    return ComposedScene(model, models.model)
 
 
 @functools.cache
@@ -100,34 +104,35 @@ def _composer_digest() -> str:
 
 
 def _compile(
-    scene: DeployScene,
-    robot: RobotDescription,
-    path: Path,
-    child_model: mujoco.MjModel,
-    cameras: dict[str, str],
+    scene: DeployScene, robot: RobotDescription, models: RobotModels, cameras: dict[str, str]
 ) -> mujoco.MjModel:
     """Build the scene's spec (see the module doc) and compile it."""
     assert robot.sim is not None
-    child = robot_spec(robot, path)
+    child, child_model = robot_spec(robot, models.path), models.model
     spec = _scene_spec(scene, robot, child)
     pose = scene.base_pose
     base = np.asarray(pose.position_m if pose and pose.position_m else [0.0, 0.0, 0.0])
     yaw = math.radians(pose.yaw_deg if pose and pose.yaw_deg else 0.0)
     own_floor = any(g.type == mujoco.mjtGeom.mjGEOM_PLANE for g in child.geoms)  # no 2nd
     floor_z = 0.0
-    if scene.scene.assets is NativeAssets.floor:  # the model brings a table: floor under it
+    if robot.mobile_base is not None:  # the base stands on the floor where it is placed
+        floor_z = float(base[2])
+    elif scene.scene.assets is NativeAssets.floor:  # the model brings a table: floor under it
         floor_z = min(0.0, base[2] + lowest_static_point(child_model) - 0.001)
     own_sky = any(t.type == mujoco.mjtTexture.mjTEXTURE_SKYBOX for t in child.textures)
     _add_world(spec, floor_z=None if own_floor else floor_z, sky=not own_sky)
     if scene.scene.assets is NativeAssets.tabletop:
-        _add_tabletop(spec, scene, base, yaw, fixed=robot.sim.floating_base is False)
+        fixed = robot.sim.floating_base is False and robot.mobile_base is None
+        _add_tabletop(spec, scene, base, yaw, fixed=fixed)
     options = scene.scene.options
     for obj in options.objects if options and options.objects else []:
         _add_object(spec, obj)
     frame = spec.worldbody.add_frame(pos=base.tolist(), quat=yaw_quat(yaw).tolist())
     center, radius = robot_extent(child_model, robot)
-    add_mounted_cameras(child, robot, cameras)
-    spec.attach(child, frame=frame, prefix="")
+    center = center + robot_offset(robot, models)
+    attach_robot(spec, child, robot, models, frame)
+    add_mounted_cameras(spec, robot, cameras)
+    add_lidar_sites(spec, robot)
     if pose is not None and pose.weld:
         _add_base_weld(spec, child_model, robot)
     add_fixed_cameras(spec, robot, cameras, base + rotate_about_z(yaw, center), yaw, radius)
@@ -238,7 +243,8 @@ def _add_object(spec: mujoco.MjSpec, obj: SceneObject) -> None:
     }
     size = [*obj.size_m, 0.0, 0.0][:3]
     body = spec.worldbody.add_body(name=f"scene_{obj.name}", pos=list(obj.position_m))
-    body.add_freejoint(name=f"scene_{obj.name}_joint")
+    if obj.free is not False:  # free: false is a static body (a wall, a table)
+        body.add_freejoint(name=f"scene_{obj.name}_joint")
     body.add_geom(
         name=f"scene_{obj.name}_geom",
         type=shapes[obj.shape],

@@ -1,0 +1,95 @@
+"""The robot's place in a native scene: its own model alone, or on its mobile base.
+
+A robot with a ``mobile_base`` is two models: the base's, attached to the world at the
+scene's base pose (the base stands on the floor: its frame is on its floor plane), and the
+robot's, attached to the base's ``mount_body`` at the mount offset. In the composed model
+the base is the root of the robot's tree, so :func:`~openral_sim.scene_geometry.root_body`
+and :func:`~openral_sim.scene_geometry.robot_bodies` see base and robot as one robot; the
+robot's own compiled model stays the robot alone, so its wiring's addresses keep their
+meaning (:func:`~openral_mujoco.robot_addresses.locate_robot` finds them again by name).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import mujoco
+import numpy as np
+from openral_core.models import LidarSensor, RobotDescription
+from openral_core.tables import mobile_base_wiring
+from openral_mujoco.mjcf_uri import robot_model_file
+from openral_mujoco.mobile_base import base_model_file, base_spec, compile_base_model, mount_origin
+from openral_mujoco.model_cache import mjcf_fingerprint
+from openral_mujoco.model_check import compile_robot_model
+from openral_mujoco.state import FloatArray
+
+
+@dataclass(frozen=True)
+class RobotModels:
+    """The robot's model file and compiled model, and its mobile base's (None without one)."""
+
+    path: Path
+    model: mujoco.MjModel
+    base_path: Path | None
+    base_model: mujoco.MjModel | None
+
+    def fingerprints(self) -> tuple[str, ...] | None:
+        """The model-cache fingerprint of every file the models read (None: unlistable)."""
+        paths = [self.path] if self.base_path is None else [self.path, self.base_path]
+        found = [mjcf_fingerprint(path) for path in paths]
+        return None if None in found else tuple(f for f in found if f is not None)
+
+
+def robot_models(robot: RobotDescription, folder: Path) -> RobotModels:
+    """Resolve and compile (or load from the model cache) the robot's and its base's models.
+
+    Raises:
+        ManifestError: At ``sim.mjcf_uri`` or ``mobile_base.mjcf_uri``.
+    """
+    path = robot_model_file(robot, folder)
+    model = compile_robot_model(robot, path)
+    if robot.mobile_base is None:
+        return RobotModels(path, model, None, None)
+    base_path = base_model_file(robot, folder)
+    return RobotModels(path, model, base_path, compile_base_model(robot, base_path))
+
+
+def attach_robot(
+    spec: mujoco.MjSpec,
+    child: mujoco.MjSpec,
+    robot: RobotDescription,
+    models: RobotModels,
+    frame: mujoco.MjsFrame,
+) -> None:
+    """Attach the robot's spec ``child`` to ``spec`` at the world ``frame`` (the base pose):
+    directly, or on its mobile base, which is attached there instead."""
+    wiring = mobile_base_wiring(robot)
+    if wiring is None or models.base_path is None:
+        spec.attach(child, frame=frame, prefix="")
+        return
+    spec.attach(base_spec(robot, models.base_path), frame=frame, prefix="")
+    mount = spec.body(wiring.mount_body)
+    assert mount is not None, "require_agreement checks the mount body before composing"
+    on_base = mount.add_frame(pos=list(wiring.mount_position_m), quat=list(wiring.mount_quat_wxyz))
+    spec.attach(child, frame=on_base, prefix="")
+
+
+def robot_offset(robot: RobotDescription, models: RobotModels) -> FloatArray:
+    """Where the robot's model sits in the frame of the base pose [m]: on its mobile base's
+    mount, else at the pose itself."""
+    wiring = mobile_base_wiring(robot)
+    if wiring is None or models.base_model is None:
+        return np.zeros(3)
+    return mount_origin(models.base_model, wiring)
+
+
+def add_lidar_sites(spec: mujoco.MjSpec, robot: RobotDescription) -> None:
+    """A site for each lidar with a ``mount_body``, at its ``mount_position_m`` with the
+    body's axes (its scan plane is the body's x-y plane)."""
+    for sensor in robot.sensors:
+        if not isinstance(sensor, LidarSensor) or sensor.mount_body is None:
+            continue
+        body = spec.body(sensor.mount_body)
+        assert body is not None, "require_agreement checks mount bodies before composing"
+        body.add_site(name=sensor.site, pos=list(sensor.mount_position_m or [0.0, 0.0, 0.0]))
