@@ -145,7 +145,7 @@ class SceneOptions(OpenralModel):
     """
     objects: Annotated[list[SceneObject] | None, Field(max_length=64)] = None
     """
-    Objects placed on the table (native only).
+    Objects of a native scene: loose props (on the table), or, with `free: false`, bodies fixed to the world such as walls and furniture (native only).
     """
 
 
@@ -238,7 +238,7 @@ class DeployScene(OpenralModel):
     """
     base_pose: BasePose | None = None
     """
-    Where the robot's base is placed in the world.
+    Where the robot's base is placed in the world. A mobile base stands on the floor there, and its odometry starts there.
     """
     scene: SceneSpec
     """
