@@ -33,6 +33,14 @@ def test_panda_mobile_passes_every_check(write_manifest: ManifestWriter) -> None
             ("mobile_base.mount_body", "not in the model"),
         ),
         (
+            ("mount_body: support", "mount_body: world"),
+            ("mobile_base.mount_body", "a body the base does not carry"),
+        ),
+        (
+            ("site: base_lidar_site", "site: center"),
+            ("sensors[2].site", "a site of that name already"),
+        ),
+        (
             ("x: joint_mobile_forward", "x: joint_mobile_yaw"),
             ("mobile_base.joints.x", "a hinge there"),
         ),
@@ -62,6 +70,8 @@ def test_panda_mobile_passes_every_check(write_manifest: ManifestWriter) -> None
     ],
     ids=[
         "mount-body",
+        "mount-on-the-world",
+        "lidar-site-taken",
         "x-not-slide",
         "yaw-not-hinge",
         "yaw-missing",

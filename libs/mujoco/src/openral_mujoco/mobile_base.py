@@ -213,6 +213,19 @@ def drive_problems(model: mujoco.MjModel, wiring: MobileBaseWiring) -> list[tupl
     return problems
 
 
+def mount_problem(model: mujoco.MjModel, wiring: MobileBaseWiring) -> str | None:
+    """Why ``wiring.mount_body`` cannot carry the robot in the base's ``model`` (it must be
+    a body the base's drive moves), or None."""
+    body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, wiring.mount_body)
+    if body < 0:
+        return "not in the model"
+    yaw = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, wiring.joints[2])
+    root = int(model.body_rootid[model.jnt_bodyid[yaw]]) if yaw >= 0 else -1
+    if body == 0 or int(model.body_rootid[body]) != root:
+        return "a body the base does not carry"
+    return None
+
+
 def _id(model: mujoco.MjModel, kind: mujoco.mjtObj, name: str) -> int:
     index = mujoco.mj_name2id(model, kind, name)
     if index < 0:

@@ -13,7 +13,12 @@ from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescri
 from openral_core.tables import HalWiring, hal_wiring, mobile_base_wiring
 
 from openral_mujoco.mjcf_model import actuator_joints, is_velocity_servo, root_is_free
-from openral_mujoco.mobile_base import base_model_file, compile_base_model, drive_problems
+from openral_mujoco.mobile_base import (
+    base_model_file,
+    compile_base_model,
+    drive_problems,
+    mount_problem,
+)
 from openral_mujoco.model_cache import cached_model, mjcf_fingerprint
 
 
@@ -212,7 +217,8 @@ def _mobile_base_rows(description: RobotDescription, model: mujoco.MjModel) -> I
     """The mount body, and a holonomic drive: its joints' layout and velocity actuators."""
     wiring = mobile_base_wiring(description)
     assert wiring is not None
-    yield _exists("mobile_base.mount_body", wiring.mount_body, mujoco.mjtObj.mjOBJ_BODY, [model])
+    problem = mount_problem(model, wiring)
+    yield CheckRow("mobile_base.mount_body", wiring.mount_body, problem or "found", ok=not problem)
     layout = "slides x, y then hinge yaw about the vertical, on one child body of the world"
     problems = drive_problems(model, wiring)
     for field, problem in problems:
@@ -235,7 +241,8 @@ def _mobile_base_rows(description: RobotDescription, model: mujoco.MjModel) -> I
 
 def _sensor_rows(description: RobotDescription, models: list[mujoco.MjModel]) -> Iterator[CheckRow]:
     """Cameras, mount bodies and sites, each found in one of ``models`` (the robot's, its
-    base's); a lidar with a mount body gets its site from the scene."""
+    base's); a lidar with a mount body gets its site from the scene, so none may have its
+    name yet."""
     body, camera, site = (
         mujoco.mjtObj.mjOBJ_BODY,
         mujoco.mjtObj.mjOBJ_CAMERA,
@@ -247,8 +254,12 @@ def _sensor_rows(description: RobotDescription, models: list[mujoco.MjModel]) ->
             yield _exists(f"{field}.camera", sensor.camera, camera, models)
         if sensor.mount_body is not None:
             yield _exists(f"{field}.mount_body", sensor.mount_body, body, models)
-        elif isinstance(sensor, LidarSensor):
+        if isinstance(sensor, LidarSensor) and sensor.mount_body is None:
             yield _exists(f"{field}.site", sensor.site, site, models)
+        elif isinstance(sensor, LidarSensor):  # the scene creates it: the name must be free
+            taken = any(mujoco.mj_name2id(m, site, sensor.site) >= 0 for m in models)
+            actual = "a site of that name already" if taken else "no site of that name"
+            yield CheckRow(f"{field}.site", f"{sensor.site}, a new site", actual, ok=not taken)
 
 
 def _exists(field: str, name: str, kind: mujoco.mjtObj, models: list[mujoco.MjModel]) -> CheckRow:
