@@ -220,10 +220,11 @@ def mount_problem(model: mujoco.MjModel, wiring: MobileBaseWiring) -> str | None
     if body < 0:
         return "not in the model"
     yaw = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, wiring.joints[2])
-    root = int(model.body_rootid[model.jnt_bodyid[yaw]]) if yaw >= 0 else -1
-    if body == 0 or int(model.body_rootid[body]) != root:
+    if body == 0 or (
+        yaw >= 0 and model.body_rootid[body] != model.body_rootid[model.jnt_bodyid[yaw]]
+    ):
         return "a body the base does not carry"
-    return None
+    return None  # (a missing yaw joint is its own finding)
 
 
 def _id(model: mujoco.MjModel, kind: mujoco.mjtObj, name: str) -> int:
