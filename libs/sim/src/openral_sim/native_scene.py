@@ -36,7 +36,7 @@ import numpy as np
 import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
 from openral_core.located import error_at
-from openral_core.models import DeployScene, DepthSensor, NativeAssets
+from openral_core.models import DeployScene, NativeAssets
 from openral_core.tables import HalWiring
 from openral_mujoco.errors import HalError
 from openral_mujoco.joint_driver import JointDriver
@@ -45,6 +45,7 @@ from openral_mujoco.state import FloatArray, JointStateSample
 
 from openral_sim.base_drive import BASE_UPDATE_STEPS, BaseDrive
 from openral_sim.depth_cloud import DepthCamera, DepthFrame
+from openral_sim.range_sensors import RangeSensors
 from openral_sim.rollout import Observation, StepResult
 from openral_sim.scene_cameras import camera_sensors
 from openral_sim.scene_checks import physics_steps_per_control
@@ -95,15 +96,13 @@ class NativeScene:
         self.base = None if base is None else BaseDrive(base, self.model, self.data)
         """The mobile base's drive and odometry (None for a robot without a mobile base)."""
         self._root_body = root_body(self.model, description)
-        depth = {s.name: s for s in description.sensors if isinstance(s, DepthSensor)}
-        self._sensors = {name: cam for name, cam in cameras.items() if name not in depth}
         robot_ids = robot_bodies(self.model, description)
-        self.depth_cameras = {
-            name: DepthCamera(self.model, depth[name], cam, robot_ids, self._root_body)
-            for name, cam in cameras.items()
-            if name in depth
-        }
-        """The depth sensors the scene file names, by sensor name (see :meth:`depth_frame`)."""
+        self.range_sensors = RangeSensors(
+            self.model, description, cameras, robot_ids, self._root_body
+        )
+        """Depth cameras and lidars (:class:`~openral_sim.range_sensors.RangeSensors`)."""
+        depth = self.range_sensors.depth
+        self._sensors = {name: cam for name, cam in cameras.items() if name not in depth}
         self._root_qpos = int(self.model.jnt_qposadr[self.model.body_jntadr[self._root_body]])
         self._width = scene.scene.observation.width
         self._height = scene.scene.observation.height
@@ -114,7 +113,6 @@ class NativeScene:
         """Whether ``reset``/``step`` render the cameras into ``obs["images"]``; may be
         changed at any time (the next observation follows it)."""
         self._renderer: mujoco.Renderer | None = None
-        self._depth_renderers: dict[str, mujoco.Renderer] = {}
         self._steps = 0
 
     # -- SimRollout ------------------------------------------------------------------------
@@ -150,29 +148,17 @@ class NativeScene:
         """MJCF name of the robot's root body, the frame depth clouds are given in."""
         return mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._root_body) or ""
 
+    @property
+    def depth_cameras(self) -> dict[str, DepthCamera]:
+        """The depth sensors the scene file names, by sensor name."""
+        return self.range_sensors.depth
+
     def depth_frame(
         self, name: str, data: mujoco.MjData, renderer: mujoco.Renderer | None = None
     ) -> DepthFrame:
-        """Depth image and self-filtered cloud of depth sensor ``name`` as ``data`` places
-        the scene (read only, kinematics current as for :meth:`render_cameras`).
-
-        Args:
-            name: A key of :attr:`depth_cameras`.
-            data: MjData of :attr:`model`.
-            renderer: A renderer of :attr:`model` at the sensor's (height, width), created on
-                the calling thread; None uses the scene's own for this sensor (made on first
-                use, on the thread that first uses it).
-
-        Raises:
-            KeyError: A sensor this scene does not render.
-        """
-        camera = self.depth_cameras[name]
-        if renderer is None:
-            renderer = self._depth_renderers.get(name)
-            if renderer is None:
-                renderer = mujoco.Renderer(self.model, camera.height, camera.width)
-                self._depth_renderers[name] = renderer
-        return camera.frame(renderer, data)
+        """Depth image and cloud of depth sensor ``name`` (see
+        :meth:`openral_sim.range_sensors.RangeSensors.depth_frame`)."""
+        return self.range_sensors.depth_frame(name, data, renderer)
 
     @property
     def image_size(self) -> tuple[int, int]:
@@ -281,9 +267,7 @@ class NativeScene:
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
-        for renderer in self._depth_renderers.values():
-            renderer.close()
-        self._depth_renderers.clear()
+        self.range_sensors.close()
 
     # -- internals -------------------------------------------------------------------------
 
