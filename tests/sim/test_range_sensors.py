@@ -4,6 +4,7 @@ the lidar sits against) is never seen, and a manifest lidar without a site is re
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Iterator
 from pathlib import Path
@@ -11,9 +12,11 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from openral_cli.main import app
 from openral_core import ManifestError, open_robot
 from openral_core.loader import load_scene
 from openral_sim.native_scene import NativeScene
+from typer.testing import CliRunner
 
 from tests.conftest import ROBOTS
 
@@ -108,3 +111,20 @@ def test_a_lidar_whose_site_the_scene_lacks_is_refused_at_its_field(tmp_path: Pa
     scene = load_scene(MOBILE / "scenes" / "room.yaml")
     with pytest.raises(ManifestError, match=r"robot\.yaml:\d+:\d+: sensors\[2\]\.site: .*nowhere"):
         NativeScene(scene, open_robot(folder / "robot.yaml"))
+
+
+def test_sim_run_on_the_room_records_every_stream(tmp_path: Path) -> None:
+    room = MOBILE / "scenes" / "room.yaml"
+    command = ["sim", "run", "--config", str(room), "--steps", "2", "--out", str(tmp_path)]
+    result = CliRunner().invoke(app, command)
+    assert result.exit_code == 0, result.output
+    names = {path.name for path in tmp_path.iterdir()}
+    assert {"wrist_0001.png", "head_depth_0001.depth.png", "head_depth_0001.points.npy"} <= names
+    lines = (tmp_path / "base_lidar.scan.jsonl").read_text().splitlines()
+    assert len(lines) == 2
+    scan = json.loads(lines[1])
+    ranges = np.array([float(r) for r in scan["ranges"]])
+    assert scan["step"] == 1 and scan["time"] > 0 and len(ranges) == 270
+    assert np.isfinite(ranges).all()  # walls all round, within 10 m
+    assert ranges.min() >= 0.05 and ranges.max() <= 10.0
+    assert len(np.load(tmp_path / "head_depth_0001.points.npy")) > 100

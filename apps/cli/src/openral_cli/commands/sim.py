@@ -9,7 +9,9 @@ positions keyed by the manifest's joint names, as ``/joint_states`` names them. 
 also writes every camera's frame (``<sensor>_<step>.png``) and, on a native scene, every
 depth sensor's image (``<sensor>_<step>.depth.png``, 16-bit, millimetres, 0 = no reading)
 and self-filtered cloud (``<sensor>_<step>.points.npy``, N x 3 float32 in the robot's base
-frame, metres).
+frame, metres), and one line per step of every lidar's scan to ``<sensor>.scan.jsonl``:
+``{"step", "time", "angle_min", "angle_increment", "ranges"}`` (radians, metres; REP 117's
+infinities as the strings ``"inf"`` and ``"-inf"``, which ``float()`` reads back).
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ class Recording:
     records: list[dict[str, object]] = field(default_factory=list)
     cameras: list[str] = field(default_factory=list)
     depth: list[str] = field(default_factory=list)
+    lidars: list[str] = field(default_factory=list)
 
 
 @app.command("run")
@@ -95,11 +98,11 @@ def run(
         lines = "".join(json.dumps(record) + "\n" for record in seen.records)
         (out_dir / "joint_states.jsonl").write_text(lines)
     table = Table(title=f"sim run: {config}")
-    for column in ("robot", "backend", "steps", "cameras", "depth", "output"):
+    for column in ("robot", "backend", "steps", "cameras", "depth", "lidars", "output"):
         table.add_column(column)
-    cameras, depth = ", ".join(seen.cameras), ", ".join(seen.depth) or "-"
+    sensors = [", ".join(names) or "-" for names in (seen.cameras, seen.depth, seen.lidars)]
     backend = scene.scene.backend.value
-    table.add_row(loaded.name, backend, str(steps), cameras, depth, str(out_dir or "-"))
+    table.add_row(loaded.name, backend, str(steps), *sensors, str(out_dir or "-"))
     out.print(table, soft_wrap=False)  # centred title, as this command always printed it
 
 
@@ -128,23 +131,37 @@ def _drive(
         if out_dir:
             for camera, image in images.items():
                 write_png(out_dir / f"{camera}_{step:04d}.png", image)
-        seen.depth = _record_depth(hal, out_dir, step)
+        seen.depth, seen.lidars = _record_range(hal, out_dir, step, state.sim_time_s)
         advance()
     return seen
 
 
-def _record_depth(hal: RobotHal, out_dir: Path | None, step: int) -> list[str]:
-    """Render each depth sensor of a native scene; write its image and cloud to ``out_dir``;
-    the sensors' names."""
+def _record_range(
+    hal: RobotHal, out_dir: Path | None, step: int, time: float | None
+) -> tuple[list[str], list[str]]:
+    """Write each depth sensor's image and cloud and each lidar's scan of a native scene to
+    ``out_dir`` (see the module doc); the depth sensors' and the lidars' names."""
     import numpy as np
     from openral_hal.sim_attached import native_scene
     from openral_mujoco.png import encode_depth_png
 
     scene = native_scene(hal)
-    if scene is None or not out_dir:
-        return list(scene.depth_cameras) if scene else []
-    for name in scene.depth_cameras:
-        frame = scene.depth_frame(name, scene.data)
-        (out_dir / f"{name}_{step:04d}.depth.png").write_bytes(encode_depth_png(frame.depth_m))
-        np.save(out_dir / f"{name}_{step:04d}.points.npy", frame.points)
-    return list(scene.depth_cameras)
+    if scene is None:
+        return [], []
+    sensors = scene.range_sensors
+    if out_dir:
+        for name in sensors.depth:
+            frame = sensors.depth_frame(name, scene.data)
+            depth_png = encode_depth_png(frame.depth_m)
+            (out_dir / f"{name}_{step:04d}.depth.png").write_bytes(depth_png)
+            np.save(out_dir / f"{name}_{step:04d}.points.npy", frame.points)
+        for name, scanner in sensors.lidars.items():
+            ranges = [
+                r if math.isfinite(r) else str(r) for r in sensors.scan(name, scene.data).tolist()
+            ]
+            line: dict[str, object] = {"step": step, "time": time}
+            line |= {"angle_min": scanner.angle_min, "angle_increment": scanner.angle_increment}
+            line["ranges"] = ranges
+            with (out_dir / f"{name}.scan.jsonl").open("w" if step == 0 else "a") as scans:
+                scans.write(json.dumps(line) + "\n")
+    return list(sensors.depth), list(sensors.lidars)
