@@ -126,3 +126,4 @@ def test_the_drive_layout_is_read_from_the_compiled_base() -> None:
     assert geometry.friction.tolist() == [250.0, 250.0, 250.0]
     assert geometry.slides.tolist() == [[1.0, 0.0], [0.0, 1.0]] and geometry.yaw_sign == 1.0
     assert geometry.anchor.tolist() == pytest.approx([-0.21, 0.0])
+    assert geometry.root_offset.tolist() == pytest.approx([0.21, 0.0, 0.0])  # body `base`

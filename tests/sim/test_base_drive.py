@@ -84,6 +84,7 @@ def test_driving_forward_at_0_3_m_s_for_2_s_moves_the_base_0_6_m(scene: NativeSc
     assert abs(stopped.y_m) < 1e-3 and abs(stopped.yaw_rad) < 1e-3
     assert abs(stopped.vx_m_s) < 1e-3
     assert (stopped.odom_frame, stopped.base_frame) == ("odom", "base_link")
+    assert _base(scene).root_in_base_frame == pytest.approx((0.21, 0.0, 0.0))
     np.testing.assert_array_equal(scene.hold_action(), hold)  # the arm's targets: untouched
     np.testing.assert_array_equal(scene.driver.setpoint, setpoint)
 

@@ -135,6 +135,9 @@ class DriveGeometry:
     """The hinge's axis (x, y) at qpos0 [m]."""
     heading: float
     """The root body's heading at qpos0 [rad]."""
+    root_offset: FloatArray
+    """The root body's origin in the base frame (x, y, z) [m]: fixed, since both turn with
+    the base (the Omron's body ``base`` is 0.21 m ahead of its yaw axis)."""
 
     def pose(self, qpos: FloatArray) -> tuple[FloatArray, float]:
         """The base frame's world (x, y) [m] and heading [rad] at ``qpos``."""
@@ -179,6 +182,9 @@ def drive_geometry(model: mujoco.MjModel, wiring: MobileBaseWiring) -> DriveGeom
         yaw_sign=1.0 if axes[2, 2] > 0 else -1.0,
         anchor=np.array(data.xanchor[joints[2], :2], dtype=np.float64),
         heading=math.atan2(rotation[1, 0], rotation[0, 0]),
+        root_offset=np.asarray(
+            rotation.T @ (data.xpos[root] - data.xanchor[joints[2]]), np.float64
+        ),
     )
 
 

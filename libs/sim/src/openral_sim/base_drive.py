@@ -142,6 +142,14 @@ class BaseDrive:
         self._origin, self._origin_heading = self.geometry.pose(self._data.qpos)
 
     @property
+    def root_in_base_frame(self) -> tuple[float, float, float]:
+        """Where the base's root body (``NativeScene.base_frame``, the frame depth clouds are
+        given in) sits in the base frame (x, y, z) [m]: a static transform from
+        ``wiring.base_frame`` to it (its axes are the base frame's)."""
+        x, y, z = self.geometry.root_offset.tolist()
+        return x, y, z
+
+    @property
     def command_in_force(self) -> tuple[float, float, float]:
         """The (vx, vy, wz) the drive ramps towards: the last command, zero after the
         timeout or a halt."""
