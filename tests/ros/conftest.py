@@ -7,6 +7,7 @@ import time
 from collections.abc import Iterator
 
 import pytest
+from openral_bridge.pacer import Pacer
 from openral_core.registry import load_robot_by_id
 from openral_nodes.manifest_node import ManifestLifecycleNode
 from openral_nodes.runtime import Spinner, ros_session
@@ -48,3 +49,12 @@ def deployed(ros_context: Context) -> Iterator[Deployed]:
         spinner.stop()
         node.destroy_node()
         probe.node.destroy_node()
+
+
+@pytest.fixture
+def pacer() -> Iterator[Pacer]:
+    """A running pacer, stopped (and joined) after the test."""
+    pacer = Pacer()
+    pacer.start()
+    yield pacer
+    assert pacer.stop()

@@ -1,17 +1,18 @@
 """ControlLoop: one writer steps a simulated HAL once per control period (a fake Tickable
-HAL counts what it was given; the timer is a real rclpy timer)."""
+HAL counts what it was given; the ticks run on a real Pacer thread)."""
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Iterator
 
 import numpy as np
 import pytest
 from openral_bridge.control_loop import ControlLoop
+from openral_bridge.pacer import Pacer
 from openral_hal.errors import SimulationDiverged
 from openral_mujoco.state import FloatArray, JointStateSample
-from openral_nodes.runtime import Spinner
 from rclpy.context import Context
 from rclpy.node import Node
 
@@ -23,13 +24,21 @@ class CountingHal:
 
     control_period_s = 0.02
 
-    def __init__(self) -> None:
+    def __init__(self, lock: threading.Lock | None = None) -> None:
         self.given: list[FloatArray | None] = []
         self.sim_time_s = 0.0
         self.estopped = False
         self.fail_next = False
+        self.lock = lock
+        self.unlocked_calls = 0
+        """Calls made without holding ``lock`` (when one is given)."""
+
+    def _check_lock(self) -> None:
+        if self.lock is not None and not self.lock.locked():
+            self.unlocked_calls += 1
 
     def tick(self, action: object | None) -> bool:
+        self._check_lock()
         if self.fail_next:
             self.fail_next = False
             raise SimulationDiverged("NaN state")
@@ -40,6 +49,7 @@ class CountingHal:
         return True
 
     def read_state(self) -> JointStateSample:
+        self._check_lock()
         zero = np.zeros(1)
         return JointStateSample(("j",), zero, zero, zero, time.monotonic_ns(), self.sim_time_s)
 
@@ -53,7 +63,7 @@ def node(ros_context: Context) -> Iterator[Node]:
 
 def _loop(node: Node, hal: CountingHal, ticked: list[float | None] | None = None) -> ControlLoop:
     on_tick = None if ticked is None else (lambda sim_time: ticked.append(sim_time))
-    return ControlLoop(node, hal, on_tick=on_tick)  # type: ignore[arg-type]
+    return ControlLoop(node, hal, on_tick=on_tick, lock=hal.lock)  # type: ignore[arg-type]
 
 
 def test_the_newest_action_wins_and_the_replaced_ones_are_counted(node: Node) -> None:
@@ -84,23 +94,61 @@ def test_an_estopped_hal_does_not_advance_and_is_not_counted(node: Node) -> None
     loop.offer(np.array([1.0]))
     loop.tick()
     assert (loop.ticks, loop.applied, hal.sim_time_s) == (0, 0, 0.0)
+    assert loop.superseded == 1  # the action that waited for the tick is dropped, counted
 
 
-def test_start_ticks_at_once_then_on_the_timer_and_stop_ends_it(
-    ros_context: Context, node: Node
+def test_each_tick_steps_and_reads_the_hal_holding_the_lock_and_keeps_the_state(
+    node: Node,
 ) -> None:
+    hal = CountingHal(threading.Lock())
+    loop = _loop(node, hal)
+    assert loop.state is None
+    loop.tick()
+    loop.tick()
+    assert hal.unlocked_calls == 0 and len(hal.given) == 2
+    assert loop.state is not None and loop.state.sim_time_s == pytest.approx(0.04)
+    hal.fail_next = True
+    loop.tick()
+    assert loop.state is None  # after a failed tick the HAL is read again
+
+
+def test_offers_from_another_thread_are_each_applied_or_counted(node: Node) -> None:
     hal = CountingHal()
     loop = _loop(node, hal)
-    with Spinner(ros_context) as spinner:
-        spinner.add_node(node)
-        spinner.call(loop.start)
-        assert loop.running
+    offered = 2000
+
+    def offer() -> None:
+        for value in range(offered):
+            loop.offer(np.array([float(value)]))
+
+    sender = threading.Thread(target=offer)
+    sender.start()
+    while sender.is_alive():
+        loop.tick()
+    sender.join()
+    loop.tick()
+    assert loop.applied + loop.superseded == offered
+    applied = [action.tolist() for action in hal.given if action is not None]
+    assert [offered - 1.0] in applied  # the newest is never superseded
+
+
+def test_start_ticks_at_once_then_on_the_pacer_and_stop_ends_it(node: Node) -> None:
+    hal = CountingHal(threading.Lock())
+    loop = _loop(node, hal)
+    pacer = Pacer()
+    loop.start(pacer)
+    assert loop.ticks == 1 and loop.running  # before the pacer runs
+    pacer.start()
+    try:
         wait_until(lambda: loop.ticks >= 10, what="ten ticks of the control loop")
-        spinner.call(loop.stop)
+        loop.stop()
         stopped = loop.ticks
-        time.sleep(0.1)  # five periods: a live timer would have ticked
-    assert loop.ticks == stopped and not loop.running
-    assert len(list(node.timers)) == 0
+        assert pacer.jobs == () and not loop.running
+        time.sleep(0.1)  # five periods: a scheduled tick would have run
+        assert loop.ticks == stopped
+    finally:
+        assert pacer.stop()
+    assert hal.unlocked_calls == 0
 
 
 def test_a_pending_action_dropped_by_stop_is_counted(node: Node) -> None:

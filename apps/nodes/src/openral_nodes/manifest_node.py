@@ -16,7 +16,7 @@ Transitions:
 - activate → connect the HAL; a simulated one gets its control loop
   (:class:`~openral_bridge.control_loop.ControlLoop`), which steps once before anything is
   published and then once per control period, publishing ``/clock`` after each step; then
-  publish ``/joint_states`` and the latched ``/openral/action_spec`` (stamped in simulated
+  publish the latched ``/openral/action_spec`` and ``/joint_states`` (stamped in simulated
   time), subscribe ``/openral/safe_action``, offer the E-stop services and start the
   :class:`~openral_bridge.SimSensorBridge`;
 - deactivate → stop all of that (the HAL stays connected and holds still);
@@ -35,18 +35,24 @@ E-stop is latched, is refused where it arrives with a warning and changes nothin
 simulated robot a valid action waits for the next control tick (a newer one replaces it and
 is counted as superseded); on a real one it goes to the HAL at once. Run it on a
 single-threaded executor only.
+
+Threads: the periodic work (control tick and ``/clock``, ``/joint_states``, camera frame
+requests, the viewer's sync) runs on one :class:`~openral_bridge.pacer.Pacer` thread per
+activation, so the executor wakes only for actions and services. Whatever touches the HAL
+holds :attr:`hal_lock`; deactivate stops and joins that thread before it removes anything.
 """
 
 from __future__ import annotations
 
 import threading
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from openral_bridge import ros_messages
 from openral_bridge.control_loop import ControlLoop
+from openral_bridge.joint_state_publisher import JointStatePublisher, sim_stamp
+from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.sim_sensor_bridge import SimSensorBridge, TopicInfo
 from openral_bridge.topics import (
     ACTION_SPEC,
@@ -56,16 +62,15 @@ from openral_bridge.topics import (
     RELEASE_ESTOP,
     SAFE_ACTION,
 )
-from openral_core import LoadedRobot, open_robot, open_robot_by_id
+from openral_core import LoadedRobot
 from openral_core.errors import OpenralError
-from openral_core.loader import load_scene
 from openral_core.models import DeployScene, RobotDescription
 from openral_hal.errors import EStopLatched, HalError, NotConnected
 from openral_hal.factory import build_hal, can_tick
 from openral_hal.protocol import RobotHal
 from openral_mujoco.action import validated_action
 from openral_sim.rollout import SimRollout
-from openral_sim.scene import build_scene, scene_robot
+from openral_sim.scene import build_scene
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
@@ -74,7 +79,7 @@ from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger
 
 from openral_nodes.lifecycle_guard import guard_change_state
-from openral_nodes.node_parameters import BOUNDS, PARAMETERS, check_rates
+from openral_nodes.node_parameters import BOUNDS, PARAMETERS, check_rates, robot_and_scene
 from openral_nodes.runtime import LATCHED
 
 NODE_NAME = "openral_manifest_node"
@@ -133,6 +138,12 @@ class ManifestLifecycleNode(LifecycleNode):
         self.bridge: SimSensorBridge | None = None
         self.loop: ControlLoop | None = None
         """The control loop of a simulated HAL while active (None for a real one)."""
+        self.pacer: Pacer | None = None
+        """The thread of the periodic work while active."""
+        self.states: JointStatePublisher | None = None
+        """``/joint_states`` while active."""
+        self.hal_lock = threading.Lock()
+        """Held by whatever reads or changes the HAL (see the module doc)."""
         self.log_boot_errors = log_boot_errors
         self.boot_error: str | None = None
         """Why the last configure failed (None after a successful one)."""
@@ -140,7 +151,6 @@ class ManifestLifecycleNode(LifecycleNode):
         """Valid actions taken (handed to the control loop, or to a real HAL)."""
         self.actions_refused = 0
         self._entities: list[tuple[str, Any]] = []
-        self._state_rate_hz = 0.0
         self._shutdown_event = shutdown_event
         guard_change_state(self, WARN_EVERY_S)
 
@@ -151,7 +161,11 @@ class ManifestLifecycleNode(LifecycleNode):
         the reason."""
         try:
             self._check_rates()
-            robot, scene = self._load()
+            robot, scene = robot_and_scene(
+                str(self._param("robot_id")),
+                str(self._param("manifest_path")),
+                str(self._param("sim_env_yaml")),
+            )
             self.hal = build_hal(
                 robot, mode=str(self._param("hal_mode")), scene=scene, env_builder=_on_demand
             )
@@ -181,20 +195,23 @@ class ManifestLifecycleNode(LifecycleNode):
             if self.log_boot_errors:
                 self._log().error(f"activate failed: {text}")
             return Result.FAILURE
-        self._state_rate_hz = float(self._param("joint_state_rate_hz"))
-        self._start_loop(hal)
-        self._create_entities()
+        self.pacer = pacer = Pacer(on_error=self._job_failed)
+        self._start_loop(hal, pacer)
+        self._create_entities(pacer)
         camera_rate = float(self._param("camera_publish_rate_hz"))
         self.bridge = SimSensorBridge(
             self,
             hal,
             hal.description,
+            pacer,
+            lock=self.hal_lock,
             viewer_enabled=bool(self._param("viewer_enabled")),
             camera_rate_hz=camera_rate or None,
         )
         self.bridge.setup()
         if self.loop is not None:  # the pace is judged from here on, not over the start-up
             self.loop.watch.restart()
+        pacer.start()
         super().on_activate(state)
         return Result.SUCCESS
 
@@ -234,8 +251,9 @@ class ManifestLifecycleNode(LifecycleNode):
         """Every topic published now, with its nominal rate (None: latched or on change)."""
         if not self._entities:
             return []
+        rate = self.states.rate_hz if self.states else None
         rows = [
-            TopicInfo(JOINT_STATES, "sensor_msgs/msg/JointState", self._state_rate_hz),
+            TopicInfo(JOINT_STATES, "sensor_msgs/msg/JointState", rate),
             TopicInfo(ACTION_SPEC, "sensor_msgs/msg/JointState", None),
         ]
         if self.loop is not None:
@@ -245,7 +263,8 @@ class ManifestLifecycleNode(LifecycleNode):
     def action_layout(self) -> tuple[tuple[str, ...], list[float]]:
         """Slot names and hold action of the connected HAL (what ``action_spec`` carries)."""
         hal = self._hal()
-        hold: list[float] = np.asarray(hal.hold_action(), dtype=np.float64).tolist()
+        with self.hal_lock:
+            hold: list[float] = np.asarray(hal.hold_action(), dtype=np.float64).tolist()
         return tuple(hal.action_names), hold
 
     # -- internals -------------------------------------------------------------------------
@@ -264,29 +283,6 @@ class ManifestLifecycleNode(LifecycleNode):
             raise NotConnected("the node has no HAL; configure it first")
         return self.hal
 
-    def _load(self) -> tuple[LoadedRobot, DeployScene | None]:
-        """The robot and the scene, each read from its file once (the scene's robot is
-        checked against the robot by ``build_hal``)."""
-        robot_id, manifest = str(self._param("robot_id")), str(self._param("manifest_path"))
-        scene_file = str(self._param("sim_env_yaml"))
-        scene = load_scene(Path(scene_file)) if scene_file else None
-        if manifest:
-            robot = open_robot(Path(manifest))
-            if robot_id and robot_id != robot.name:
-                raise ValueError(
-                    f"parameter robot_id is {robot_id} but manifest_path {manifest} is "
-                    f"{robot.name}; set one of them"
-                )
-            return robot, scene
-        if robot_id:
-            return open_robot_by_id(robot_id), scene
-        if scene is not None and scene.robot_id:
-            return scene_robot(scene), scene
-        raise ValueError(
-            "no robot: set parameter robot_id or manifest_path, or a sim_env_yaml scene "
-            "that names its robot_id"
-        )
-
     def _fail_configure(self, message: str) -> Any:
         self.boot_error = message
         if self.log_boot_errors:
@@ -294,52 +290,44 @@ class ManifestLifecycleNode(LifecycleNode):
         self.description = self.hal = None
         return Result.FAILURE
 
-    def _start_loop(self, hal: RobotHal) -> None:
+    def _start_loop(self, hal: RobotHal, pacer: Pacer) -> None:
         """A simulated HAL's control loop: it steps once now, so every message after this
         carries a simulated time > 0."""
         self._clock_pub = self.create_publisher(Clock, CLOCK, 10)
         self._entities = [("publisher", self._clock_pub)]
         if can_tick(hal):
-            self.loop = ControlLoop(self, hal, on_tick=self._publish_clock)
-            self.loop.start()
+            self.loop = ControlLoop(self, hal, on_tick=self._publish_clock, lock=self.hal_lock)
+            self.loop.start(pacer)
 
-    def _create_entities(self) -> None:
+    def _create_entities(self, pacer: Pacer) -> None:
+        """The latched action spec, ``/joint_states`` (published once now), the action
+        subscription and the E-stop services."""
+        hal = self._hal()
         spec = self.create_publisher(JointState, ACTION_SPEC, LATCHED)
         names, hold = self.action_layout()
         spec_msg = JointState(name=list(names), position=hold)
-        spec_msg.header.stamp = self._stamp(self._hal().read_state().sim_time_s)
+        with self.hal_lock:
+            sim_time_s = hal.read_state().sim_time_s
+        spec_msg.header.stamp = sim_stamp(self, sim_time_s)
         spec.publish(spec_msg)
-        self._joint_pub = self.create_publisher(JointState, JOINT_STATES, 10)
+        rate_hz = float(self._param("joint_state_rate_hz"))
+        latest = (lambda: loop.state) if (loop := self.loop) is not None else None
+        self.states = JointStatePublisher(self, hal, self.hal_lock, rate_hz, latest=latest)
+        self.states.start(pacer)
         self._entities += [
             ("publisher", spec),
-            ("publisher", self._joint_pub),
             (
                 "subscription",
                 self.create_subscription(Float64MultiArray, SAFE_ACTION, self._on_safe_action, 10),
             ),
             ("service", self.create_service(Trigger, ESTOP, self._on_estop)),
             ("service", self.create_service(Trigger, RELEASE_ESTOP, self._on_release_estop)),
-            ("timer", self.create_timer(1.0 / self._state_rate_hz, self._publish_state)),
         ]
-        self._publish_state()
 
-    def _stamp(self, sim_time_s: float | None) -> Any:
-        """Simulated time as a header stamp; the node clock for a HAL without one."""
-        if sim_time_s is None:
-            return self.get_clock().now().to_msg()
-        return ros_messages.stamp(sim_time_s)
-
-    def _publish_state(self) -> None:
-        sample = self._hal().read_state()
-        self._joint_pub.publish(
-            ros_messages.joint_state_msg(
-                sample.names,
-                sample.positions,
-                sample.velocities,
-                sample.efforts,
-                self._stamp(sample.sim_time_s),
-            )
-        )
+    def _job_failed(self, job: PacedJob, error: Exception) -> None:
+        """A periodic job raised (the pacer's thread goes on)."""
+        text = f"{job.name} failed ({type(error).__name__}: {error})"
+        self._log().error(text, throttle_duration_sec=WARN_EVERY_S)
 
     def _publish_clock(self, sim_time: float | None) -> None:
         if sim_time is not None:
@@ -350,7 +338,8 @@ class ManifestLifecycleNode(LifecycleNode):
         try:
             values = validated_action(np.asarray(msg.data, dtype=np.float64), hal.action_names)
             if self.loop is None:
-                hal.send_action(values)
+                with self.hal_lock:
+                    hal.send_action(values)
             elif hal.estopped:
                 raise EStopLatched()
             else:
@@ -362,21 +351,31 @@ class ManifestLifecycleNode(LifecycleNode):
         self.actions_accepted += 1
 
     def _on_estop(self, request: Any, response: Any) -> Any:
-        self._hal().estop()
+        with self.hal_lock:  # a tick in progress ends first; none follows
+            self._hal().estop()
         self._log().warning("E-stop latched: actions are refused and the scene is frozen")
         response.success, response.message = True, "E-stop latched"
         return response
 
     def _on_release_estop(self, request: Any, response: Any) -> Any:
-        self._hal().release_estop()
+        with self.hal_lock:
+            self._hal().release_estop()
         self._log().info("E-stop released")
         response.success, response.message = True, "E-stop released"
         return response
 
     def _stop(self) -> None:
+        """Stop the periodic work (its thread joined first), then remove every entity."""
+        if self.pacer is not None:
+            pacer, self.pacer = self.pacer, None
+            if not pacer.stop():
+                self._log().warning("the periodic work did not stop within its timeout")
         if self.loop is not None:
             self.loop.stop()
             self.loop = None
+        if self.states is not None:
+            self.states.stop()
+            self.states = None
         if self.bridge is not None:
             self.bridge.teardown()
             self.bridge = None
@@ -384,7 +383,6 @@ class ManifestLifecycleNode(LifecycleNode):
             "publisher": self.destroy_publisher,
             "subscription": self.destroy_subscription,
             "service": self.destroy_service,
-            "timer": self.destroy_timer,
         }
         for kind, entity in reversed(self._entities):
             destroy[kind](entity)

@@ -1,9 +1,16 @@
-"""The manifest node's parameters: names, defaults, and the ranges checked at configure."""
+"""The manifest node's parameters: names, defaults, the ranges checked at configure, and
+the robot and scene they name."""
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any
+
+from openral_core import LoadedRobot, open_robot, open_robot_by_id
+from openral_core.loader import load_scene
+from openral_core.models import DeployScene
+from openral_sim.scene import scene_robot
 
 PARAMETERS: dict[str, Any] = {
     "robot_id": "",
@@ -43,3 +50,33 @@ def check_rates(values: dict[str, Any]) -> None:
             raise ValueError(
                 f"parameter {name} must be within {low:g}-{high:g} {unit}{unset}, got {number:g}"
             )
+
+
+def robot_and_scene(
+    robot_id: str, manifest_path: str, sim_env_yaml: str
+) -> tuple[LoadedRobot, DeployScene | None]:
+    """The robot and the scene the parameters name, each read from its file once (the
+    scene's robot is checked against the robot by ``build_hal``): ``manifest_path`` as it
+    reads, else ``robot_id`` from ``robots/``, else the robot the scene names.
+
+    Raises:
+        ValueError: ``robot_id`` and ``manifest_path`` disagree, or nothing names a robot.
+        OpenralError: A file that does not load.
+    """
+    scene = load_scene(Path(sim_env_yaml)) if sim_env_yaml else None
+    if manifest_path:
+        robot = open_robot(Path(manifest_path))
+        if robot_id and robot_id != robot.name:
+            raise ValueError(
+                f"parameter robot_id is {robot_id} but manifest_path {manifest_path} is "
+                f"{robot.name}; set one of them"
+            )
+        return robot, scene
+    if robot_id:
+        return open_robot_by_id(robot_id), scene
+    if scene is not None and scene.robot_id:
+        return scene_robot(scene), scene
+    raise ValueError(
+        "no robot: set parameter robot_id or manifest_path, or a sim_env_yaml scene "
+        "that names its robot_id"
+    )

@@ -1,12 +1,13 @@
 """The control loop of a simulated robot under ``deploy sim``: one writer steps the scene.
 
 A real arm's controller runs at its own rate whatever its clients do; this loop gives a
-simulated one the same behaviour. A wall-clock timer on the node fires once per control
-period (:attr:`Tickable.control_period_s`, the scene's ``control_freq_hz``) and each tick
-advances the scene by exactly one period:
+simulated one the same behaviour. A job on the node's :class:`~openral_bridge.pacer.Pacer`
+(its thread for periodic work) runs once per control period (:attr:`Tickable.control_period_s`,
+the scene's ``control_freq_hz``) and each tick advances the scene by exactly one period:
 
-- with the newest action that arrived since the last tick (:meth:`ControlLoop.offer`); an
-  action replaced by a newer one before a tick is counted in :attr:`superseded`, never
+- with the newest action that arrived since the last tick (:meth:`ControlLoop.offer`, from
+  any thread); an action replaced by a newer one before a tick, or dropped (by :meth:`stop`,
+  or because the E-stop latched before the tick), is counted in :attr:`superseded`, never
   applied and never silently lost;
 - with no new action, holding what is commanded (:meth:`Tickable.tick` with None: the targets
   in force on a position-controlled scene, the backend's hold on a delta controller).
@@ -17,21 +18,26 @@ freezes too). A tick that is late is not made up: the loop never runs faster tha
 time, and when the machine cannot keep up it says so once per slow spell with the measured
 real-time factor (:class:`~openral_bridge.real_time.RealTimeWatch`).
 
+Threads: a tick steps the HAL while holding ``lock``, the lock every other user of the HAL
+takes (the node's E-stop services, the joint-state and camera jobs), so nothing reads or
+changes the scene in the middle of a step. :meth:`offer` takes a lock of its own and never
+waits for a tick.
+
 This replaces the design record's idle stepper, which stepped only while nobody commanded
-the scene and at the camera rate (so simulated time ran at the camera rate's pace). The
-loop runs on the node's single-threaded executor, so it never runs at the same time as the
-node's other callbacks.
+the scene and at the camera rate (so simulated time ran at the camera rate's pace).
 """
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from openral_hal.protocol import Tickable
-from openral_mujoco.state import FloatArray
+from openral_mujoco.state import FloatArray, JointStateSample
 
+from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.real_time import RealTimeWatch
 
 if TYPE_CHECKING:
@@ -42,77 +48,103 @@ WARN_EVERY_S = 2.0
 
 
 class ControlLoop:
-    """Steps one :class:`Tickable` HAL once per control period on a node's timer."""
+    """Steps one :class:`Tickable` HAL once per control period on a :class:`Pacer`."""
 
     def __init__(
-        self, node: Node, hal: Tickable, on_tick: Callable[[float | None], None] | None = None
+        self,
+        node: Node,
+        hal: Tickable,
+        on_tick: Callable[[float | None], None] | None = None,
+        *,
+        lock: threading.Lock | None = None,
     ) -> None:
         """Nothing runs until :meth:`start`.
 
         Args:
-            node: The node that owns the timer (and whose logger reports).
+            node: The node whose logger reports.
             hal: A connected simulated HAL.
             on_tick: Called after every tick that advanced the scene with its simulated
-                time [s] (None for a HAL without one), e.g. to publish ``/clock``.
+                time [s] (None for a HAL without one), e.g. to publish ``/clock``; the HAL
+                lock is not held.
+            lock: The HAL's lock, held while a tick steps and reads it (default: a lock of
+                the loop's own).
         """
         self.node = node
         self.hal = hal
         self.on_tick = on_tick
+        self.lock = lock if lock is not None else threading.Lock()
         self.period_s = float(hal.control_period_s)
         self.ticks = 0
         """Ticks that advanced the scene."""
         self.applied = 0
         """Actions applied by a tick."""
         self.superseded = 0
-        """Actions replaced by a newer one before any tick applied them."""
+        """Actions replaced by a newer one, or dropped, before any tick applied them."""
         self.failed = 0
         """Ticks that raised (a diverged simulation, a refused action)."""
         self.watch = RealTimeWatch()
+        self.state: JointStateSample | None = None
+        """The HAL's state read right after the last tick that stepped (holding the lock;
+        the scene does not change between ticks); None before one, or after a failed tick."""
         self._pending: FloatArray | None = None
-        self._timer: Any = None
+        self._pending_lock = threading.Lock()
+        self._job: tuple[Pacer, PacedJob] | None = None
 
     @property
     def running(self) -> bool:
         """True between :meth:`start` and :meth:`stop`."""
-        return self._timer is not None
+        return self._job is not None
 
-    def start(self) -> None:
+    def start(self, pacer: Pacer) -> None:
         """Tick once now (so simulated time has advanced before anything is published),
-        then once per control period."""
+        then once per control period on ``pacer``."""
         self.stop()
         self.watch.restart()
         self.tick()
-        self._timer = self.node.create_timer(self.period_s, self.tick)
+        self._job = (pacer, pacer.every(self.period_s, self.tick, "control"))
 
     def stop(self) -> None:
-        """Destroy the timer (idempotent); a pending action is dropped and counted."""
-        if self._timer is not None:
-            self.node.destroy_timer(self._timer)
-            self._timer = None
-        if self._pending is not None:
-            self.superseded += 1
-            self._pending = None
+        """Unschedule the tick (idempotent; returns once a tick in progress has ended); a
+        pending action is dropped and counted."""
+        if self._job is not None:
+            pacer, job = self._job
+            self._job = None
+            pacer.cancel(job)
+        with self._pending_lock:
+            if self._pending is not None:
+                self.superseded += 1
+                self._pending = None
 
     def offer(self, action: FloatArray) -> None:
-        """Make ``action`` (already validated) the one the next tick applies."""
-        if self._pending is not None:
-            self.superseded += 1
-        self._pending = action
+        """Make ``action`` (already validated) the one the next tick applies (any thread)."""
+        with self._pending_lock:
+            if self._pending is not None:
+                self.superseded += 1
+            self._pending = action
 
     def tick(self) -> None:
-        """Advance the scene one control period (see the module doc); never raises."""
-        action, self._pending = self._pending, None
+        """Advance the scene one control period (see the module doc); a HAL error is
+        counted and logged, never raised (``on_tick``'s own errors are)."""
+        with self._pending_lock:
+            action, self._pending = self._pending, None
         try:
-            stepped = self.hal.tick(action)
+            with self.lock:
+                stepped = self.hal.tick(action)
+                state = self.hal.read_state() if stepped else self.state
+                self.state = state
         except Exception as error:  # a diverged scene, or a bug: never the end of the graph
+            self.state = None
             self._failed(error)
             return
-        if not stepped:  # E-stopped: time is frozen on purpose
+        if not stepped:  # E-stopped: time is frozen on purpose, the action is dropped
             self.watch.restart()
+            if action is not None:
+                with self._pending_lock:
+                    self.superseded += 1
             return
         self.ticks += 1
         self.applied += int(action is not None)
-        sim_time = self.hal.read_state().sim_time_s
+        sim_time = state.sim_time_s if state is not None else None
         if self.on_tick is not None:
             self.on_tick(sim_time)
         if sim_time is not None:

@@ -1,12 +1,12 @@
 """FrameRenderer: camera frames of a live MuJoCo scene, rendered off the control path.
 
-The control loop steps the live ``MjData`` on the node's executor thread; a camera frame
+The control loop steps the live ``MjData`` on the node's pacer thread; a camera frame
 takes milliseconds to tens of milliseconds to render (llvmpipe, software EGL), so a frame
 is never rendered there. When a camera is due, :meth:`FrameRenderer.request` (called on the
-executor thread, between two control ticks, so the state is consistent) copies the live
-data into that camera's own preallocated ``MjData`` with ``mj_copyData`` and returns
-(Panda tabletop: 6 µs in a hot loop, 30-55 µs median at a 20 Hz control pace with cold
-caches). One render thread owns the ``mujoco.Renderer`` (created on that thread: an EGL
+pacer thread holding the HAL's lock, between two control ticks, so the state is consistent)
+copies the live data into that camera's own preallocated ``MjData`` with ``mj_copyData``
+and returns (Panda tabletop: 6 µs in a hot loop, 30-55 µs median at a 20 Hz control pace
+with cold caches). One render thread owns the ``mujoco.Renderer`` (created on that thread: an EGL
 context is current on one thread only); it renders the copy and hands the frame and the
 copy's ``data.time`` to the publish callback. The render thread never reads the live data.
 
@@ -45,7 +45,8 @@ import numpy.typing as npt
 
 ImageArray = npt.NDArray[np.uint8]
 RenderFn = Callable[[mujoco.Renderer, mujoco.MjData, str], ImageArray]
-"""Render one sensor's frame of the snapshot data with the render thread's renderer."""
+"""Render one sensor's frame of the snapshot data with the render thread's renderer (the
+frame may live in a buffer the next render of that sensor reuses: it is published first)."""
 PublishFn = Callable[[str, ImageArray, float], None]
 """Publish one sensor's frame with the snapshot's simulated time [s] (render thread)."""
 
@@ -104,7 +105,7 @@ class FrameRenderer:
         self.error: BaseException | None = None
         """What stopped the render thread (the renderer or a publish failed), else None."""
 
-    # -- executor thread -------------------------------------------------------------------
+    # -- caller's thread --------------------------------------------------------------------
 
     @property
     def sensors(self) -> tuple[str, ...]:
@@ -133,7 +134,7 @@ class FrameRenderer:
     def request(self, sensor: str) -> bool:
         """Snapshot the live data for one frame of ``sensor`` and hand it to the thread.
 
-        Call it where nothing steps the live data (the executor thread, between ticks).
+        Call it where nothing steps the live data (holding the HAL's lock, between ticks).
 
         Returns:
             True when a frame was queued; False when the previous frame of ``sensor`` is

@@ -6,17 +6,18 @@ can do:
 - each manifest RGB sensor the scene renders → ``sensor_msgs/Image`` (rgb8) on
   ``/openral/cameras/<name>/image`` and ``sensor_msgs/CameraInfo`` on
   ``/openral/cameras/<name>/camera_info``, frame id from the manifest, at the sensor's own
-  ``rate_hz`` (one timer per sensor), or at ``camera_rate_hz`` for every sensor when given;
-- the MuJoCo passive viewer when enabled and a display exists.
+  ``rate_hz`` (one job per sensor on the node's :class:`~openral_bridge.pacer.Pacer`), or
+  at ``camera_rate_hz`` for every sensor when given;
+- the MuJoCo passive viewer when enabled and a display exists (synced by a pacer job).
 
 A native scene renders a camera only when its frame is due, off the control path: the
-sensor's timer (on the node's single-threaded executor, so never during a control tick)
-snapshots the live state and a :class:`~openral_bridge.frame_renderer.FrameRenderer`
+sensor's job (on the pacer's thread, holding the HAL's lock, so never during a control
+tick) snapshots the live state and a :class:`~openral_bridge.frame_renderer.FrameRenderer`
 thread renders and publishes it; a camera still busy with its previous frame is skipped and
 counted (:attr:`SimSensorBridge.frames_skipped`). While the bridge serves its cameras the
 scene's ``reset``/``step`` render nothing. A backend without MuJoCo handles, or one that
 renders inside its own step (robosuite), publishes the last observation's frames
-(``read_images()``) instead, on the executor thread.
+(``read_images()``) instead, on the pacer's thread.
 
 Header stamps are simulation time (MuJoCo ``data.time``; the node publishes ``/clock``):
 a rendered frame carries its snapshot's time, so the stamp says which physics state it
@@ -41,7 +42,9 @@ from openral_mujoco.display import has_display
 from openral_sim.native_scene import NativeScene
 
 from openral_bridge import ros_messages
+from openral_bridge.camera_messages import CameraMessages
 from openral_bridge.frame_renderer import FrameRenderer
+from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.topics import camera_image, camera_info
 
 if TYPE_CHECKING:
@@ -62,14 +65,14 @@ class TopicInfo:
 
 @dataclass
 class _Camera:
-    """One published RGB sensor: its manifest entry, rate [Hz], fovy [deg], publishers."""
+    """One published RGB sensor: its manifest entry, rate [Hz], messages, publishers."""
 
     sensor: RgbSensor
     rate_hz: float
-    fovy_deg: float | None
+    messages: CameraMessages
     image_pub: Any
     info_pub: Any | None
-    timer: Any = None
+    job: PacedJob | None = None
     published: int = 0
 
 
@@ -81,7 +84,9 @@ class SimSensorBridge:
         node: Node,
         hal: RobotHal,
         description: RobotDescription,
+        pacer: Pacer,
         *,
+        lock: threading.Lock | None = None,
         viewer_enabled: bool = True,
         camera_rate_hz: float | None = None,
         viewer_sync_rate_hz: float = 30.0,
@@ -89,10 +94,13 @@ class SimSensorBridge:
         """Nothing is created until :meth:`setup`.
 
         Args:
-            node: The rclpy node that owns the publishers and timers.
+            node: The rclpy node that owns the publishers.
             hal: A connected HAL; images need :class:`CameraHal`, the viewer
                 :class:`MujocoBacked`.
             description: The robot's manifest (sensors, rates, frame ids).
+            pacer: Runs the cameras' and the viewer's periodic jobs.
+            lock: The HAL's lock, held while a job reads the HAL or the live scene
+                (default: a lock of the bridge's own).
             viewer_enabled: Open the MuJoCo passive viewer when a display exists.
             camera_rate_hz: Publish rate of every camera [Hz]; None: each sensor's
                 ``rate_hz``.
@@ -108,6 +116,8 @@ class SimSensorBridge:
         self.node = node
         self.hal = hal
         self.description = description
+        self.pacer = pacer
+        self.lock = lock if lock is not None else threading.Lock()
         self.viewer_enabled = viewer_enabled
         self.camera_rate_hz = camera_rate_hz
         self.viewer_sync_rate_hz = viewer_sync_rate_hz
@@ -118,7 +128,7 @@ class SimSensorBridge:
         self._scene_rendered_observations = True
         self._frames: FrameRenderer | None = None
         self._viewer: Any = None
-        self._viewer_timer: Any = None
+        self._viewer_job: PacedJob | None = None
 
     # -- lifecycle -------------------------------------------------------------------------
 
@@ -148,16 +158,17 @@ class SimSensorBridge:
         return sum(self._frames.skipped.values()) if self._frames else 0
 
     def setup(self) -> None:
-        """Create the publishers and timers the manifest and HAL allow, and publish once."""
+        """Create the publishers and pacer jobs the manifest and HAL allow, and publish
+        once."""
         self.teardown()
         self._setup_cameras()
         self._setup_viewer()
         self._report_unrendered()
 
     def teardown(self) -> None:
-        """Stop the render thread, destroy every timer and publisher and close the viewer
-        (idempotent)."""
-        self._stop_camera_timers()
+        """Cancel every job, stop the render thread, destroy every publisher and close the
+        viewer (idempotent; call it without holding the HAL's lock)."""
+        self._stop_camera_jobs()
         if self._frames is not None:
             frames, self._frames = self._frames, None
             if not frames.stop():
@@ -171,9 +182,9 @@ class SimSensorBridge:
                     self.node.destroy_publisher(publisher)
         self._cameras.clear()
         self._camera_hal = None
-        if self._viewer_timer is not None:
-            self.node.destroy_timer(self._viewer_timer)
-            self._viewer_timer = None
+        if self._viewer_job is not None:
+            self.pacer.cancel(self._viewer_job)
+            self._viewer_job = None
         if self._viewer is not None:
             viewer, self._viewer = self._viewer, None
             viewer.close()
@@ -205,7 +216,8 @@ class SimSensorBridge:
         if scene is not None:
             self._start_renderer(scene)
         for name, camera in self._cameras.items():
-            camera.timer = self.node.create_timer(1.0 / camera.rate_hz, partial(self._due, name))
+            period = 1.0 / camera.rate_hz
+            camera.job = self.pacer.every(period, partial(self._due, name), f"camera {name}")
         for name in self._cameras:
             self._due(name)
 
@@ -219,7 +231,8 @@ class SimSensorBridge:
             topic = camera_info(sensor.name)
             info = self.node.create_publisher(CameraInfo, topic, IMAGE_QUEUE_DEPTH)
         rate = self.camera_rate_hz if self.camera_rate_hz is not None else sensor.rate_hz
-        self._cameras[sensor.name] = _Camera(sensor, float(rate), fovy, image, info)
+        messages = CameraMessages(sensor.frame_id, fovy)
+        self._cameras[sensor.name] = _Camera(sensor, float(rate), messages, image, info)
 
     def _native_scene(self) -> NativeScene | None:
         """The native scene behind the HAL (it renders on demand), else None."""
@@ -230,12 +243,17 @@ class SimSensorBridge:
 
     def _start_renderer(self, scene: NativeScene) -> None:
         """Render this scene's cameras on a thread of their own; the scene stops rendering
-        into its observations until :meth:`teardown`."""
+        into its observations until :meth:`teardown`. A frame is drawn straight into its
+        camera's reused ``Image`` (what :meth:`NativeScene.render_cameras` draws, without its
+        copy)."""
+        cameras, (height, width) = scene.camera_models, scene.image_size
+        messages = {name: camera.messages for name, camera in self._cameras.items()}
 
         def render(
             renderer: mujoco.Renderer, data: mujoco.MjData, sensor: str
         ) -> npt.NDArray[np.uint8]:
-            return scene.render_cameras(data, (sensor,), renderer)[sensor]
+            renderer.update_scene(data, camera=cameras[sensor])
+            return renderer.render(out=messages[sensor].pixels(height, width))
 
         model, live = scene.mujoco_handles()
         self._frames = FrameRenderer(
@@ -247,32 +265,34 @@ class SimSensorBridge:
         scene.render_observations = False
 
     def _due(self, name: str) -> None:
-        """A camera's timer: request a rendered frame, or publish the last observed one."""
+        """A camera's job: request a rendered frame, or publish the last observed one."""
         frames = self._frames
         if frames is not None:
             if frames.error is not None:
                 self._camera_failed(frames.error)
             else:
-                frames.request(name)
+                with self.lock:
+                    frames.request(name)
             return
-        if self._camera_hal is None:
+        camera_hal = self._camera_hal
+        if camera_hal is None:
             return
-        image = self._camera_hal.read_images().get(name)
+        with self.lock:
+            image = camera_hal.read_images().get(name)
+            sim_time_s = self._sim_time_s() if image is not None else 0.0
         if image is not None:
-            self._publish(name, image, self._sim_time_s())
+            self._publish(name, image, sim_time_s)
 
     def _publish(self, name: str, image: npt.NDArray[np.uint8], sim_time_s: float) -> None:
-        """Publish one frame and its camera info (executor or render thread)."""
+        """Publish one frame and its camera info (pacer or render thread)."""
         camera = self._cameras.get(name)
         if camera is None:
             return
-        stamp = ros_messages.stamp(sim_time_s)
-        frame_id = camera.sensor.frame_id
-        camera.image_pub.publish(ros_messages.image_msg(image, stamp, frame_id))
-        if camera.info_pub is not None and camera.fovy_deg is not None:
-            height, width = image.shape[:2]
-            info = ros_messages.camera_info_msg(width, height, camera.fovy_deg, stamp, frame_id)
-            camera.info_pub.publish(info)
+        camera.messages.fill(image)
+        image_msg, info_msg = camera.messages.stamped(ros_messages.stamp(sim_time_s))
+        camera.image_pub.publish(image_msg)
+        if camera.info_pub is not None and info_msg is not None:
+            camera.info_pub.publish(info_msg)
         with self._count_lock:
             camera.published += 1
 
@@ -283,17 +303,17 @@ class SimSensorBridge:
             f"camera rendering stopped ({type(error).__name__}: {error}); "
             "the robot keeps running without camera images"
         )
-        self._stop_camera_timers()
+        self._stop_camera_jobs()
         self._camera_hal = None
         if self._frames is not None:
             frames, self._frames = self._frames, None
             frames.stop()
 
-    def _stop_camera_timers(self) -> None:
+    def _stop_camera_jobs(self) -> None:
         for camera in self._cameras.values():
-            if camera.timer is not None:
-                self.node.destroy_timer(camera.timer)
-                camera.timer = None
+            if camera.job is not None:
+                self.pacer.cancel(camera.job)
+                camera.job = None
 
     def _sim_time_s(self) -> float:
         sim_time = self.hal.read_state().sim_time_s
@@ -337,20 +357,21 @@ class SimSensorBridge:
         except Exception as error:  # a broken GL stack must not stop the robot
             log.warning(f"viewer unavailable ({type(error).__name__}: {error}); running headless")
             return
-        self._viewer_timer = self.node.create_timer(
-            1.0 / self.viewer_sync_rate_hz, self._sync_viewer
-        )
+        period = 1.0 / self.viewer_sync_rate_hz
+        self._viewer_job = self.pacer.every(period, self._sync_viewer, "viewer")
 
     def _sync_viewer(self) -> None:
         viewer = self._viewer
         if viewer is None:
             return
         if viewer.is_running():
-            viewer.sync()
+            with self.lock:
+                viewer.sync()
             return
         self._log().info("viewer closed; the node keeps running")
-        self.node.destroy_timer(self._viewer_timer)
-        self._viewer_timer = self._viewer = None
+        if self._viewer_job is not None:
+            self.pacer.cancel(self._viewer_job)
+        self._viewer_job = self._viewer = None
         viewer.close()
 
     def _log(self) -> Any:

@@ -1,0 +1,171 @@
+"""Pacer: periodic jobs on one thread by a deadline schedule (real thread, real clock; a
+late job is simulated by moving the pacer's clock, never by a sleep)."""
+
+from __future__ import annotations
+
+import itertools
+import threading
+import time
+from collections.abc import Callable, Iterator
+
+import pytest
+from openral_bridge.pacer import PacedJob, Pacer
+
+WAIT_S = 15.0
+
+
+def wait_until(predicate: Callable[[], bool], what: str) -> None:
+    deadline = time.monotonic() + WAIT_S
+    while not predicate():
+        if time.monotonic() > deadline:
+            pytest.fail(f"timed out after {WAIT_S} s waiting for {what}")
+        time.sleep(0.005)
+
+
+@pytest.fixture
+def pacers() -> Iterator[list[Pacer]]:
+    """Pacers a test made; each is stopped (and must have ended) afterwards."""
+    made: list[Pacer] = []
+    yield made
+    for pacer in made:
+        assert pacer.stop()
+
+
+def test_jobs_due_together_run_in_one_wake_in_the_order_they_were_added(
+    pacers: list[Pacer],
+) -> None:
+    calls: list[tuple[str, int]] = []
+    wakes = [0]
+    pacer = Pacer()
+    pacers.append(pacer)
+
+    def count_wake() -> None:
+        wakes[0] += 1
+
+    # added first, on the finest grid: it runs first in every wake and numbers it
+    pacer.every(0.01, count_wake, "wake")
+    pacer.every(0.01, lambda: calls.append(("fast", wakes[0])), "fast")
+    pacer.every(0.02, lambda: calls.append(("slow", wakes[0])), "slow")
+    pacer.start()
+    wait_until(lambda: sum(name == "slow" for name, _ in calls) >= 10, "ten slow calls")
+    assert pacer.stop()
+    for index, (name, wake) in enumerate(calls):
+        if name == "slow":  # always right after the fast job of the same wake
+            assert index > 0 and calls[index - 1] == ("fast", wake)
+
+
+def test_first_call_is_one_period_after_start_and_none_after_stop(pacers: list[Pacer]) -> None:
+    called = threading.Event()
+    times: list[float] = []
+    pacer = Pacer()
+    pacers.append(pacer)
+    pacer.every(0.05, lambda: (times.append(time.monotonic()), called.set()), "job")
+    started = time.monotonic()
+    pacer.start()
+    assert called.wait(WAIT_S)
+    assert times[0] - started >= 0.05 - 0.002  # never early (within the merge window)
+    assert pacer.stop() and not pacer.running
+    count = len(times)
+    time.sleep(0.15)  # three periods: a live job would have run
+    assert len(times) == count
+
+
+def test_a_late_job_skips_the_grid_times_it_missed_and_counts_them(pacers: list[Pacer]) -> None:
+    offset = [0.0]
+    period = 0.02
+    job_runs: list[float] = []
+
+    def clock() -> float:
+        return time.monotonic() + offset[0]
+
+    def job() -> None:
+        job_runs.append(clock())
+        if len(job_runs) == 3:  # this call "took" 2.5 periods
+            offset[0] += 2.5 * period
+
+    pacer = Pacer(clock=clock)
+    pacers.append(pacer)
+    paced = pacer.every(period, job, "job")
+    pacer.start()
+    wait_until(lambda: len(job_runs) >= 6, "six calls")
+    assert pacer.stop()
+    assert paced.skipped >= 2  # counted, and not made up: no burst after the late call
+    gaps = [b - a for a, b in itertools.pairwise(job_runs)]
+    assert all(gap >= period - 0.002 for gap in gaps), gaps
+
+
+def test_a_raising_job_is_reported_and_keeps_its_schedule(pacers: list[Pacer]) -> None:
+    errors: list[tuple[str, str]] = []
+    runs = [0]
+
+    def broken() -> None:
+        runs[0] += 1
+        raise RuntimeError("boom")
+
+    def broken_reporter(job: PacedJob, error: Exception) -> None:
+        errors.append((job.name, str(error)))
+        raise ValueError("the reporter fails too")
+
+    pacer = Pacer(on_error=broken_reporter)
+    pacers.append(pacer)
+    pacer.every(0.01, broken, "broken")
+    pacer.start()
+    wait_until(lambda: runs[0] >= 3, "three calls")
+    assert pacer.running
+    assert errors[0] == ("broken", "boom")
+
+
+def test_cancel_waits_for_a_call_in_progress_and_stops_the_job(pacers: list[Pacer]) -> None:
+    inside, release = threading.Event(), threading.Event()
+    runs = [0]
+
+    def slow() -> None:
+        runs[0] += 1
+        inside.set()
+        assert release.wait(WAIT_S)
+
+    pacer = Pacer()
+    pacers.append(pacer)
+    job = pacer.every(0.01, slow, "slow")
+    pacer.start()
+    assert inside.wait(WAIT_S)
+    cancelled = threading.Event()
+    canceller = threading.Thread(target=lambda: (pacer.cancel(job), cancelled.set()))
+    canceller.start()
+    assert not cancelled.wait(0.05)  # the call in progress holds it
+    release.set()
+    assert cancelled.wait(WAIT_S)
+    canceller.join()
+    count = runs[0]
+    time.sleep(0.05)
+    assert runs[0] == count and pacer.jobs == ()
+
+
+def test_a_job_can_cancel_itself_and_jobs_can_be_added_while_running(
+    pacers: list[Pacer],
+) -> None:
+    pacer = Pacer()
+    pacers.append(pacer)
+    runs: dict[str, int] = {"once": 0, "late": 0}
+    jobs: dict[str, PacedJob] = {}
+
+    def once() -> None:
+        runs["once"] += 1
+        pacer.cancel(jobs["once"])
+
+    jobs["once"] = pacer.every(0.01, once, "once")
+    pacer.start()
+    jobs["late"] = pacer.every(0.01, lambda: runs.__setitem__("late", runs["late"] + 1), "late")
+    wait_until(lambda: runs["late"] >= 5, "calls of a job added while running")
+    assert runs["once"] == 1 and pacer.jobs == (jobs["late"],)
+
+
+@pytest.mark.parametrize("period", [0.0, -1.0, float("inf"), float("nan")])
+def test_a_period_that_is_not_positive_and_finite_is_refused(period: float) -> None:
+    with pytest.raises(ValueError, match="must be > 0 s"):
+        Pacer().every(period, lambda: None, "bad")
+
+
+def test_stop_without_start_and_twice_is_fine() -> None:
+    pacer = Pacer()
+    assert pacer.stop() and pacer.stop()
