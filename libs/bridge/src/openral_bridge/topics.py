@@ -17,6 +17,12 @@ ESTOP = "/openral/estop"
 """std_srvs/Trigger: latch the E-stop."""
 RELEASE_ESTOP = "/openral/release_estop"
 """std_srvs/Trigger: release the E-stop."""
+CMD_VEL = "/cmd_vel"
+"""geometry_msgs/Twist: the mobile base's velocity command, base frame."""
+ODOM = "/odom"
+"""nav_msgs/Odometry: the mobile base's pose (odometry frame) and twist (base frame)."""
+SCAN = "/scan"
+"""sensor_msgs/LaserScan of a robot's only lidar (with more: ``/scan/<sensor>``)."""
 
 
 def camera_image(sensor: str) -> str:
@@ -25,5 +31,20 @@ def camera_image(sensor: str) -> str:
 
 
 def camera_info(sensor: str) -> str:
-    """sensor_msgs/CameraInfo of one manifest RGB sensor."""
+    """sensor_msgs/CameraInfo of one manifest RGB or depth sensor."""
     return f"/openral/cameras/{sensor}/camera_info"
+
+
+def scan(sensor: str, only: bool) -> str:
+    """sensor_msgs/LaserScan of one lidar: :data:`SCAN` when it is the robot's only one."""
+    return SCAN if only else f"{SCAN}/{sensor}"
+
+
+def depth_image(sensor: str) -> str:
+    """sensor_msgs/Image (32FC1, metres) of one manifest depth sensor."""
+    return f"/openral/cameras/{sensor}/depth"
+
+
+def depth_points(sensor: str) -> str:
+    """sensor_msgs/PointCloud2 of one depth sensor, in the robot's base frame."""
+    return f"/openral/cameras/{sensor}/points"

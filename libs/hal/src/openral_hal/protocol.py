@@ -7,7 +7,9 @@ spec's slots, and latches an E-stop. Capabilities are separate Protocols, checke
 * :class:`CameraHal` renders the manifest's RGB sensors;
 * :class:`Tickable` is advanced by a control loop, one control period per tick (simulated
   HALs only; a real HAL never is);
-* :class:`MujocoBacked` exposes the live MuJoCo model and data.
+* :class:`MujocoBacked` exposes the live MuJoCo model and data;
+* :class:`MobileBaseHal` drives a mobile base with velocity commands and reports its
+  odometry (when its ``base`` is not None).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import numpy as np
 import numpy.typing as npt
 from openral_core.models import RobotDescription
 from openral_mujoco.state import FloatArray, JointStateSample
+from openral_sim.base_drive import BaseCommand, BaseDrive, BaseOdometry
 
 from openral_hal.errors import EStopLatched
 
@@ -126,6 +129,28 @@ class MujocoBacked(Protocol):
 
     def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
         """The live (model, data), or None when the backend is not MuJoCo."""
+        ...
+
+
+@runtime_checkable
+class MobileBaseHal(RobotHal, Protocol):
+    """A HAL that may carry a mobile base (``base`` None: this robot has none)."""
+
+    @property
+    def base(self) -> BaseDrive | None:
+        """The base's drive, or None."""
+        ...
+
+    def command_base(self, vx_m_s: float, vy_m_s: float, wz_rad_s: float) -> BaseCommand:
+        """Drive at this base-frame velocity [m/s, m/s, rad/s] (clamped to the limits).
+
+        Raises:
+            EStopLatched: The E-stop is latched. ActionRejected: A non-finite value.
+        """
+        ...
+
+    def base_odometry(self) -> BaseOdometry:
+        """The base's pose in the odometry frame and twist in the base frame now."""
         ...
 
 
