@@ -72,8 +72,8 @@ class Rig:
     def close(self) -> None:
         assert self.pacer.stop()
         self.spinner.call(self.bridge.stop)
-        self.node.destroy_node()
-        self.client.destroy_node()
+        self.node.destroy_node()  # type: ignore[no-untyped-call]
+        self.client.destroy_node()  # type: ignore[no-untyped-call]
 
 
 @pytest.fixture
