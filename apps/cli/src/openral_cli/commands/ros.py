@@ -5,6 +5,7 @@ Examples::
     openral ros topics --rate
     openral ros echo /joint_states --once
     openral ros snapshot /openral/cameras/agentview/image --out agentview.png
+    openral ros pub /cmd_vel geometry_msgs/msg/Twist "{linear: {x: 0.3}}" --count 40 --rate 20
 
 rclpy is imported only when a command runs, so the rest of the CLI works without the
 ``ros`` extra.
@@ -29,7 +30,8 @@ if TYPE_CHECKING:
     from rclpy.node import Node
 
 app = typer.Typer(
-    help="Inspect the ROS 2 graph: topics, messages, camera frames.", no_args_is_help=True
+    help="Inspect the ROS 2 graph: topics, messages, camera frames; publish a message.",
+    no_args_is_help=True,
 )
 
 DomainId = Annotated[
@@ -201,3 +203,48 @@ def snapshot(
         f"frame {escaped(msg.header.frame_id) or '-'}) from {info.name}",
         markup=False,
     )
+
+
+@app.command("pub")
+def pub(
+    topic: Annotated[str, typer.Argument(help="Topic name, e.g. /cmd_vel.")],
+    type_name: Annotated[str, typer.Argument(help="Message type, e.g. geometry_msgs/msg/Twist.")],
+    values: Annotated[
+        str, typer.Argument(help="Field values as YAML, e.g. '{linear: {x: 0.3}}'.")
+    ] = "{}",
+    count: Annotated[int, typer.Option("--count", min=1, help="Messages to publish.")] = 1,
+    rate: Annotated[
+        float, typer.Option("--rate", min=0.01, max=1000.0, help="Messages per second.")
+    ] = 10.0,
+    timeout: Timeout = 5.0,
+    domain_id: DomainId = None,
+) -> None:
+    """Publish COUNT messages of TYPE with VALUES on TOPIC at RATE, once a subscriber listens.
+
+    Only types of the packages openral installs are built; VALUES is read like a manifest
+    (no aliases, tags or deep nesting) and checked field by field before anything is sent.
+    """
+    require_ros()
+    from openral_core.errors import OpenralError, escaped
+    from openral_nodes.message_fill import build_message, parse_values
+    from openral_nodes.topic_graph import graph_topics, message_class, topic_name
+
+    name = topic_name(topic)
+    msg = build_message(message_class(type_name, name), parse_values(values))
+    with _probe_node(domain_id) as node:
+        publisher = node.create_publisher(type(msg), name, 10)
+        deadline = time.monotonic() + timeout
+        while publisher.get_subscription_count() == 0:  # a peer of another type never matches
+            types = {info.name: info.types for info in graph_topics(node)}.get(name, ())
+            if any(other != type_name for other in types):
+                shown = ", ".join(map(escaped, types))
+                raise OpenralError(f"{name} carries {shown}, not {escaped(type_name)}")
+            if time.monotonic() >= deadline:
+                raise OpenralError(f"no subscriber on {name} within {timeout:g} s; nothing sent")
+            time.sleep(0.05)
+        start = time.monotonic()
+        for index in range(count):
+            time.sleep(max(0.0, start + index / rate - time.monotonic()))
+            publisher.publish(msg)
+        time.sleep(0.2)  # let the last message leave before the node goes
+    out.print(f"published {count} {type_name} on {name} at {rate:g} Hz", markup=False)
