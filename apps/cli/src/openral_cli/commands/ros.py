@@ -197,10 +197,10 @@ def snapshot(
     rgb = depth_colours(depth_metres(msg)) if depth else image_to_rgb(msg)
     out_file.parent.mkdir(parents=True, exist_ok=True)
     write_png(out_file, rgb)
-    what = f"{sensor_summary(msg)}, colour-mapped" if depth else f"{msg.encoding}"
+    size = f"{rgb.shape[1]}x{rgb.shape[0]}"
+    what = f"{sensor_summary(msg)}, colour-mapped" if depth else f"{size} {msg.encoding}"
     out.print(
-        f"wrote {out_file} ({rgb.shape[1]}x{rgb.shape[0]} {what}, "
-        f"frame {escaped(msg.header.frame_id) or '-'}) from {info.name}",
+        f"wrote {out_file} ({what}, frame {escaped(msg.header.frame_id) or '-'}) from {info.name}",
         markup=False,
     )
 
