@@ -6,9 +6,11 @@ For each image size (the scene file's ``observation`` replaced, in a temporary c
    ``/proc``) of the bare loop of :mod:`benchmarks.camera_bare` (same composed scene, same
    control rate, same cameras at the same rate, rendered with ``mujoco.Renderer``, no ROS),
    and of ``deploy sim --camera-rate R`` with a subscriber on every image topic, each over
-   the same window once it is up; the bare loop runs before and after the deploy runs (the
-   mean of the two is the baseline, as other work on the machine comes and goes); the ratio
-   deploy / bare is the camera path's overhead.
+   the same window once it is up, in ``--pairs`` interleaved pairs (bare, then deploy; other
+   work on a shared machine comes and goes, and one 6 s window of either moves by up to
+   ~10 %); the median of the pairs' ratios deploy / bare is the camera path's overhead, and
+   their range is shown beside it. Each run's CPU is also split by thread
+   (:mod:`benchmarks.camera_threads`).
 2. The highest camera rate ``deploy sim`` sustains: ``--camera-rate`` 5, 10, 20, 30, 60 Hz
    in turn (until one fails), each sustained when every camera's rate received by the
    subscriber (arrival times, :mod:`benchmarks.deploy_launch`) is within 5 % of it.
@@ -37,6 +39,7 @@ from rich.console import Console
 from rich.table import Table
 
 from benchmarks.camera_report import RATE_TOLERANCE, rate_table, ratio_table
+from benchmarks.camera_threads import cpu_window, thread_table
 from benchmarks.deploy_launch import (
     DEFAULT_SCENE,
     REPO,
@@ -44,7 +47,6 @@ from benchmarks.deploy_launch import (
     camera_topic,
     deploy_env,
     received_rate,
-    tree_cpu_seconds,
     warm_up,
     watched_deploy,
 )
@@ -97,13 +99,6 @@ def sized_scene(scene: Path, size: Size, folder: Path) -> Path:
     return path
 
 
-def cpu_per_second(pid: int, window_s: float) -> float:
-    """CPU seconds per wall second of ``pid`` and its descendants over ``window_s``."""
-    cpu0, wall0 = tree_cpu_seconds(pid), time.monotonic()
-    time.sleep(window_s)
-    return (tree_cpu_seconds(pid) - cpu0) / (time.monotonic() - wall0)
-
-
 def measure_bare(scene: Path, rate_hz: float, window_s: float) -> dict[str, Any]:
     """CPU per second of the bare loop over ``window_s``, and what the loop counted."""
     command = [sys.executable, "-m", "benchmarks.camera_bare", "--scene", str(scene)]
@@ -116,11 +111,11 @@ def measure_bare(scene: Path, rate_hz: float, window_s: float) -> dict[str, Any]
         if not launch.wait_active(UP_TIMEOUT_S):
             raise RuntimeError(f"the bare loop did not start: {launch.lines[-5:]}")
         time.sleep(SETTLE_S)
-        cpu = cpu_per_second(process.pid, window_s)
+        cpu, threads = cpu_window(process.pid, window_s)
     finally:
         launch.stop()
     counts = json.loads(launch.lines[-1]) if launch.lines else {}
-    return {"cpu_per_s": cpu, "counts": counts, "exit_code": launch.exit_code}
+    return {"cpu_per_s": cpu, "threads": threads, "counts": counts, "exit_code": launch.exit_code}
 
 
 def measure_deploy(
@@ -135,45 +130,61 @@ def measure_deploy(
         launch.wait_active(5.0)
         time.sleep(SETTLE_S)
         watcher.reset()
-        cpu = cpu_per_second(launch.process.pid, window_s)
+        cpu, threads = cpu_window(launch.process.pid, window_s)
         arrivals = watcher.snapshot()
     received = {camera: received_rate(arrivals[camera_topic(camera)]) for camera in cameras}
     return {
         "cpu_per_s": cpu,
+        "threads": threads,
         "received_hz": received,
         "sustained": sustained(rate_hz, received),
         "exit_code": launch.exit_code,
     }
 
 
+def measure_pairs(
+    scene: Path, cameras: list[str], args: argparse.Namespace, console: Console, label: str
+) -> list[dict[str, Any]]:
+    """``args.pairs`` interleaved runs of the bare loop and of deploy sim at
+    ``args.camera_rate``, each pair with its ratio (deploy / bare CPU per second)."""
+    pairs = []
+    for index in range(args.pairs):
+        console.print(
+            f"{label}: pair {index + 1}/{args.pairs} at {args.camera_rate:g} Hz: "
+            "bare MuJoCo loop, then deploy sim …"
+        )
+        bare = measure_bare(scene, args.camera_rate, args.seconds)
+        deploy = measure_deploy(scene, cameras, args.camera_rate, args.seconds)
+        ratio = deploy["cpu_per_s"] / bare["cpu_per_s"] if bare["cpu_per_s"] > 0 else math.inf
+        pairs.append({"bare": bare, "deploy": deploy, "ratio": ratio})
+    return pairs
+
+
 def measure_size(
     scene: Path, size: Size, args: argparse.Namespace, console: Console
 ) -> dict[str, Any]:
-    """The bare loop and the rate search (which includes ``args.camera_rate``) at ``size``."""
+    """The interleaved pairs and the rate search (which reuses the first pair's deploy run
+    at ``args.camera_rate``) at ``size``."""
     cameras = list(load_scene(scene).scene.cameras)
     label = f"{size[0]}x{size[1]}"
-    console.print(f"{label}: bare MuJoCo loop at {args.camera_rate:g} Hz …")
-    bare_runs = [measure_bare(scene, args.camera_rate, args.seconds)]
-    trials: dict[float, dict[str, Any]] = {}
+    pairs = measure_pairs(scene, cameras, args, console, label)
+    trials: dict[float, dict[str, Any]] = {args.camera_rate: pairs[0]["deploy"]}
     for rate in sorted(set(args.rates)):
-        console.print(f"{label}: deploy sim --camera-rate {rate:g} …")
-        trials[rate] = measure_deploy(scene, cameras, rate, args.seconds)
+        if rate not in trials:
+            console.print(f"{label}: deploy sim --camera-rate {rate:g} …")
+            trials[rate] = measure_deploy(scene, cameras, rate, args.seconds)
         if not trials[rate]["sustained"]:
             break
-    if args.camera_rate not in trials:
-        console.print(f"{label}: deploy sim --camera-rate {args.camera_rate:g} (for the ratio) …")
-        trials[args.camera_rate] = measure_deploy(scene, cameras, args.camera_rate, args.seconds)
-    console.print(f"{label}: bare MuJoCo loop again …")  # the machine may have changed since
-    bare_runs.append(measure_bare(scene, args.camera_rate, args.seconds))
-    bare_cpu = statistics.mean(run["cpu_per_s"] for run in bare_runs)
-    deploy_cpu = trials[args.camera_rate]["cpu_per_s"]
     tried = {rate: trial["received_hz"] for rate, trial in trials.items() if rate in args.rates}
+    ratios = [pair["ratio"] for pair in pairs]
     return {
         "size": label,
-        "bare_cpu_per_s": bare_cpu,
-        "bare_runs": bare_runs,
-        "deploy_cpu_per_s": deploy_cpu,
-        "ratio": deploy_cpu / bare_cpu if bare_cpu > 0 else math.inf,
+        "bare_cpu_per_s": statistics.median(pair["bare"]["cpu_per_s"] for pair in pairs),
+        "deploy_cpu_per_s": statistics.median(pair["deploy"]["cpu_per_s"] for pair in pairs),
+        "ratio": statistics.median(ratios),
+        "ratio_range": [min(ratios), max(ratios)],
+        "pairs": pairs,
+        "median_pair": sorted(range(len(pairs)), key=lambda i: ratios[i])[len(pairs) // 2],
         "trials": {f"{rate:g}": trial for rate, trial in sorted(trials.items())},
         "highest_sustained_hz": highest_sustained(tried),
     }
@@ -191,6 +202,9 @@ def parse_args() -> argparse.Namespace:
     )
     parser.add_argument(
         "--camera-rate", type=float, default=10.0, help="camera rate of the CPU ratio [Hz]"
+    )
+    parser.add_argument(
+        "--pairs", type=int, default=3, help="interleaved bare/deploy runs of the CPU ratio"
     )
     parser.add_argument(
         "--rates", default="5,10,20,30,60", help="camera rates to try, comma-separated [Hz]"
@@ -213,7 +227,19 @@ def main() -> int:
             measure_size(sized_scene(args.scene, size, Path(folder)), size, args, console)
             for size in args.sizes
         ]
-    tables: list[Table] = [ratio_table(results, args), rate_table(results, args)]
+    tables: list[Table] = [
+        ratio_table(results, args),
+        rate_table(results, args),
+        thread_table(
+            [
+                (f"{result['size']} {side}", pair[side]["threads"])
+                for result in results
+                for pair in [result["pairs"][result["median_pair"]]]
+                for side in ("bare", "deploy")
+            ],
+            f"CPU s per wall s by thread, cameras at {args.camera_rate:g} Hz (median pair)",
+        ),
+    ]
     for table in tables:
         console.print(table)
     scene = args.scene.relative_to(REPO) if args.scene.is_relative_to(REPO) else args.scene
@@ -235,7 +261,8 @@ def main() -> int:
         f"arrival times at a subscriber in this process. {time.monotonic() - started:.0f} s. "
         f"Written to {path}."
     )
-    codes = [run["exit_code"] for r in results for run in r["bare_runs"]]
+    runs = [pair[side] for r in results for pair in r["pairs"] for side in ("bare", "deploy")]
+    codes = [run["exit_code"] for run in runs]
     codes += [t["exit_code"] for r in results for t in r["trials"].values()]
     return 0 if all(code == 0 for code in codes) else 1
 

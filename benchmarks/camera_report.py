@@ -21,8 +21,9 @@ def ratio_table(results: list[dict[str, Any]], args: argparse.Namespace) -> Tabl
     table = Table(
         title=f"CPU s per wall s: deploy sim vs bare MuJoCo loop, cameras at "
         f"{args.camera_rate:g} Hz, {args.seconds:g} s windows",
-        caption=f"{args.scene.name}; bare: mean of a run before and one after the deploy runs "
-        f"(frames/s rendered); load average after: {load} on {os.cpu_count()} cores",
+        caption=f"{args.scene.name}; medians of {args.pairs} interleaved pairs (bare frames/s "
+        f"rendered; ratio: median and range of the pairs' ratios); load average after: "
+        f"{load} on {os.cpu_count()} cores",
     )
     columns = ("size", "bare loop", "deploy sim", "ratio", "target", "highest rate sustained")
     for column in columns:
@@ -30,13 +31,14 @@ def ratio_table(results: list[dict[str, Any]], args: argparse.Namespace) -> Tabl
     for result in results:
         ratio = result["ratio"]
         colour = "green" if ratio <= RATIO_TARGET else "red"
-        frames = [_frames_per_s(run["counts"]) for run in result["bare_runs"]]
+        frames = [_frames_per_s(pair["bare"]["counts"]) for pair in result["pairs"]]
         best = result["highest_sustained_hz"]
+        low, high = result["ratio_range"]
         table.add_row(
             result["size"],
             f"{result['bare_cpu_per_s']:.3f} ({min(frames):.1f}/s)",
             f"{result['deploy_cpu_per_s']:.3f}",
-            f"[{colour}]{ratio:.2f}[/]",
+            f"[{colour}]{ratio:.2f}[/] ({low:.2f}-{high:.2f})",
             f"≤ {RATIO_TARGET:.2f}",
             "none" if best is None else f"{best:g} Hz",
         )

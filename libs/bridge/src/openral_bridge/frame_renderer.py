@@ -43,6 +43,8 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 
+from openral_bridge.os_thread import name_os_thread
+
 ImageArray = npt.NDArray[np.uint8]
 RenderFn = Callable[[mujoco.Renderer, mujoco.MjData, str], ImageArray]
 """Render one sensor's frame of the snapshot data with the render thread's renderer (the
@@ -79,7 +81,7 @@ class FrameRenderer:
         render: RenderFn,
         publish: PublishFn,
         *,
-        name: str = "openral-camera-render",
+        name: str = "openral-render",
     ) -> None:
         """Nothing runs until :meth:`start`.
 
@@ -90,7 +92,7 @@ class FrameRenderer:
             size: (height, width) of the render thread's renderer [px].
             render: Renders one sensor of the snapshot data.
             publish: Receives each frame and its simulated time [s], on the render thread.
-            name: The render thread's name.
+            name: The render thread's name (also in the OS, at most 15 bytes there).
         """
         self._model = model
         self._live = live
@@ -171,6 +173,7 @@ class FrameRenderer:
     # -- render thread ---------------------------------------------------------------------
 
     def _run(self) -> None:
+        name_os_thread(self._thread.name)
         try:
             renderer = mujoco.Renderer(self._model, *self._size)
         except Exception as error:  # no GL context: the cameras stop, the robot does not

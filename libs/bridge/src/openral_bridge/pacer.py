@@ -30,6 +30,8 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from openral_bridge.os_thread import name_os_thread
+
 MERGE_S = 0.001
 """Jobs due within this long after the one that woke the pacer run in the same wake [s]."""
 STOP_TIMEOUT_S = 5.0
@@ -73,7 +75,7 @@ class Pacer:
 
         Args:
             on_error: Told about a callback that raised (default: ignored).
-            name: The thread's name.
+            name: The thread's name (also in the OS, see :mod:`openral_bridge.os_thread`).
             clock: Monotonic wall clock [s].
         """
         self._on_error = on_error
@@ -154,6 +156,7 @@ class Pacer:
     # -- the pacer's thread ----------------------------------------------------------------
 
     def _run(self) -> None:
+        name_os_thread(self._thread.name)
         while not self._stopping:
             with self._jobs_lock:
                 jobs = list(self._jobs)
