@@ -184,6 +184,7 @@ def test_an_estop_stops_the_base_and_refuses_its_commands() -> None:
         hal.estop()
         base = hal.base
         assert base is not None and base.velocity_in_force == (0.0, 0.0, 0.0)
+        assert hal.base_odometry().vx_m_s == 0.0  # braked: the frozen scene stands still
         handles = hal.mujoco_handles()
         assert handles is not None
         data = handles[1]

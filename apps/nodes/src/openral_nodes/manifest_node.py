@@ -18,7 +18,8 @@ Transitions:
   published and then once per control period, publishing ``/clock`` after each step; then
   publish the latched ``/openral/action_spec`` and ``/joint_states`` (stamped in simulated
   time), subscribe ``/openral/safe_action``, offer the E-stop services and start the
-  :class:`~openral_bridge.SimSensorBridge`;
+  :class:`~openral_nodes.scene_bridges.SceneBridges` (cameras, depth and lidar, a mobile
+  base's ``/cmd_vel`` and ``/odom``);
 - deactivate → stop all of that (the HAL stays connected and holds still);
 - cleanup / shutdown / error → also disconnect and drop the HAL; shutdown also sets the
   ``shutdown_event`` the owner passed, so a process can end when told to over ROS.
@@ -53,7 +54,7 @@ from openral_bridge import ros_messages
 from openral_bridge.control_loop import ControlLoop
 from openral_bridge.joint_state_publisher import JointStatePublisher, sim_stamp
 from openral_bridge.pacer import PacedJob, Pacer
-from openral_bridge.sim_sensor_bridge import SimSensorBridge, TopicInfo
+from openral_bridge.sim_sensor_bridge import TopicInfo
 from openral_bridge.topics import (
     ACTION_SPEC,
     CLOCK,
@@ -81,6 +82,7 @@ from std_srvs.srv import Trigger
 from openral_nodes.lifecycle_guard import guard_change_state
 from openral_nodes.node_parameters import BOUNDS, PARAMETERS, check_rates, robot_and_scene
 from openral_nodes.runtime import LATCHED
+from openral_nodes.scene_bridges import SceneBridges
 
 NODE_NAME = "openral_manifest_node"
 WARN_EVERY_S = 2.0
@@ -135,7 +137,7 @@ class ManifestLifecycleNode(LifecycleNode):
             self.declare_parameter(name, default)
         self.description: RobotDescription | None = None
         self.hal: RobotHal | None = None
-        self.bridge: SimSensorBridge | None = None
+        self.bridge: SceneBridges | None = None
         self.loop: ControlLoop | None = None
         """The control loop of a simulated HAL while active (None for a real one)."""
         self.pacer: Pacer | None = None
@@ -198,15 +200,14 @@ class ManifestLifecycleNode(LifecycleNode):
         self.pacer = pacer = Pacer(on_error=self._job_failed)
         self._start_loop(hal, pacer)
         self._create_entities(pacer)
-        camera_rate = float(self._param("camera_publish_rate_hz"))
-        self.bridge = SimSensorBridge(
+        self.bridge = SceneBridges(
             self,
             hal,
-            hal.description,
             pacer,
-            lock=self.hal_lock,
+            self.hal_lock,
             viewer_enabled=bool(self._param("viewer_enabled")),
-            camera_rate_hz=camera_rate or None,
+            camera_rate_hz=float(self._param("camera_publish_rate_hz")) or None,
+            odom_rate_hz=float(self._param("joint_state_rate_hz")),
         )
         self.bridge.setup()
         if self.loop is not None:  # the pace is judged from here on, not over the start-up

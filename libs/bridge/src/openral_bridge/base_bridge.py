@@ -31,6 +31,7 @@ from openral_sim.base_drive import BaseOdometry
 
 from openral_bridge import ros_messages
 from openral_bridge.pacer import PacedJob, Pacer
+from openral_bridge.sim_sensor_bridge import TopicInfo
 from openral_bridge.topics import CMD_VEL, ODOM
 
 if TYPE_CHECKING:
@@ -82,6 +83,10 @@ class BaseBridge:
         self._entities: list[tuple[str, Any]] = []
         self._pacer: Pacer | None = None
         self._job: PacedJob | None = None
+
+    def topics(self) -> list[TopicInfo]:
+        """What the bridge publishes (``/cmd_vel`` is subscribed, not listed)."""
+        return [TopicInfo(ODOM, "nav_msgs/msg/Odometry", self.rate_hz)] if self._entities else []
 
     def start(self, pacer: Pacer) -> None:
         """Advertise ``/odom`` and publish it once now and then as a job of ``pacer``;

@@ -38,6 +38,7 @@ from __future__ import annotations
 import queue
 import threading
 from collections.abc import Callable, Iterable
+from typing import Generic, TypeVar
 
 import mujoco
 import numpy as np
@@ -46,10 +47,12 @@ import numpy.typing as npt
 from openral_bridge.os_thread import name_os_thread
 
 ImageArray = npt.NDArray[np.uint8]
-RenderFn = Callable[[mujoco.Renderer, mujoco.MjData, str], ImageArray]
+FrameT = TypeVar("FrameT")
+"""What one render makes: an RGB image, a depth frame with its cloud."""
+RenderFn = Callable[[mujoco.Renderer, mujoco.MjData, str], FrameT]
 """Render one sensor's frame of the snapshot data with the render thread's renderer (the
 frame may live in a buffer the next render of that sensor reuses: it is published first)."""
-PublishFn = Callable[[str, ImageArray, float], None]
+PublishFn = Callable[[str, FrameT, float], None]
 """Publish one sensor's frame with the snapshot's simulated time [s] (render thread)."""
 
 STOP_TIMEOUT_S = 5.0
@@ -68,9 +71,10 @@ class _Slot:
         self.skipped = 0
 
 
-class FrameRenderer:
+class FrameRenderer(Generic[FrameT]):
     """Snapshots taken on the caller's thread, rendered and published on one thread of
-    its own; at most one frame per camera in flight."""
+    its own; at most one frame per camera in flight. Frames are RGB images for cameras
+    (``FrameRenderer[ImageArray]``) or whatever ``render`` makes (a depth frame)."""
 
     def __init__(
         self,
@@ -78,8 +82,8 @@ class FrameRenderer:
         live: mujoco.MjData,
         sensors: Iterable[str],
         size: tuple[int, int],
-        render: RenderFn,
-        publish: PublishFn,
+        render: RenderFn[FrameT],
+        publish: PublishFn[FrameT],
         *,
         name: str = "openral-render",
     ) -> None:

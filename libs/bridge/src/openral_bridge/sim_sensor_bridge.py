@@ -22,7 +22,8 @@ renders inside its own step (robosuite), publishes the last observation's frames
 Header stamps are simulation time (MuJoCo ``data.time``; the node publishes ``/clock``):
 a rendered frame carries its snapshot's time, so the stamp says which physics state it
 shows; a HAL without simulation time stamps with the node clock. Depth and lidar sensors
-are not rendered by the scenes yet and are reported, not published.
+are :class:`~openral_bridge.range_bridge.RangeBridge`'s; those it does not serve are
+reported, not published.
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ from openral_sim.native_scene import NativeScene
 
 from openral_bridge import ros_messages
 from openral_bridge.camera_messages import CameraMessages
-from openral_bridge.frame_renderer import FrameRenderer
+from openral_bridge.frame_renderer import FrameRenderer, ImageArray
 from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.topics import camera_image, camera_info
 
@@ -90,6 +91,7 @@ class SimSensorBridge:
         viewer_enabled: bool = True,
         camera_rate_hz: float | None = None,
         viewer_sync_rate_hz: float = 30.0,
+        served_elsewhere: frozenset[str] = frozenset(),
     ) -> None:
         """Nothing is created until :meth:`setup`.
 
@@ -105,6 +107,8 @@ class SimSensorBridge:
             camera_rate_hz: Publish rate of every camera [Hz]; None: each sensor's
                 ``rate_hz``.
             viewer_sync_rate_hz: How often the viewer is synchronised [Hz].
+            served_elsewhere: Depth and lidar sensors another bridge publishes (the rest
+                are reported as not published).
 
         Raises:
             ValueError: A rate that is not positive.
@@ -121,12 +125,13 @@ class SimSensorBridge:
         self.viewer_enabled = viewer_enabled
         self.camera_rate_hz = camera_rate_hz
         self.viewer_sync_rate_hz = viewer_sync_rate_hz
+        self.served_elsewhere = served_elsewhere
         self._cameras: dict[str, _Camera] = {}
         self._count_lock = threading.Lock()
         self._camera_hal: CameraHal | None = None
         self._scene: NativeScene | None = None
         self._scene_rendered_observations = True
-        self._frames: FrameRenderer | None = None
+        self._frames: FrameRenderer[ImageArray] | None = None
         self._viewer: Any = None
         self._viewer_job: PacedJob | None = None
 
@@ -384,7 +389,7 @@ class SimSensorBridge:
         skipped = [
             f"{s.name} ({s.kind})"
             for s in self.description.sensors
-            if isinstance(s, DepthSensor | LidarSensor)
+            if (isinstance(s, DepthSensor | LidarSensor) and s.name not in self.served_elsewhere)
             or (isinstance(s, RgbSensor) and s.name not in self._cameras)
         ]
         if skipped:

@@ -129,12 +129,15 @@ class BaseDrive:
         return BaseCommand(vx * scale, vy * scale, turn, clamped)
 
     def halt(self) -> None:
-        """Stop commanding at once (an E-stop): command, ramp and every drive ctrl to zero."""
+        """Stop at once (an E-stop): command, ramp and every drive ctrl to zero, and the
+        drive joints' velocities too (the base brakes to a standstill; its odometry says
+        so)."""
         self._target = np.zeros(3)
         self._velocity = np.zeros(3)
         self._joint_velocity = np.zeros(3)
         self._last_command_s = -math.inf
         self._data.ctrl[self.geometry.actuator] = 0.0
+        self._data.qvel[self.geometry.dof] = 0.0
 
     def reset(self) -> None:
         """After the scene's reset: halted, and the odometry frame is the base frame now."""

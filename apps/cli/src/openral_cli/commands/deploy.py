@@ -167,7 +167,7 @@ def _shut_down(node: ManifestLifecycleNode, stop: threading.Event) -> str:
 
 def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
     """What the graph offers: published topics in a table (fits 80 columns), then inputs."""
-    from openral_bridge.topics import ESTOP, RELEASE_ESTOP, SAFE_ACTION
+    from openral_bridge.topics import CMD_VEL, ESTOP, RELEASE_ESTOP, SAFE_ACTION
     from rich import box
     from rich.table import Table
 
@@ -189,6 +189,8 @@ def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
         f"{', '.join(names)})",
         soft_wrap=False,
     )
+    if node.bridge is not None and node.bridge.base is not None:
+        out.print(f"base:     {CMD_VEL} (geometry_msgs/msg/Twist, base frame)", soft_wrap=False)
     out.print(f"E-stop:   {ESTOP}, {RELEASE_ESTOP} (std_srvs/srv/Trigger)", soft_wrap=False)
     out.print(
         "running; stop with Ctrl-C. In a second terminal: openral ros topics", soft_wrap=False

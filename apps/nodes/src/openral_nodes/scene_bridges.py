@@ -1,0 +1,84 @@
+"""SceneBridges: everything a simulated robot publishes and takes beyond its joints.
+
+- cameras and the viewer (:class:`~openral_bridge.sim_sensor_bridge.SimSensorBridge`);
+- on a native scene, its depth cameras (image, camera info, cloud) and lidars (scans)
+  (:class:`~openral_bridge.range_bridge.RangeBridge`);
+- for a robot with a mobile base, ``/cmd_vel`` in and ``/odom`` out
+  (:class:`~openral_bridge.base_bridge.BaseBridge`, at the joint-state rate).
+
+All their periodic work runs on the node's pacer and every call into the HAL or the live
+scene holds the node's HAL lock. A sensor none of them serves is reported once at setup.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import TYPE_CHECKING
+
+from openral_bridge.base_bridge import BaseBridge
+from openral_bridge.pacer import Pacer
+from openral_bridge.range_bridge import RangeBridge
+from openral_bridge.sim_sensor_bridge import SimSensorBridge, TopicInfo
+from openral_hal.protocol import MobileBaseHal, RobotHal
+from openral_hal.sim_attached import native_scene
+
+if TYPE_CHECKING:
+    from rclpy.node import Node
+
+
+class SceneBridges:
+    """The camera, range-sensor and mobile-base bridges of one HAL on one node."""
+
+    def __init__(
+        self,
+        node: Node,
+        hal: RobotHal,
+        pacer: Pacer,
+        lock: threading.Lock,
+        *,
+        viewer_enabled: bool,
+        camera_rate_hz: float | None,
+        odom_rate_hz: float,
+    ) -> None:
+        """Nothing is created until :meth:`setup` (see the bridges for the arguments)."""
+        scene = native_scene(hal)
+        self.range = RangeBridge(node, scene, lock) if scene is not None else None
+        served: frozenset[str] = frozenset()
+        if scene is not None:
+            served = frozenset(scene.range_sensors.depth) | frozenset(scene.range_sensors.lidars)
+        self.base = None
+        if isinstance(hal, MobileBaseHal) and hal.base is not None:
+            self.base = BaseBridge(node, hal, odom_rate_hz, lock)
+        self.sensors = SimSensorBridge(
+            node,
+            hal,
+            hal.description,
+            pacer,
+            lock=lock,
+            viewer_enabled=viewer_enabled,
+            camera_rate_hz=camera_rate_hz,
+            served_elsewhere=served,
+        )
+        self.pacer = pacer
+
+    def setup(self) -> None:
+        """Start every bridge; each publishes once now."""
+        self.sensors.setup()
+        if self.range is not None:
+            self.range.start(self.pacer)
+        if self.base is not None:
+            self.base.start(self.pacer)
+
+    def teardown(self) -> None:
+        """Stop every bridge (idempotent)."""
+        if self.base is not None:
+            self.base.stop()
+        if self.range is not None:
+            self.range.stop()
+        self.sensors.teardown()
+
+    def topics(self) -> list[TopicInfo]:
+        """What the bridges publish now, with their nominal rates."""
+        rows = self.sensors.topics()
+        rows += self.range.topics() if self.range is not None else []
+        return rows + (self.base.topics() if self.base is not None else [])
