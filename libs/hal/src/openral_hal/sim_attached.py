@@ -72,6 +72,8 @@ class SimAttachedHAL(EStopLatch):
             env_action_dim: Action width, for a backend that does not report ``action_dim``.
         """
         self.env = env
+        # checked once: a runtime Protocol check costs ~17 us, too much for every tick
+        self._manifest_env = env if isinstance(env, ManifestRollout) else None
         self.robot = robot
         description = robot.description
         self.env_reset_seed = env_reset_seed
@@ -128,7 +130,7 @@ class SimAttachedHAL(EStopLatch):
             raise ConfigurationError(f"{type(self.env).__name__}: action width {width} < 1")
         obs = self.env.reset(seed=self.env_reset_seed)
         handles = self.env.mujoco_handles()
-        if handles is not None and not isinstance(self.env, ManifestRollout):
+        if handles is not None and self._manifest_env is None:
             self._resolve_addresses(handles[0])
         self._action_dim = width
         self._action_names = self._slot_names(width)
@@ -189,8 +191,8 @@ class SimAttachedHAL(EStopLatch):
         velocities and efforts.
         """
         obs = self._require_obs()
-        if isinstance(self.env, ManifestRollout):
-            return self.env.joint_state()
+        if self._manifest_env is not None:
+            return self._manifest_env.joint_state()
         handles = self.env.mujoco_handles()
         count = len(self.joint_names)
         if handles is None:
@@ -320,8 +322,8 @@ class SimAttachedHAL(EStopLatch):
 
     def _on_release(self) -> None:
         """A native scene holds the pose the E-stop froze; nothing jumps on release."""
-        if isinstance(self.env, ManifestRollout) and self._obs is not None:
-            self.env.hold_current_pose()
+        if self._manifest_env is not None and self._obs is not None:
+            self._manifest_env.hold_current_pose()
 
     def _require_obs(self) -> Observation:
         if self._obs is None:
