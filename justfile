@@ -66,7 +66,7 @@ bench-hal *ARGS:
 bench-scene *ARGS:
     python -m benchmarks.scene_step {{ARGS}}
 
-# deploy sim start-up (median of 5: first state, first frames), camera rate and CPU; writes benchmarks/results/deploy_startup.json.
+# deploy sim start-up (median of 5: first state, first sensor messages), stream rates and CPU, on the franka tabletop and the mobile room; writes benchmarks/results/deploy_startup*.json.
 bench-deploy *ARGS:
     python -m benchmarks.deploy_startup {{ARGS}}
 

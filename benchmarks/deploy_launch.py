@@ -112,7 +112,11 @@ class Watcher:
     """Records arrival times (``time.monotonic``) of joint states and camera frames, and the
     CPU time the watched process had used when each topic's first message arrived."""
 
-    def __init__(self, node: Node, cameras: list[str]) -> None:
+    def __init__(
+        self, node: Node, cameras: list[str], extra: Mapping[str, type[Any]] | None = None
+    ) -> None:
+        """Watch ``/joint_states``, each camera's image and each ``extra`` topic (name →
+        message class)."""
         self.pid: int | None = None
         """The watched process (set after launching it)."""
         self.first_cpu_s: dict[str, float] = {}
@@ -121,10 +125,10 @@ class Watcher:
         node.create_subscription(
             JointState, JOINT_STATES, partial(self._on, JOINT_STATES), 50, raw=True
         )
-        for camera in cameras:
-            topic = camera_topic(camera)
+        topics: dict[str, type[Any]] = {camera_topic(camera): Image for camera in cameras}
+        for topic, kind in {**topics, **(extra or {})}.items():
             self.arrivals[topic] = []
-            node.create_subscription(Image, topic, partial(self._on, topic), 50, raw=True)
+            node.create_subscription(kind, topic, partial(self._on, topic), 50, raw=True)
         self.changed = threading.Condition()
 
     def _on(self, topic: str, _msg: Any) -> None:
@@ -227,18 +231,22 @@ class Launch:
 
 @contextmanager
 def watched_deploy(
-    scene: Path, cameras: list[str], *options: str, env: Mapping[str, str] | None = None
+    scene: Path,
+    cameras: list[str],
+    *options: str,
+    env: Mapping[str, str] | None = None,
+    extra: Mapping[str, type[Any]] | None = None,
 ) -> Iterator[tuple[Launch, Watcher]]:
     """Launch ``openral deploy sim`` on a fresh domain with a :class:`Watcher` on it; stop it
     (SIGINT) when the block ends. ``options`` are extra command-line options, ``env`` extra
-    environment variables."""
+    environment variables, ``extra`` more topics to watch (name → message class)."""
     domain = claim_domain_id()
     if PROFILE_VARIABLE not in os.environ:  # a profile of the user's own is left alone
         WATCHER_PROFILE.write_text(WATCHER_PROFILE_XML)
         os.environ[PROFILE_VARIABLE] = str(WATCHER_PROFILE)
     with ros_session(domain_id=domain) as context, Spinner(context) as spinner:
         node = Node("bench_watcher", context=context)
-        watcher = Watcher(node, cameras)
+        watcher = Watcher(node, cameras, extra)
         spinner.add_node(node)
         command = [str(OPENRAL), "deploy", "sim", "--config", str(scene), "--no-viewer"]
         command += [*options, "--domain-id", str(domain)]

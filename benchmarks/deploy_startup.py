@@ -1,10 +1,14 @@
-"""``openral deploy sim`` from launch to live graph: first joint state, first frames, rate, CPU.
+"""``openral deploy sim`` from launch to live graph: first joint state, first sensor
+messages, rates, CPU.
 
 Each run launches ``openral deploy sim --no-viewer`` as a subprocess on a ROS domain of its
 own and watches it from this process (:mod:`benchmarks.deploy_launch`): the time from
-``Popen`` to the first ``/joint_states`` and to the first image of every camera, then the
-camera rate over a sustained window (arrival times at the subscriber) and the deploy
-process's CPU use over the same window (``/proc``; 100 % = one core). One untimed launch
+``Popen`` to the first ``/joint_states`` and to the first message of every sensor stream
+(camera images, depth images and clouds, scans, odometry: :mod:`benchmarks.sensor_streams`),
+then each stream's rate over a sustained window (arrival times at the subscriber) against
+its nominal rate, and the deploy process's CPU use over the same window (``/proc``;
+100 % = one core). ``--scene robots/panda_mobile/scenes/room.yaml`` measures the mobile
+robot's depth, cloud, scan and odometry streams. One untimed launch
 first fills the bytecode cache and the compiled-model cache (see
 :mod:`benchmarks.deploy_launch` and :mod:`openral_mujoco.model_cache`); the timed runs then
 start as a user's second launch of an unchanged scene does. ``--cold-runs`` more launches
@@ -24,7 +28,6 @@ import time
 from pathlib import Path
 from typing import Any
 
-from openral_core.loader import load_scene
 from rich.console import Console
 from rich.table import Table
 
@@ -32,7 +35,6 @@ from benchmarks.deploy_launch import (
     DEFAULT_SCENE,
     JOINT_STATES,
     REPO,
-    camera_topic,
     deploy_env,
     received_rate,
     tree_cpu_seconds,
@@ -40,23 +42,27 @@ from benchmarks.deploy_launch import (
     watched_deploy,
 )
 from benchmarks.results_file import write_results
+from benchmarks.sensor_streams import Stream, sensor_streams
 
 TARGETS = {"first_state_s": 1.0, "first_frames_s": 1.5, "rate_error": 0.05}
 """Median launch → first /joint_states [s], median launch → first frame of every camera [s],
-and the largest relative camera-rate error over the window."""
+and the largest relative rate error of a sensor stream over the window."""
+ROOM_SCENE = REPO / "robots" / "panda_mobile" / "scenes" / "room.yaml"
+"""The mobile manipulator's room: depth, cloud, scan and odometry streams."""
 BOOT_TIMEOUT_S = 60.0
 Run = dict[str, Any]
 """One launch's measures, as ``one_run`` returns them and the JSON stores them."""
 
 
 def one_run(
-    scene: Path, cameras: list[str], window_s: float, rate_hz: float, model_cache: str = ""
+    scene: Path, streams: list[Stream], window_s: float, rate_hz: float, model_cache: str = ""
 ) -> Run:
     """Launch, wait for every first message, measure a window, stop with SIGINT; with
     ``model_cache``, the launch's compiled-model cache is that folder."""
     env = {"OPENRAL_MODEL_CACHE": model_cache} if model_cache else None
     options = ("--camera-rate", str(rate_hz))
-    with watched_deploy(scene, cameras, *options, env=env) as (launch, watcher):
+    extra = {stream.topic: stream.kind for stream in streams}
+    with watched_deploy(scene, [], *options, env=env, extra=extra) as (launch, watcher):
         booted = watcher.wait(lambda: all(watcher.arrivals.values()), BOOT_TIMEOUT_S)
         if not booted:
             raise RuntimeError(f"no first message on every topic within {BOOT_TIMEOUT_S} s")
@@ -85,7 +91,12 @@ def one_run(
 def parse_args() -> argparse.Namespace:
     """The command line: scene, number of runs, measuring window and camera rate."""
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--scene", type=Path, default=DEFAULT_SCENE, help="deploy-scene file")
+    parser.add_argument(
+        "--scene",
+        type=Path,
+        action="append",
+        help="deploy-scene file (repeatable; default: the franka tabletop, then the room)",
+    )
     parser.add_argument("--runs", type=int, default=5, help="launches to time")
     parser.add_argument("--window", type=float, default=10.0, help="rate/CPU window [s]")
     parser.add_argument("--camera-rate", type=float, default=10.0, help="camera rate [Hz]")
@@ -96,7 +107,7 @@ def parse_args() -> argparse.Namespace:
 
 
 def time_runs(
-    args: argparse.Namespace, cameras: list[str], console: Console
+    args: argparse.Namespace, streams: list[Stream], console: Console
 ) -> tuple[list[Run], list[Run]]:
     """One untimed warm-up launch, ``args.runs`` measured ones, then ``args.cold_runs`` each
     with an empty model cache, announcing each."""
@@ -104,11 +115,11 @@ def time_runs(
     runs, cold = [], []
     for index in range(args.runs):
         console.print(f"run {index + 1}/{args.runs} …")
-        runs.append(one_run(args.scene, cameras, args.window, args.camera_rate))
+        runs.append(one_run(args.scene, streams, args.window, args.camera_rate))
     for index in range(args.cold_runs):
         console.print(f"run {index + 1}/{args.cold_runs} with an empty model cache …")
         with tempfile.TemporaryDirectory(prefix="openral-bench-cold-") as folder:
-            cold.append(one_run(args.scene, cameras, args.window, args.camera_rate, folder))
+            cold.append(one_run(args.scene, streams, args.window, args.camera_rate, folder))
     return runs, cold
 
 
@@ -124,20 +135,20 @@ def _target_row(table: Table, label: str, values: list[float], target: float, un
     )
 
 
-def _startup_rows(table: Table, runs: list[Run], cold: list[Run], cameras: list[str]) -> None:
-    """Launch to the first joint state and to every camera's first frame (also with an empty
-    model cache), to each camera's, and to the printed ``running`` line."""
-    labels = {"first_state_s": "/joint_states", "first_frames_s": "frame of every camera"}
+def _startup_rows(table: Table, runs: list[Run], cold: list[Run], streams: list[Stream]) -> None:
+    """Launch to the first joint state and to every sensor stream's first message (also
+    with an empty model cache), to each stream's, and to the printed ``running`` line."""
+    labels = {"first_state_s": "/joint_states", "first_frames_s": "message of every sensor"}
     for key, label in labels.items():
         _target_row(table, f"launch → first {label}", [r[key] for r in runs], TARGETS[key], "s")
         if cold:
             values = [r[key] for r in cold]
             row = (f"{statistics.median(values):.2f} s", f"{max(values):.2f} s", "")
             table.add_row(f"  with an empty model cache ({len(cold)} runs)", *row)
-    for camera in cameras:
-        firsts = [r["first_frame_s"][camera_topic(camera)] for r in runs]
+    for stream in streams:
+        firsts = [r["first_frame_s"][stream.topic] for r in runs]
         row = (f"{statistics.median(firsts):.2f} s", f"{max(firsts):.2f} s", "")
-        table.add_row(f"  first {camera} frame", *row)
+        table.add_row(f"  first {stream.topic}", *row)
     cpu = [r["cpu_to_first_state_s"] for r in runs]
     row = (f"{statistics.median(cpu):.2f} s", f"{max(cpu):.2f} s", "")
     table.add_row("deploy CPU until its first /joint_states", *row)
@@ -147,14 +158,14 @@ def _startup_rows(table: Table, runs: list[Run], cold: list[Run], cameras: list[
 
 
 def _streaming_rows(
-    table: Table, runs: list[Run], cameras: list[str], args: argparse.Namespace
+    table: Table, runs: list[Run], streams: list[Stream], args: argparse.Namespace
 ) -> None:
-    """Each camera's rate error over the window, the joint-state rate and the deploy CPU."""
-    for camera in cameras:
-        rates = [r["rates_hz"][camera_topic(camera)] for r in runs]
-        worst = max(abs(x - args.camera_rate) / args.camera_rate for x in rates)
+    """Each stream's rate error over the window, the joint-state rate and the deploy CPU."""
+    for stream in streams:
+        rates = [r["rates_hz"][stream.topic] for r in runs]
+        worst = max(abs(x - stream.rate_hz) / stream.rate_hz for x in rates)
         table.add_row(
-            f"{camera} rate over {args.window:g} s",
+            f"{stream.topic} ({stream.rate_hz:g} Hz) over {args.window:g} s",
             f"{statistics.median(rates):.2f} Hz",
             f"[{'green' if worst <= TARGETS['rate_error'] else 'red'}]{100 * worst:.1f} % off[/]",
             f"± {100 * TARGETS['rate_error']:g} %",
@@ -167,7 +178,7 @@ def _streaming_rows(
 
 def results_table(
     args: argparse.Namespace,
-    cameras: list[str],
+    streams: list[Stream],
     runs: tuple[list[Run], list[Run]],
     load: tuple[float, ...],
 ) -> Table:
@@ -179,8 +190,8 @@ def results_table(
     )
     for column in ("measure", "median", "worst", "target"):
         table.add_column(column, justify="left" if column == "measure" else "right")
-    _startup_rows(table, runs[0], runs[1], cameras)
-    _streaming_rows(table, runs[0], cameras, args)
+    _startup_rows(table, runs[0], runs[1], streams)
+    _streaming_rows(table, runs[0], streams, args)
     return table
 
 
@@ -193,10 +204,14 @@ def bytecode_note() -> str:
 def save_results(
     args: argparse.Namespace, runs: tuple[list[Run], list[Run]], load: tuple[float, ...]
 ) -> Path:
-    """Write the settings, targets and every run to ``benchmarks/results/deploy_startup.json``."""
+    """Write the settings, targets and every run to ``benchmarks/results/deploy_startup.json``
+    (``deploy_startup_<scene>.json`` for another scene than the default)."""
     scene = args.scene.relative_to(REPO) if args.scene.is_relative_to(REPO) else args.scene
+    suffix = (
+        "" if args.scene == DEFAULT_SCENE else f"_{args.scene.parent.parent.name}_{args.scene.stem}"
+    )
     return write_results(
-        "deploy_startup",
+        "deploy_startup" + suffix,
         {
             "scene": str(scene),
             "camera_rate_hz": args.camera_rate,
@@ -219,19 +234,24 @@ def _medians(runs: list[Run]) -> dict[str, float]:
 
 
 def main() -> int:
-    """Time the runs, print the table, write the JSON; 1 if any run did not exit cleanly."""
+    """Time the runs of each scene, print its table, write its JSON; 1 if any run did not
+    exit cleanly."""
     args = parse_args()
-    cameras = list(load_scene(args.scene).scene.cameras)
     console = Console()
-    load = os.getloadavg()
-    runs = time_runs(args, cameras, console)
-    console.print(results_table(args, cameras, runs, load))
-    path = save_results(args, runs, load)
-    console.print(
-        "Times from Popen (includes interpreter start-up); rates from arrival times at a "
-        f"subscriber in this process; CPU: 100 % = one core. Written to {path}."
-    )
-    return 0 if all(r["exit_code"] == 0 for r in runs[0] + runs[1]) else 1
+    clean = True
+    for scene in args.scene or [DEFAULT_SCENE, ROOM_SCENE]:
+        args.scene = scene
+        streams = sensor_streams(scene, args.camera_rate)
+        load = os.getloadavg()
+        runs = time_runs(args, streams, console)
+        console.print(results_table(args, streams, runs, load))
+        path = save_results(args, runs, load)
+        console.print(
+            "Times from Popen (includes interpreter start-up); rates from arrival times at a "
+            f"subscriber in this process; CPU: 100 % = one core. Written to {path}."
+        )
+        clean &= all(r["exit_code"] == 0 for r in runs[0] + runs[1])
+    return 0 if clean else 1
 
 
 if __name__ == "__main__":
