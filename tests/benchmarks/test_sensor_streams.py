@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from benchmarks.sensor_streams import JOINT_STATE_RATE_HZ, sensor_streams
-
 from tests.conftest import ROBOTS
 
 
