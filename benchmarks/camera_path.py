@@ -35,6 +35,8 @@ from pathlib import Path
 from typing import Any
 
 from openral_core.loader import load_scene
+from openral_core.models import RgbSensor
+from openral_sim.scene import scene_robot
 from rich.console import Console
 from rich.table import Table
 
@@ -86,13 +88,14 @@ def parse_size(text: str) -> Size:
 
 
 def sized_scene(scene: Path, size: Size, folder: Path) -> Path:
-    """A copy of ``scene`` whose images are ``size``, written into ``folder`` (JSON, which is
-    YAML) after it validated; ``scene`` itself when its size already is ``size``."""
-    document = load_scene(scene).model_dump(mode="json", exclude_none=True)
-    observation = document["scene"]["observation"]
-    if (observation["width"], observation["height"]) == size:
-        return scene
-    observation["width"], observation["height"] = size
+    """A copy of ``scene`` whose images are ``size`` and whose cameras are its RGB sensors
+    only (a depth camera is not part of the camera path; bench-deploy has its rows),
+    written into ``folder`` (JSON, which is YAML) after it validated."""
+    loaded = load_scene(scene)
+    rgb = {s.name for s in scene_robot(loaded).description.sensors if isinstance(s, RgbSensor)}
+    document = loaded.model_dump(mode="json", exclude_none=True)
+    document["scene"]["cameras"] = [c for c in document["scene"]["cameras"] if c in rgb]
+    document["scene"]["observation"]["width"], document["scene"]["observation"]["height"] = size
     path = folder / f"{scene.stem}_{size[0]}x{size[1]}.yaml"
     path.write_text(json.dumps(document, indent=2) + "\n")
     load_scene(path)  # refuse a copy the loader would refuse, here rather than in a child

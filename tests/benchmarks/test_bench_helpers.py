@@ -41,10 +41,12 @@ def test_the_highest_rate_sustained_stops_at_the_first_failure() -> None:
     assert highest_sustained({5.0: {"a": 4.0}}) is None
 
 
-def test_a_sized_copy_of_a_scene_loads_with_the_new_size(tmp_path: Path) -> None:
+def test_a_sized_copy_of_a_scene_loads_with_the_new_size_and_its_rgb_cameras(
+    tmp_path: Path,
+) -> None:
     assert parse_size("640x480") == (640, 480)
-    copy = sized_scene(TABLETOP, (640, 480), tmp_path)
-    observation = load_scene(copy).scene.observation
-    assert (observation.width, observation.height) == (640, 480)
-    assert load_scene(copy).scene.cameras == load_scene(TABLETOP).scene.cameras
-    assert sized_scene(TABLETOP, (128, 128), tmp_path) == TABLETOP  # already that size
+    assert load_scene(TABLETOP).scene.cameras == ["agentview", "wrist", "front_depth"]
+    for size in ((640, 480), (128, 128)):
+        copy = load_scene(sized_scene(TABLETOP, size, tmp_path)).scene
+        assert (copy.observation.width, copy.observation.height) == size
+        assert copy.cameras == ["agentview", "wrist"]  # the depth camera is not the camera path

@@ -6,11 +6,13 @@ from benchmarks.sensor_streams import JOINT_STATE_RATE_HZ, sensor_streams
 from tests.conftest import ROBOTS
 
 
-def test_the_franka_tabletop_has_two_camera_streams_at_the_benchs_camera_rate() -> None:
+def test_the_franka_tabletop_has_two_cameras_at_the_benchs_rate_and_its_depth_camera() -> None:
     streams = sensor_streams(ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml", 12.0)
     assert [(s.topic, s.kind.__name__, s.rate_hz) for s in streams] == [
         ("/openral/cameras/agentview/image", "Image", 12.0),
         ("/openral/cameras/wrist/image", "Image", 12.0),
+        ("/openral/cameras/front_depth/depth", "Image", 5.0),
+        ("/openral/cameras/front_depth/points", "PointCloud2", 5.0),
     ]
 
 

@@ -80,8 +80,8 @@ def test_a_missing_scene_exits_1_with_one_line(tmp_path: Path) -> None:
 def test_a_scene_that_fails_at_configure_exits_1_with_one_line(tmp_path: Path) -> None:
     scene = tmp_path / "bad_camera.yaml"
     text = FRANKA_SCENE.read_text()
-    assert text.count("cameras: [agentview, wrist]") == 1
-    scene.write_text(text.replace("cameras: [agentview, wrist]", "cameras: [agentview, nosuch]"))
+    assert text.count("cameras: [agentview, wrist,") == 1
+    scene.write_text(text.replace("cameras: [agentview, wrist,", "cameras: [agentview, nosuch,"))
     process = deploy("--config", str(scene), domain=claim_domain_id())
     _, err = process.communicate(timeout=EXIT_WAIT_S)
     assert process.returncode == 1

@@ -1,8 +1,8 @@
 """Depth sensors of a native scene: metric depth, a cloud in the robot's base frame that
 matches ray-cast truth, and never a point on or within 1 cm of the robot itself.
 
-The scene is the franka tabletop with a depth camera added to a copy of the manifest: a
-fixed camera the scene frames around the robot, so the arm fills part of the view, and the
+The scene is the franka tabletop seen by the manifest's ``front_depth`` camera: a fixed
+camera the scene frames around the robot, so the arm fills part of the view, and the
 tabletop's 5 cm red cube sits in front of it.
 """
 
@@ -26,10 +26,6 @@ from typer.testing import CliRunner
 
 from tests.conftest import ROBOTS
 
-SENSOR = (
-    "  - {name: front_depth, kind: depth, fovy_deg: 58.0, width: 160, height: 120, rate_hz: 5.0,"
-    " frame_id: front_depth_optical_frame, range_m: [0.1, 4.0]}\n"
-)
 PROBE = "      - {name: probe, shape: sphere, size_m: [0.0005], position_m: [3.0, 3.0, 0.01]}\n"
 VISIBLE = np.array([1, 1, 1, 0, 0, 0], dtype=np.uint8)
 """Geom groups the renderer draws by default (what a camera sees)."""
@@ -37,16 +33,16 @@ VISIBLE = np.array([1, 1, 1, 0, 0, 0], dtype=np.uint8)
 
 @pytest.fixture(scope="module")
 def files(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
-    """(manifest, scene file): franka with a depth camera, the tabletop seen by it."""
-    folder = tmp_path_factory.mktemp("depth") / "franka_panda"
-    folder.mkdir()
-    text = (ROBOTS / "franka_panda" / "robot.yaml").read_text()
-    (folder / "robot.yaml").write_text(text.replace("sim:\n", SENSOR + "sim:\n", 1))
+    """(manifest, scene file): the franka, and its tabletop seen by its depth camera only,
+    with a tiny probe sphere parked far away (see ``_closest_robot_surface``)."""
+    folder = tmp_path_factory.mktemp("depth")
     scene_text = (ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml").read_text()
-    scene_text = scene_text.replace("cameras: [agentview, wrist]", "cameras: [front_depth]")
+    listed = "cameras: [agentview, wrist, front_depth]"
+    assert scene_text.count(listed) == 1
+    scene_text = scene_text.replace(listed, "cameras: [front_depth]")
     scene_text = scene_text.replace("    objects:\n", "    objects:\n" + PROBE)
     (folder / "tabletop.yaml").write_text(scene_text)
-    return folder / "robot.yaml", folder / "tabletop.yaml"
+    return ROBOTS / "franka_panda" / "robot.yaml", folder / "tabletop.yaml"
 
 
 @pytest.fixture(scope="module")

@@ -63,7 +63,7 @@ def test_sim_run_writes_frames_and_joint_states(tmp_path: Path) -> None:
 def test_a_camera_the_robot_does_not_have_is_an_error(tmp_path: Path) -> None:
     text = (ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml").read_text()
     bad = tmp_path / "scene.yaml"
-    bad.write_text(text.replace("cameras: [agentview, wrist]", "cameras: [agentview, belly]"))
+    bad.write_text(text.replace("cameras: [agentview, wrist,", "cameras: [agentview, belly,"))
     with pytest.raises(ManifestError) as info:
         build_sim_env_from_yaml(bad)
     (issue,) = info.value.issues

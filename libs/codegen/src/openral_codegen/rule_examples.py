@@ -136,8 +136,8 @@ RULE_BREAKS = (
         SchemaName.SCENE,
         4,
         SCENE_FILE,
-        "cameras: [agentview, wrist]",
-        "cameras: [agentview, wrist_cam]",
+        "cameras: [agentview, wrist, front_depth]",
+        "cameras: [agentview, wrist_cam, front_depth]",
         "openral_sim.scene_cameras.camera_sensors",
     ),
     RuleBreak(
