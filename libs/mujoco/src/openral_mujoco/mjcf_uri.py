@@ -104,12 +104,25 @@ def robot_model_file(robot: RobotDescription, manifest_dir: Path | None = None) 
     """
     if robot.sim is None:
         raise error_at(robot, ("sim",), "the robot has no sim block; it has no model")
+    return resolve_manifest_uri(robot, robot.sim.mjcf_uri, ("sim", "mjcf_uri"), manifest_dir)
+
+
+def resolve_manifest_uri(
+    robot: RobotDescription, uri: str, field: tuple[str, ...], manifest_dir: Path | None
+) -> Path:
+    """The checked MJCF file of ``uri``, a field of ``robot``'s manifest at ``field``,
+    relative to ``manifest_dir`` (default: the folder the manifest was loaded from, else
+    ``robots/<name>/``).
+
+    Raises:
+        ManifestError: At ``field``, saying why the URI does not give a usable file.
+    """
     source = source_file(robot)
     folder = manifest_dir or (source.parent if source else manifest_path(robot.name).parent)
     try:
-        return resolve_mjcf_uri(robot.sim.mjcf_uri, folder)
+        return resolve_mjcf_uri(uri, folder)
     except MjcfUriError as error:
-        raise error_at(robot, ("sim", "mjcf_uri"), f"{error.uri!r}: {error.problem}") from None
+        raise error_at(robot, field, f"{error.uri!r}: {error.problem}") from None
 
 
 def locate_mjcf_uri(uri: str, manifest_dir: Path | None = None) -> tuple[Path, Confinement | None]:

@@ -22,12 +22,11 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 from openral_core.errors import ManifestError
-from openral_core.located import error_at, source_file
+from openral_core.located import error_at
 from openral_core.models import RobotDescription
-from openral_core.registry import manifest_path
 from openral_core.tables import MobileBaseWiring
 
-from openral_mujoco.mjcf_uri import MjcfUriError, resolve_mjcf_uri
+from openral_mujoco.mjcf_uri import resolve_manifest_uri
 from openral_mujoco.model_cache import cached_model, mjcf_fingerprint
 
 IntArray = npt.NDArray[np.intp]
@@ -47,13 +46,8 @@ def base_model_file(robot: RobotDescription, manifest_dir: Path | None = None) -
     """
     if robot.mobile_base is None:
         raise error_at(robot, ("base",), "the robot has no mobile_base; it has no base model")
-    source = source_file(robot)
-    folder = manifest_dir or (source.parent if source else manifest_path(robot.name).parent)
-    try:
-        return resolve_mjcf_uri(robot.mobile_base.mjcf_uri, folder)
-    except MjcfUriError as error:
-        field = ("mobile_base", "mjcf_uri")
-        raise error_at(robot, field, f"{error.uri!r}: {error.problem}") from None
+    field = ("mobile_base", "mjcf_uri")
+    return resolve_manifest_uri(robot, robot.mobile_base.mjcf_uri, field, manifest_dir)
 
 
 def compile_base_model(robot: RobotDescription, path: Path) -> mujoco.MjModel:
