@@ -57,6 +57,15 @@ def test_two_objects_with_one_name_are_refused_by_the_loader(tmp_path: Path) -> 
     assert "duplicate object name 'red_cube' (also at scene.options.objects[0].name)" in message
 
 
+def _ur5e_scene(tmp_path: Path) -> Path:
+    """The franka tabletop for the ur5e, with the two cameras both robots have."""
+    scene = _copy(tmp_path, FRANKA_SCENE, "robot_id: franka_panda", "robot_id: ur5e")
+    text = scene.read_text()
+    assert text.count("cameras: [agentview, wrist, front_depth]") == 1
+    scene.write_text(text.replace("agentview, wrist, front_depth]", "agentview, wrist]"))
+    return scene
+
+
 def test_floating_base_on_a_fixed_robot_is_refused_at_the_field(tmp_path: Path) -> None:
     manifest = _copy(
         tmp_path,
@@ -74,7 +83,7 @@ def test_floating_base_on_a_fixed_robot_is_refused_at_the_field(tmp_path: Path) 
     assert (base.file, base.line) == (manifest, _line_of(manifest, "floating_base"))
     assert "the manifest says true, the model has no free joint at qpos 0" in base.message
     assert not hal.connected
-    scene = _copy(tmp_path, FRANKA_SCENE, "robot_id: franka_panda", "robot_id: ur5e")
+    scene = _ur5e_scene(tmp_path)
     with pytest.raises(ManifestError, match=r"robot\.yaml:\d+:\d+: sim\.floating_base: "):
         NativeScene(load_scene(scene), robot)
 
@@ -87,7 +96,7 @@ def test_a_manifest_camera_the_model_lacks_is_refused_at_the_field(tmp_path: Pat
         "    kind: rgb\n    camera: no_such_camera",
         folder="ur5e",
     )
-    scene = _copy(tmp_path, FRANKA_SCENE, "robot_id: franka_panda", "robot_id: ur5e")
+    scene = _ur5e_scene(tmp_path)
     with pytest.raises(ManifestError) as error:
         NativeScene(load_scene(scene), open_robot(manifest))
     file, line, field, message = _only_issue(error)
