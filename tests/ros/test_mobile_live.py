@@ -4,8 +4,8 @@ subprocess, read and driven by a client on a domain of its own, as a nav stack w
 - ``/scan`` has finite ranges (walls all round), the head depth camera's cloud is not empty,
   ``/odom`` is published;
 - ``/cmd_vel`` at 0.3 m/s, sent at 20 Hz for 2.0 s and then a zero Twist, moves the base
-  0.6 ± 0.05 m along x in ``/odom`` (the control loop runs in real time, so 2.0 s of wall
-  time is 2.0 s of simulated time);
+  0.6 ± 0.05 m along x in ``/odom`` and on ``/joint_states`` (its x slide); the control
+  loop runs in real time, so 2.0 s of wall time is 2.0 s of simulated time;
 - after the E-stop is latched the base is at a standstill within 0.2 s (of wall time, in
   ``/odom``), and ``/cmd_vel`` no longer moves it.
 """
@@ -19,10 +19,10 @@ import numpy as np
 import pytest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
-from openral_bridge.topics import CMD_VEL, ESTOP, ODOM, SCAN, depth_points
+from openral_bridge.topics import CMD_VEL, ESTOP, JOINT_STATES, ODOM, SCAN, depth_points
 from openral_nodes.runtime import Spinner, claim_domain_id, ros_session
 from openral_nodes.topic_codec import cloud_points
-from sensor_msgs.msg import LaserScan, PointCloud2
+from sensor_msgs.msg import JointState, LaserScan, PointCloud2
 from std_srvs.srv import Trigger
 
 from tests.conftest import ROBOTS
@@ -57,7 +57,7 @@ class Client:
 def client(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Client]:
     logs = tmp_path_factory.mktemp("mobile_live")
     domain = claim_domain_id()
-    topics = {SCAN: LaserScan, POINTS: PointCloud2, ODOM: Odometry}
+    topics = {SCAN: LaserScan, POINTS: PointCloud2, ODOM: Odometry, JOINT_STATES: JointState}
     with ros_session(domain_id=domain) as context, deploy_sim(ROOM, domain, logs) as process:
         probe = Probe(context, topics, name="mobile_client")
         with Spinner(context) as spinner:
@@ -85,14 +85,24 @@ def test_scan_cloud_and_odom_are_published(client: Client) -> None:
     assert (odom.header.frame_id, odom.child_frame_id) == ("odom", "base_link")
 
 
+def _forward_slide(client: Client) -> float:
+    """The base's x slide [m] on the latest /joint_states (after the manifest's joints)."""
+    msg = client.probe.latest(JOINT_STATES)
+    assert list(msg.name[:8]) == [f"panda_joint{i}" for i in range(1, 8)] + ["panda_finger_joint1"]
+    return float(msg.position[list(msg.name).index("joint_mobile_forward")])
+
+
 def test_cmd_vel_for_2_s_moves_the_base_0_6_m(client: Client) -> None:
     x0 = client.probe.latest(ODOM).pose.pose.position.x
+    slide0 = _forward_slide(client)
     client.drive(0.3, 2.0)
     client.drive(0.0, 0.0)
     time.sleep(1.0)  # the ramp down, and /odom of the standstill
     odom = client.probe.latest(ODOM)
     print(f"/cmd_vel 0.3 m/s for 2.0 s: {odom.pose.pose.position.x - x0:.4f} m in /odom")
     assert odom.pose.pose.position.x - x0 == pytest.approx(0.6, abs=0.05)
+    print(f"joint_mobile_forward on /joint_states: {_forward_slide(client) - slide0:.4f} m")
+    assert _forward_slide(client) - slide0 == pytest.approx(0.6, abs=0.05)  # the scene's
     assert abs(odom.pose.pose.position.y) < 0.02
     assert abs(odom.twist.twist.linear.x) < 0.01
 

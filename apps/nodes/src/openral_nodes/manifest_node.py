@@ -68,7 +68,7 @@ from openral_core.errors import OpenralError
 from openral_core.models import DeployScene, RobotDescription
 from openral_hal.errors import EStopLatched, HalError, NotConnected
 from openral_hal.factory import build_hal, can_tick
-from openral_hal.protocol import RobotHal
+from openral_hal.protocol import MobileBaseHal, RobotHal
 from openral_mujoco.action import validated_action
 from openral_sim.rollout import SimRollout
 from openral_sim.scene import build_scene
@@ -313,7 +313,10 @@ class ManifestLifecycleNode(LifecycleNode):
         spec.publish(spec_msg)
         rate_hz = float(self._param("joint_state_rate_hz"))
         latest = (lambda: loop.state) if (loop := self.loop) is not None else None
-        self.states = JointStatePublisher(self, hal, self.hal_lock, rate_hz, latest=latest)
+        base = hal.base if isinstance(hal, MobileBaseHal) else None
+        self.states = JointStatePublisher(
+            self, hal, self.hal_lock, rate_hz, latest=latest, base=base
+        )
         self.states.start(pacer)
         self._entities += [
             ("publisher", spec),

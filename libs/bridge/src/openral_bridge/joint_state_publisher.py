@@ -2,7 +2,10 @@
 
 Each message carries every manifest joint (name, position, velocity, effort) of one
 :meth:`RobotHal.read_state`, stamped in simulated time (the node clock for a HAL without
-one). The state is read holding the HAL's lock, so it is never read in the middle of a
+one). A robot with a mobile base adds its drive joints after them, under their MJCF names
+(``BaseDrive.joint_state``: the x and y slides [m] and the yaw hinge [rad]), so the scene's
+base pose is on ``/joint_states`` too; the action contract has no base slots.
+The state is read holding the HAL's lock, so it is never read in the middle of a
 control tick; the message is built and published after the lock is released.
 
 A simulated scene changes only when the control loop ticks, and the loop reads the state
@@ -18,8 +21,10 @@ import threading
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
 from openral_hal.protocol import RobotHal
 from openral_mujoco.state import JointStateSample
+from openral_sim.base_drive import BaseDrive
 from sensor_msgs.msg import JointState
 
 from openral_bridge import ros_messages
@@ -53,6 +58,7 @@ class JointStatePublisher:
         rate_hz: float,
         *,
         latest: LatestFn | None = None,
+        base: BaseDrive | None = None,
     ) -> None:
         """Nothing is created until :meth:`start`.
 
@@ -63,12 +69,14 @@ class JointStatePublisher:
             rate_hz: Publish rate [Hz].
             latest: The state as of the last control tick (see the module doc); None, or
                 a None from it, reads the HAL.
+            base: The robot's mobile base, whose drive joints are appended (None: none).
         """
         self.node = node
         self.hal = hal
         self.lock = lock
         self.rate_hz = float(rate_hz)
         self.latest = latest
+        self.base = base
         self.published = 0
         """Messages published since :meth:`start`."""
         self._publisher: Any = None
@@ -113,8 +121,15 @@ class JointStatePublisher:
         if self._message is not None and self._message[0] is sample:
             return self._message[1]
         stamp = sim_stamp(self.node, sample.sim_time_s)
-        message = ros_messages.joint_state_msg(
-            sample.names, sample.positions, sample.velocities, sample.efforts, stamp
-        )
+        names, positions = sample.names, sample.positions
+        velocities, efforts = sample.velocities, sample.efforts
+        if self.base is not None:  # read on the pacer's thread, which also ticks: same state
+            with self.lock:
+                base = self.base.joint_state()
+            names += base.names
+            positions = np.concatenate([positions, base.positions])
+            velocities = np.concatenate([velocities, base.velocities])
+            efforts = np.concatenate([efforts, base.efforts])
+        message = ros_messages.joint_state_msg(names, positions, velocities, efforts, stamp)
         self._message = (sample, message)
         return message

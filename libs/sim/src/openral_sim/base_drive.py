@@ -32,6 +32,7 @@ is exact and current after every step.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 
 import mujoco
@@ -40,7 +41,7 @@ from openral_core.tables import MobileBaseWiring
 from openral_mujoco.errors import ActionRejected
 from openral_mujoco.joint_driver import SLEW_CHUNK_STEPS
 from openral_mujoco.mobile_base import DriveGeometry, drive_geometry
-from openral_mujoco.state import FloatArray
+from openral_mujoco.state import FloatArray, JointStateSample
 
 BASE_UPDATE_STEPS = SLEW_CHUNK_STEPS
 """Physics steps between two updates of the base's actuators (10 ms on a 2 ms step): the
@@ -222,4 +223,18 @@ class BaseDrive:
             sim_time_s=float(data.time),
             odom_frame=self.wiring.odom_frame,
             base_frame=self.wiring.base_frame,
+        )
+
+    def joint_state(self) -> JointStateSample:
+        """The drive joints (x, y, yaw, by their MJCF names) as the scene's data holds them
+        now: positions [m, m, rad], velocities [m/s, m/s, rad/s] and actuator forces [N,
+        N, N·m], for ``/joint_states`` beside the manifest's joints."""
+        geometry, data = self.geometry, self._data
+        return JointStateSample(
+            names=self.wiring.joints,
+            positions=data.qpos[geometry.qpos].copy(),
+            velocities=data.qvel[geometry.dof].copy(),
+            efforts=data.qfrc_actuator[geometry.dof].copy(),
+            stamp_ns=time.monotonic_ns(),
+            sim_time_s=float(data.time),
         )
