@@ -38,7 +38,7 @@ import numpy as np
 import numpy.typing as npt
 from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
 from openral_hal.protocol import CameraHal, MujocoBacked, RobotHal
-from openral_hal.sim_attached import SimAttachedHAL
+from openral_hal.sim_attached import native_scene
 from openral_mujoco.display import has_display
 from openral_sim.native_scene import NativeScene
 
@@ -210,7 +210,7 @@ class SimSensorBridge:
         hal = self.hal
         if not isinstance(hal, CameraHal):
             return
-        scene = self._native_scene()
+        scene = native_scene(hal)
         rendered = set(scene.camera_names) if scene else set(hal.read_images())
         for sensor in self.description.sensors:
             if isinstance(sensor, RgbSensor) and sensor.name in rendered:
@@ -238,13 +238,6 @@ class SimSensorBridge:
         rate = self.camera_rate_hz if self.camera_rate_hz is not None else sensor.rate_hz
         messages = CameraMessages(sensor.frame_id, fovy)
         self._cameras[sensor.name] = _Camera(sensor, float(rate), messages, image, info)
-
-    def _native_scene(self) -> NativeScene | None:
-        """The native scene behind the HAL (it renders on demand), else None."""
-        hal = self.hal
-        if isinstance(hal, SimAttachedHAL) and isinstance(hal.env, NativeScene):
-            return hal.env
-        return None
 
     def _start_renderer(self, scene: NativeScene) -> None:
         """Render this scene's cameras on a thread of their own; the scene stops rendering
