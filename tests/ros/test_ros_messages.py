@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 from openral_bridge.ros_messages import (
     camera_info_msg,
-    depth_to_points,
     image_msg,
     joint_state_msg,
     laser_scan_msg,
@@ -81,14 +80,3 @@ def test_point_cloud_round_trips_xyz() -> None:
     assert np.array_equal(np.frombuffer(bytes(msg.data), np.float32).reshape(2, 3), points)
     with pytest.raises(ValueError, match="N x 3"):
         point_cloud_msg(np.zeros((2, 2)), stamp(0), "base")
-
-
-def test_depth_back_projection_puts_the_centre_ray_on_the_axis() -> None:
-    depth = np.full((3, 3), 2.0, np.float32)
-    depth[0, 0] = 50.0  # out of range: dropped
-    points = depth_to_points(depth, 90.0, (0.1, 10.0))
-    assert len(points) == 8
-    centre = points[3]  # row 1, col 1 (after the dropped pixel)
-    assert centre == pytest.approx([0.0, 0.0, 2.0])
-    # focal = 1.5 px; the pixel right of the centre is one pixel off-axis: x = z / f
-    assert points[4] == pytest.approx([2.0 / 1.5, 0.0, 2.0])

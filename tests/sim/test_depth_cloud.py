@@ -20,7 +20,7 @@ import pytest
 from openral_cli.main import app
 from openral_core import open_robot
 from openral_core.loader import load_scene
-from openral_sim.depth_cloud import near_any
+from openral_sim.depth_cloud import focal_length_px, near_any, pixel_rays
 from openral_sim.native_scene import NativeScene
 from typer.testing import CliRunner
 
@@ -207,3 +207,13 @@ def _read_png16(path: Path) -> npt.NDArray[np.float64]:
         offset += 12 + length
     rows = np.frombuffer(zlib.decompress(chunks), np.uint8).reshape(height, 1 + 2 * width)
     return rows[:, 1:].copy().view(">u2").astype(np.float64)
+
+
+def test_pixel_rays_put_the_centre_ray_on_the_axis_one_focal_length_per_pixel() -> None:
+    focal = focal_length_px(3, 90.0)
+    assert focal == pytest.approx(1.5)  # (height / 2) / tan(fovy / 2)
+    rays = pixel_rays(3, 3, focal)  # MuJoCo's camera frame: x right, y up, along -z
+    assert rays[1, 1] == pytest.approx([0.0, 0.0, -1.0])
+    # the pixel right of the centre is one pixel off-axis: x = z / f; the one above, y = z / f
+    assert rays[1, 2] == pytest.approx([1.0 / 1.5, 0.0, -1.0])
+    assert rays[0, 1] == pytest.approx([0.0, 1.0 / 1.5, -1.0])

@@ -6,13 +6,13 @@ vertical field of view, joint states, laser scans and xyz point clouds.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 from builtin_interfaces.msg import Time
+from openral_sim.depth_cloud import focal_length_px
 from sensor_msgs.msg import (
     CameraInfo,
     Image,
@@ -58,16 +58,12 @@ def image_msg(image: npt.NDArray[Any], stamp_msg: Any, frame_id: str) -> Any:
     return msg
 
 
-def focal_px(height: int, fovy_deg: float) -> float:
-    """Focal length [px] of an ideal square-pixel pinhole: ``(height / 2) / tan(fovy / 2)``."""
-    return (height / 2.0) / math.tan(math.radians(fovy_deg) / 2.0)
-
-
 def camera_info_msg(width: int, height: int, fovy_deg: float, stamp_msg: Any, frame_id: str) -> Any:
     """``sensor_msgs/CameraInfo`` of an ideal pinhole (MuJoCo's camera model).
 
-    Square pixels (:func:`focal_px`), principal point at the image centre, no distortion;
-    ROS puts pixel centres on integer coordinates, so the centre is
+    Square pixels (:func:`~openral_sim.depth_cloud.focal_length_px`, the focal length the
+    depth clouds use too), principal point at the image centre, no distortion; ROS puts
+    pixel centres on integer coordinates, so the centre is
     ``((width - 1) / 2, (height - 1) / 2)``.
 
     Args:
@@ -75,7 +71,7 @@ def camera_info_msg(width: int, height: int, fovy_deg: float, stamp_msg: Any, fr
         height: Image height [px].
         fovy_deg: Vertical field of view [deg].
     """
-    focal = focal_px(height, fovy_deg)
+    focal = focal_length_px(height, fovy_deg)
     cx, cy = (width - 1) / 2.0, (height - 1) / 2.0
     msg = CameraInfo()
     msg.header.stamp = stamp_msg
@@ -156,21 +152,3 @@ def point_cloud_msg(points: FloatArray, stamp_msg: Any, frame_id: str) -> Any:
     msg.is_dense = bool(np.isfinite(xyz).all())
     msg.data = xyz.tobytes()
     return msg
-
-
-def depth_to_points(
-    depth_m: FloatArray, fovy_deg: float, range_m: tuple[float, float]
-) -> npt.NDArray[np.float32]:
-    """Back-project a depth image into optical-frame points (x right, y down, z forward).
-
-    Pixels outside ``range_m`` are dropped.
-    """
-    depth = np.asarray(depth_m, dtype=np.float32)
-    height, width = depth.shape
-    focal = focal_px(height, fovy_deg)
-    rows, cols = np.indices((height, width), dtype=np.float32)
-    keep = (depth >= range_m[0]) & (depth <= range_m[1])
-    z = depth[keep]
-    x = (cols[keep] + 0.5 - width / 2.0) * z / focal
-    y = (rows[keep] + 0.5 - height / 2.0) * z / focal
-    return np.stack([x, y, z], axis=1).astype(np.float32)
