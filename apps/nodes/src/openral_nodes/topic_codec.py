@@ -37,16 +37,7 @@ def image_to_rgb(msg: Any) -> npt.NDArray[np.uint8]:
             f"image encoding {msg.encoding!r} is not supported; expected one of "
             f"{', '.join(CHANNELS)}"
         )
-    height, width, step = int(msg.height), int(msg.width), int(msg.step)
-    row_bytes = width * channels
-    buffer = np.frombuffer(msg.data, dtype=np.uint8)
-    if step < row_bytes or buffer.size < step * height:
-        raise ImageEncodingError(
-            f"malformed {msg.encoding} image: {width}x{height}, step {step}, "
-            f"{buffer.size} data bytes (need step >= {row_bytes} and {step * height} bytes)"
-        )
-    rows = buffer[: step * height].reshape(height, step)[:, :row_bytes]
-    pixels = rows.reshape(height, width, channels)
+    pixels = _pixel_bytes(msg, channels).reshape(int(msg.height), int(msg.width), channels)
     if msg.encoding == "bgr8":
         pixels = pixels[:, :, ::-1]
     elif msg.encoding == "mono8":
@@ -68,19 +59,28 @@ def depth_metres(msg: Any) -> npt.NDArray[np.float32]:
         )
     code, scale = kind
     dtype = np.dtype((">" if msg.is_bigendian else "<") + code)
-    height, width, step = int(msg.height), int(msg.width), int(msg.step)
-    item = dtype.itemsize
-    buffer = np.frombuffer(msg.data, dtype=np.uint8)
-    if step < width * item or buffer.size < step * height:
-        raise ImageEncodingError(
-            f"malformed {msg.encoding} image: {width}x{height}, step {step}, "
-            f"{buffer.size} data bytes (need step >= {width * item} and {step * height} bytes)"
-        )
-    rows = buffer[: step * height].reshape(height, step)[:, : width * item]
+    rows = _pixel_bytes(msg, dtype.itemsize)
     values = rows.copy().view(dtype).astype(np.float32) * np.float32(scale)
     if code == "u2":
         values[values == 0] = np.nan
-    return values.reshape(height, width)
+    return values.reshape(int(msg.height), int(msg.width))
+
+
+def _pixel_bytes(msg: Any, pixel_bytes: int) -> npt.NDArray[np.uint8]:
+    """H x (W * ``pixel_bytes``) bytes of an Image's rows, its ``step`` padding dropped.
+
+    Raises:
+        ImageEncodingError: A step shorter than a row, or fewer bytes than the rows need.
+    """
+    height, width, step = int(msg.height), int(msg.width), int(msg.step)
+    row_bytes = width * pixel_bytes
+    buffer = np.frombuffer(msg.data, dtype=np.uint8)
+    if step < row_bytes or buffer.size < step * height:
+        raise ImageEncodingError(
+            f"malformed {msg.encoding} image: {width}x{height}, step {step}, "
+            f"{buffer.size} data bytes (need step >= {row_bytes} and {step * height} bytes)"
+        )
+    return buffer[: step * height].reshape(height, step)[:, :row_bytes]
 
 
 def depth_colours(depth_m: npt.NDArray[np.floating]) -> npt.NDArray[np.uint8]:
