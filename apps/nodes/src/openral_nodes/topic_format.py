@@ -61,26 +61,25 @@ def _cloud_summary(points: np.ndarray[Any, Any]) -> str:
     return f"{len(points)} points, {bounds} m"
 
 
+def _span(label: str, values: np.ndarray[Any, Any], none: str) -> str:
+    """``"<label> <min> to <max> m"`` of the finite ``values``, or ``none`` without one."""
+    finite = values[np.isfinite(values)]
+    if not finite.size:
+        return none
+    return f"{label} {format_value(float(finite.min()))} to {format_value(float(finite.max()))} m"
+
+
 def _scan_summary(ranges: np.ndarray[Any, Any]) -> str:
-    finite = ranges[np.isfinite(ranges)]
-    span = (
-        f"range {format_value(float(finite.min()))} to {format_value(float(finite.max()))} m"
-        if finite.size
-        else "no finite range"
-    )
+    span = _span("range", ranges, "no finite range")
     far, near = int(np.sum(ranges == np.inf)), int(np.sum(ranges == -np.inf))
     return f"{ranges.size} beams, {span}, {far} without a return (+inf), {near} too close (-inf)"
 
 
 def _depth_summary(depth: np.ndarray[Any, Any]) -> str:
-    seen = depth[np.isfinite(depth)]
-    span = (
-        f"depth {format_value(float(seen.min()))} to {format_value(float(seen.max()))} m"
-        if seen.size
-        else "no reading"
-    )
+    unseen = int(np.sum(~np.isfinite(depth)))
     height, width = depth.shape
-    return f"{width}x{height} depth image, {span}, {depth.size - seen.size} pixels without one"
+    span = _span("depth", depth, "no reading")
+    return f"{width}x{height} depth image, {span}, {unseen} pixels without one"
 
 
 def _lines(msg: Any, indent: int, max_items: int) -> list[str]:
