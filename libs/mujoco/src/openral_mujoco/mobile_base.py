@@ -27,7 +27,7 @@ from openral_core.models import RobotDescription
 from openral_core.tables import MobileBaseWiring
 
 from openral_mujoco.mjcf_uri import resolve_manifest_uri
-from openral_mujoco.model_cache import cached_model, mjcf_fingerprint
+from openral_mujoco.model_cache import cached_mjcf
 
 IntArray = npt.NDArray[np.intp]
 FloatArray = npt.NDArray[np.float64]
@@ -57,14 +57,12 @@ def compile_base_model(robot: RobotDescription, path: Path) -> mujoco.MjModel:
         ManifestError: At ``mobile_base.mjcf_uri`` when MuJoCo cannot load the file.
     """
 
-    def build() -> mujoco.MjModel:
-        try:
-            return mujoco.MjModel.from_xml_path(str(path))
-        except ValueError as error:
-            raise unloadable_base(robot, path, error) from None
+    return cached_base_model(robot, path)[0]
 
-    fingerprint = mjcf_fingerprint(path)
-    return cached_model(None if fingerprint is None else ("base", fingerprint), build)
+
+def cached_base_model(robot: RobotDescription, path: Path) -> tuple[mujoco.MjModel, str | None]:
+    """:func:`compile_base_model` and the fingerprint of the files it read (None: none)."""
+    return cached_mjcf(path, "base", lambda error: unloadable_base(robot, path, error))
 
 
 def base_spec(robot: RobotDescription, path: Path) -> mujoco.MjSpec:

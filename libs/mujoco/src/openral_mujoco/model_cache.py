@@ -102,6 +102,24 @@ def mjcf_fingerprint(path: Path) -> str | None:
         return None
 
 
+def cached_mjcf(
+    path: Path, kind: str, refused: Callable[[ValueError], Exception]
+) -> tuple[mujoco.MjModel, str | None]:
+    """The model of the MJCF file at ``path``, compiled or read from the cache under
+    ``kind`` (what the file is: ``robot``, ``base``), and its :func:`mjcf_fingerprint`
+    (None: not cached). MuJoCo's refusal (a ValueError) is raised as ``refused(error)``."""
+
+    def build() -> mujoco.MjModel:
+        try:
+            return mujoco.MjModel.from_xml_path(str(path))
+        except ValueError as error:  # MuJoCo's parser and compiler report this way
+            raise refused(error) from None
+
+    fingerprint = mjcf_fingerprint(path)
+    parts = None if fingerprint is None else (kind, fingerprint)
+    return cached_model(parts, build), fingerprint
+
+
 def cached_model(
     parts: Sequence[str] | None, build: Callable[[], mujoco.MjModel]
 ) -> mujoco.MjModel:

@@ -19,7 +19,7 @@ from openral_mujoco.mobile_base import (
     drive_problems,
     mount_problem,
 )
-from openral_mujoco.model_cache import cached_model, mjcf_fingerprint
+from openral_mujoco.model_cache import cached_mjcf
 
 
 @dataclass(frozen=True)
@@ -101,15 +101,14 @@ def compile_robot_model(description: RobotDescription, path: Path) -> mujoco.MjM
     Raises:
         ManifestError: At ``sim.mjcf_uri`` when MuJoCo cannot load the file.
     """
+    return cached_robot_model(description, path)[0]
 
-    def build() -> mujoco.MjModel:
-        try:
-            return mujoco.MjModel.from_xml_path(str(path))
-        except ValueError as error:  # MuJoCo's parser and compiler report this way
-            raise unloadable_model(description, path, error) from None
 
-    fingerprint = mjcf_fingerprint(path)
-    return cached_model(None if fingerprint is None else ("robot", fingerprint), build)
+def cached_robot_model(
+    description: RobotDescription, path: Path
+) -> tuple[mujoco.MjModel, str | None]:
+    """:func:`compile_robot_model` and the fingerprint of the files it read (None: none)."""
+    return cached_mjcf(path, "robot", lambda error: unloadable_model(description, path, error))
 
 
 def unloadable_model(description: RobotDescription, path: Path, error: Exception) -> ManifestError:

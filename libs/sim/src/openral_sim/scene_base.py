@@ -19,26 +19,22 @@ import numpy as np
 from openral_core.models import LidarSensor, RobotDescription
 from openral_core.tables import mobile_base_wiring
 from openral_mujoco.mjcf_uri import robot_model_file
-from openral_mujoco.mobile_base import base_model_file, base_spec, compile_base_model, mount_origin
-from openral_mujoco.model_cache import mjcf_fingerprint
-from openral_mujoco.model_check import compile_robot_model
+from openral_mujoco.mobile_base import base_model_file, base_spec, cached_base_model, mount_origin
+from openral_mujoco.model_check import cached_robot_model
 from openral_mujoco.state import FloatArray
 
 
 @dataclass(frozen=True)
 class RobotModels:
-    """The robot's model file and compiled model, and its mobile base's (None without one)."""
+    """The robot's model file and compiled model, its mobile base's (None without one), and
+    the model-cache fingerprints of every file they read (None: a file list that could not
+    be made, then nothing is cached)."""
 
     path: Path
     model: mujoco.MjModel
     base_path: Path | None
     base_model: mujoco.MjModel | None
-
-    def fingerprints(self) -> tuple[str, ...] | None:
-        """The model-cache fingerprint of every file the models read (None: unlistable)."""
-        paths = [self.path] if self.base_path is None else [self.path, self.base_path]
-        found = [mjcf_fingerprint(path) for path in paths]
-        return None if None in found else tuple(f for f in found if f is not None)
+    fingerprints: tuple[str, ...] | None
 
 
 def robot_models(robot: RobotDescription, folder: Path) -> RobotModels:
@@ -48,11 +44,19 @@ def robot_models(robot: RobotDescription, folder: Path) -> RobotModels:
         ManifestError: At ``sim.mjcf_uri`` or ``mobile_base.mjcf_uri``.
     """
     path = robot_model_file(robot, folder)
-    model = compile_robot_model(robot, path)
+    model, fingerprint = cached_robot_model(robot, path)
     if robot.mobile_base is None:
-        return RobotModels(path, model, None, None)
+        return RobotModels(path, model, None, None, _known(fingerprint))
     base_path = base_model_file(robot, folder)
-    return RobotModels(path, model, base_path, compile_base_model(robot, base_path))
+    base_model, base_fingerprint = cached_base_model(robot, base_path)
+    prints = _known(fingerprint, base_fingerprint)
+    return RobotModels(path, model, base_path, base_model, prints)
+
+
+def _known(*fingerprints: str | None) -> tuple[str, ...] | None:
+    """All of ``fingerprints``, or None when one is unknown."""
+    known = tuple(f for f in fingerprints if f is not None)
+    return known if len(known) == len(fingerprints) else None
 
 
 def attach_robot(

@@ -84,7 +84,7 @@ def compose(
     models = robot_models(robot, folder)
     require_agreement(robot, models.model, models.base_model)
     check_object_names(scene, models.model, models.base_model)
-    fingerprints = models.fingerprints()
+    fingerprints = models.fingerprints
     parts = None
     if fingerprints is not None:
         inputs = (scene.model_dump_json(), robot.model_dump_json(), json.dumps(cameras))
