@@ -203,8 +203,16 @@ class RangeBridge:
         if frames is None:
             self._publish_scan(name)
             return
-        if frames.error is not None:
-            raise RuntimeError(f"depth sensor {name} stopped rendering: {frames.error}")
+        if frames.error is not None:  # as a camera does: said once, its job ends
+            stream = self._streams[name]
+            if self._pacer is not None and stream.job is not None:
+                self._pacer.cancel(stream.job)
+                stream.job = None
+            self._log().error(
+                f"depth sensor {name} stopped rendering ({type(frames.error).__name__}: "
+                f"{frames.error}); the robot keeps running without its depth"
+            )
+            return
         with self.lock:
             frames.request(name)
 
