@@ -1,8 +1,9 @@
 """Drift guards: the JSON Schemas and the generated models accept exactly the same documents.
 
 Documents are drawn from the schemas themselves (hypothesis-jsonschema), then mutated.
-A document must be accepted or rejected by both jsonschema and the strict pydantic model;
-never by only one of them.
+A document must be accepted or rejected alike by jsonschema, by the model in JSON mode
+(how the loader calls it) and by the model in Python mode (``model_validate(dict)``, how a
+user calls the class); never by only some of them.
 """
 
 from __future__ import annotations
@@ -45,11 +46,19 @@ def _schema_accepts(name: SchemaName, document: Any) -> bool:
 
 
 def _model_accepts(name: SchemaName, document: Any) -> bool:
-    try:
-        MODELS[name].model_validate_json(json.dumps(document), strict=True)
-    except ValidationError:
-        return False
-    return True
+    """The model's verdict; JSON mode and Python mode must give the same one."""
+    verdicts = set()
+    for validate in (
+        lambda: MODELS[name].model_validate_json(json.dumps(document), strict=True),
+        lambda: MODELS[name].model_validate(copy.deepcopy(document)),
+    ):
+        try:
+            validate()
+            verdicts.add(True)
+        except ValidationError:
+            verdicts.add(False)
+    assert len(verdicts) == 1, f"JSON mode and Python mode disagree on {document!r}"
+    return verdicts.pop()
 
 
 def _nodes(document: Any, path: tuple[Any, ...] = ()) -> list[tuple[tuple[Any, ...], Any]]:
@@ -75,7 +84,9 @@ def _replace(document: Any, path: tuple[Any, ...], value: Any) -> Any:
     return result
 
 
-WRONG_TYPE_VALUES = st.sampled_from(["text", 3, 2.5, True, None, [], {}, 1e9, -1e9, 1.0])
+WRONG_TYPE_VALUES = st.sampled_from(
+    ["text", 3, 2.5, True, None, [], {}, 1e9, -1e9, 1.0, "2.5", "3"]
+)
 
 
 @st.composite
@@ -83,7 +94,7 @@ def mutated(draw: st.DrawFn, name: SchemaName) -> tuple[str, Any]:
     """A schema-valid document with one random mutation applied."""
     document = draw(from_schema(bundled_schema(name)))
     nodes = _nodes(document)
-    kind = draw(st.sampled_from(["extra_key", "wrong_type", "drop_key", "out_of_range"]))
+    kind = draw(st.sampled_from(["extra_key", "wrong_type", "drop_key", "out_of_range", "as_text"]))
     objects = [(p, n) for p, n in nodes if isinstance(n, dict)]
     if kind == "extra_key":
         path, node = draw(st.sampled_from(objects))
@@ -101,6 +112,9 @@ def mutated(draw: st.DrawFn, name: SchemaName) -> tuple[str, Any]:
     if not leaves:
         return kind, document
     path, leaf = draw(st.sampled_from(leaves))
+    if kind == "as_text":
+        # A lax model would coerce "2.175" to a number and "true"/1 to a bool.
+        return kind, _replace(document, path, json.dumps(leaf) if not isinstance(leaf, str) else 1)
     if kind == "out_of_range" and isinstance(leaf, int | float) and not isinstance(leaf, bool):
         return kind, _replace(document, path, draw(st.sampled_from([1e7, -1e7, 10**7, -1])))
     return kind, _replace(document, path, draw(WRONG_TYPE_VALUES))
@@ -129,3 +143,34 @@ def test_mutated_documents_get_the_same_verdict_from_schema_and_model(name: Sche
             assert not verdict
 
     check()
+
+
+def _manifests() -> list[tuple[str, Any]]:
+    from openral_core import robot_ids
+    from openral_core.paths import robots_dir
+    from ruamel.yaml import YAML
+
+    yaml = YAML(typ="safe")
+    return [(rid, yaml.load(robots_dir() / rid / "robot.yaml")) for rid in robot_ids()]
+
+
+@pytest.mark.parametrize(("robot", "manifest"), _manifests(), ids=lambda v: str(v)[:20])
+def test_every_number_and_flag_of_a_manifest_as_text_is_refused_alike(
+    robot: str, manifest: Any
+) -> None:
+    """Each numeric or boolean leaf of a real manifest, written as text ("2.175", "true")
+    or a number written as a bool, gets the schema's verdict from the model in both modes."""
+    assert _model_accepts(SchemaName.ROBOT, manifest), robot
+    leaves = [
+        (path, leaf)
+        for path, leaf in _nodes(manifest)
+        if path and isinstance(leaf, bool | int | float)
+    ]
+    assert leaves, robot
+    for path, leaf in leaves:
+        for wrong in (json.dumps(leaf), not leaf if isinstance(leaf, bool) else True):
+            document = _replace(manifest, path, wrong)
+            verdict = _schema_accepts(SchemaName.ROBOT, document)
+            assert verdict == _model_accepts(SchemaName.ROBOT, document), (robot, path, wrong)
+            if not isinstance(leaf, bool) or wrong != (not leaf):
+                assert not verdict, (robot, path, wrong)

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 from enum import Enum, StrEnum
+from pydantic import ConfigDict, Field, StrictFloat, StrictInt, StrictStr
 from typing import Annotated, Literal
-from pydantic import ConfigDict, Field
 from openral_base import OpenralModel
 from typing_extensions import TypeAliasType
 from . import sim_schema
@@ -29,7 +29,7 @@ class Type(StrEnum):
 
 
 PositionLimit = TypeAliasType(
-    "PositionLimit", Annotated[float, Field(ge=-1000.0, le=1000.0)]
+    "PositionLimit", Annotated[StrictFloat, Field(ge=-1000.0, le=1000.0)]
 )
 
 
@@ -42,7 +42,7 @@ class LimitedJoint(OpenralModel):
         extra="forbid",
     )
     name: Annotated[
-        str,
+        StrictStr,
         Field(
             examples=["panda_joint1", "shoulder_pan_joint"],
             pattern="^[A-Za-z][A-Za-z0-9_]{0,62}$",
@@ -62,16 +62,16 @@ class LimitedJoint(OpenralModel):
     """
     Lower and upper position limit [rad for revolute, m for prismatic]. The lower bound must be below the upper bound.
     """
-    velocity_limit: Annotated[float, Field(gt=0.0, le=1000.0)]
+    velocity_limit: Annotated[StrictFloat, Field(gt=0.0, le=1000.0)]
     """
     Largest allowed speed [rad/s for revolute and continuous, m/s for prismatic].
     """
-    effort_limit: Annotated[float, Field(gt=0.0, le=100000.0)]
+    effort_limit: Annotated[StrictFloat, Field(gt=0.0, le=100000.0)]
     """
     Largest allowed effort [N·m for revolute and continuous, N for prismatic].
     """
     sim_joint_name: Annotated[
-        str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+        StrictStr | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
     ] = None
     """
     The joint's name in the robot's native MJCF model where it differs from the canonical name (for example `joint1` for `panda_joint1`). Absent means the MJCF uses the canonical name. Robosuite's `robot0_` prefixes are stripped automatically and never written here.
@@ -87,7 +87,7 @@ class ContinuousJoint(OpenralModel):
         extra="forbid",
     )
     name: Annotated[
-        str,
+        StrictStr,
         Field(
             examples=["panda_joint1", "shoulder_pan_joint"],
             pattern="^[A-Za-z][A-Za-z0-9_]{0,62}$",
@@ -100,16 +100,16 @@ class ContinuousJoint(OpenralModel):
     """
     `continuous`: unbounded rotation, radians.
     """
-    velocity_limit: Annotated[float, Field(gt=0.0, le=1000.0)]
+    velocity_limit: Annotated[StrictFloat, Field(gt=0.0, le=1000.0)]
     """
     Largest allowed speed [rad/s for revolute and continuous, m/s for prismatic].
     """
-    effort_limit: Annotated[float, Field(gt=0.0, le=100000.0)]
+    effort_limit: Annotated[StrictFloat, Field(gt=0.0, le=100000.0)]
     """
     Largest allowed effort [N·m for revolute and continuous, N for prismatic].
     """
     sim_joint_name: Annotated[
-        str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+        StrictStr | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
     ] = None
     """
     The joint's name in the robot's native MJCF model where it differs from the canonical name (for example `joint1` for `panda_joint1`). Absent means the MJCF uses the canonical name. Robosuite's `robot0_` prefixes are stripped automatically and never written here.
@@ -130,7 +130,7 @@ class MountAxis(Enum):
 
 
 MountPositionMItem = TypeAliasType(
-    "MountPositionMItem", Annotated[float, Field(ge=-10.0, le=10.0)]
+    "MountPositionMItem", Annotated[StrictFloat, Field(ge=-10.0, le=10.0)]
 )
 
 
@@ -143,7 +143,8 @@ class RgbSensor(OpenralModel):
         extra="forbid",
     )
     name: Annotated[
-        str, Field(examples=["agentview", "wrist"], pattern="^[a-z][a-z0-9_]{0,62}$")
+        StrictStr,
+        Field(examples=["agentview", "wrist"], pattern="^[a-z][a-z0-9_]{0,62}$"),
     ]
     """
     Sensor name, unique within the robot. Topics are derived from it (`/openral/cameras/<name>/image`).
@@ -152,14 +153,14 @@ class RgbSensor(OpenralModel):
     """
     `rgb`: a colour camera.
     """
-    camera: Annotated[str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")] = (
-        None
-    )
+    camera: Annotated[
+        StrictStr | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+    ] = None
     """
     MJCF camera the sensor renders from (rgb and depth). Defaults to the sensor name.
     """
     robosuite_camera: Annotated[
-        str | None,
+        StrictStr | None,
         Field(
             examples=["robot0_eye_in_hand"], pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$"
         ),
@@ -168,7 +169,7 @@ class RgbSensor(OpenralModel):
     Camera in a robosuite environment's model this sensor renders from when a deploy scene uses `backend: robosuite`. Defaults to the sensor name (`agentview` is a camera every robosuite environment has). It sits on the sensor, next to `camera` (the name in the robot's own MJCF), because it is a fact about the robot that every robosuite scene of it shares: robosuite names the cameras it mounts on a robot after the robot's slot, such as `robot0_eye_in_hand` for the first robot's wrist camera.
     """
     mount_body: Annotated[
-        str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+        StrictStr | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
     ] = None
     """
     MJCF body (native name) the camera is rigidly attached to, such as the hand for a wrist camera. Absent means a fixed camera placed by the scene.
@@ -184,24 +185,24 @@ class RgbSensor(OpenralModel):
     """
     Position in `mount_body`'s frame [m] x, y, z: of the camera (rgb and depth; absent: the default placement, see mount_axis) or of the site the scene creates for a lidar (absent: the body's origin). Needs `mount_body`.
     """
-    fovy_deg: Annotated[float, Field(gt=0.0, lt=180.0)] = 45.0
+    fovy_deg: Annotated[StrictFloat, Field(gt=0.0, lt=180.0)] = 45.0
     """
     Vertical field of view [deg] of a camera the scene creates.
     """
-    width: Annotated[int, Field(ge=16, le=4096)]
+    width: Annotated[StrictInt, Field(ge=16, le=4096)]
     """
     Image width [px], 16 to 4096.
     """
-    height: Annotated[int, Field(ge=16, le=4096)]
+    height: Annotated[StrictInt, Field(ge=16, le=4096)]
     """
     Image height [px], 16 to 4096.
     """
-    rate_hz: Annotated[float, Field(ge=0.1, le=1000.0)]
+    rate_hz: Annotated[StrictFloat, Field(ge=0.1, le=1000.0)]
     """
     Nominal publish rate [Hz] on a real robot, 0.1 to 1000; the sim bridge's camera rate is a runtime setting.
     """
     frame_id: Annotated[
-        str,
+        StrictStr,
         Field(
             examples=["agentview_optical_frame"],
             pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$",
@@ -211,7 +212,7 @@ class RgbSensor(OpenralModel):
     TF frame of the sensor's optical centre, copied into message headers.
     """
     vla_feature_key: Annotated[
-        str | None,
+        StrictStr | None,
         Field(
             examples=["observation.images.camera1"],
             pattern="^observation\\.images\\.[a-z][a-z0-9_]{0,62}$",
@@ -222,7 +223,9 @@ class RgbSensor(OpenralModel):
     """
 
 
-RangeMItem = TypeAliasType("RangeMItem", Annotated[float, Field(ge=0.0, le=1000.0)])
+RangeMItem = TypeAliasType(
+    "RangeMItem", Annotated[StrictFloat, Field(ge=0.0, le=1000.0)]
+)
 
 
 class DepthSensor(OpenralModel):
@@ -234,7 +237,8 @@ class DepthSensor(OpenralModel):
         extra="forbid",
     )
     name: Annotated[
-        str, Field(examples=["agentview", "wrist"], pattern="^[a-z][a-z0-9_]{0,62}$")
+        StrictStr,
+        Field(examples=["agentview", "wrist"], pattern="^[a-z][a-z0-9_]{0,62}$"),
     ]
     """
     Sensor name, unique within the robot. Topics are derived from it (`/openral/cameras/<name>/image`).
@@ -243,14 +247,14 @@ class DepthSensor(OpenralModel):
     """
     `depth`: a depth camera (depth image and point cloud).
     """
-    camera: Annotated[str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")] = (
-        None
-    )
+    camera: Annotated[
+        StrictStr | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+    ] = None
     """
     MJCF camera the sensor renders from (rgb and depth). Defaults to the sensor name.
     """
     mount_body: Annotated[
-        str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+        StrictStr | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
     ] = None
     """
     MJCF body (native name) the camera is rigidly attached to, such as the hand for a wrist camera. Absent means a fixed camera placed by the scene.
@@ -266,24 +270,24 @@ class DepthSensor(OpenralModel):
     """
     Position in `mount_body`'s frame [m] x, y, z: of the camera (rgb and depth; absent: the default placement, see mount_axis) or of the site the scene creates for a lidar (absent: the body's origin). Needs `mount_body`.
     """
-    fovy_deg: Annotated[float, Field(gt=0.0, lt=180.0)] = 45.0
+    fovy_deg: Annotated[StrictFloat, Field(gt=0.0, lt=180.0)] = 45.0
     """
     Vertical field of view [deg] of a camera the scene creates.
     """
-    width: Annotated[int, Field(ge=16, le=4096)]
+    width: Annotated[StrictInt, Field(ge=16, le=4096)]
     """
     Image width [px], 16 to 4096.
     """
-    height: Annotated[int, Field(ge=16, le=4096)]
+    height: Annotated[StrictInt, Field(ge=16, le=4096)]
     """
     Image height [px], 16 to 4096.
     """
-    rate_hz: Annotated[float, Field(ge=0.1, le=1000.0)]
+    rate_hz: Annotated[StrictFloat, Field(ge=0.1, le=1000.0)]
     """
     Nominal publish rate [Hz] on a real robot, 0.1 to 1000; the sim bridge's camera rate is a runtime setting.
     """
     frame_id: Annotated[
-        str,
+        StrictStr,
         Field(
             examples=["agentview_optical_frame"],
             pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$",
@@ -302,7 +306,7 @@ class DepthSensor(OpenralModel):
 
 
 AngleRangeDegItem = TypeAliasType(
-    "AngleRangeDegItem", Annotated[float, Field(ge=-360.0, le=360.0)]
+    "AngleRangeDegItem", Annotated[StrictFloat, Field(ge=-360.0, le=360.0)]
 )
 
 
@@ -315,7 +319,8 @@ class LidarSensor(OpenralModel):
         extra="forbid",
     )
     name: Annotated[
-        str, Field(examples=["agentview", "wrist"], pattern="^[a-z][a-z0-9_]{0,62}$")
+        StrictStr,
+        Field(examples=["agentview", "wrist"], pattern="^[a-z][a-z0-9_]{0,62}$"),
     ]
     """
     Sensor name, unique within the robot. Topics are derived from it (`/openral/cameras/<name>/image`).
@@ -324,12 +329,12 @@ class LidarSensor(OpenralModel):
     """
     `lidar`: a planar laser scanner.
     """
-    site: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
+    site: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
     """
     MJCF site the lidar's rays start from (lidar only): a site of the robot's (or its mobile base's) model, or, with `mount_body`, the name of the site a native scene creates there.
     """
     mount_body: Annotated[
-        str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+        StrictStr | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
     ] = None
     """
     MJCF body (native name, of the robot's or its mobile base's model) a native scene creates the lidar's `site` on, at `mount_position_m`, with the body's axes (the scan plane is the body's x-y plane), for a model that has no site where the lidar sits. Absent: `site` is a site of the model.
@@ -341,20 +346,20 @@ class LidarSensor(OpenralModel):
     """
     Position in `mount_body`'s frame [m] x, y, z: of the camera (rgb and depth; absent: the default placement, see mount_axis) or of the site the scene creates for a lidar (absent: the body's origin). Needs `mount_body`.
     """
-    width: Annotated[int, Field(ge=1, le=4096)]
+    width: Annotated[StrictInt, Field(ge=1, le=4096)]
     """
     Number of rays in one scan, 1 to 4096.
     """
-    height: Annotated[int, Field(ge=1, le=1)]
+    height: Annotated[StrictInt, Field(ge=1, le=1)]
     """
     Scan lines: always 1 (a planar lidar).
     """
-    rate_hz: Annotated[float, Field(ge=0.1, le=1000.0)]
+    rate_hz: Annotated[StrictFloat, Field(ge=0.1, le=1000.0)]
     """
     Nominal publish rate [Hz] on a real robot, 0.1 to 1000; the sim bridge's camera rate is a runtime setting.
     """
     frame_id: Annotated[
-        str,
+        StrictStr,
         Field(
             examples=["agentview_optical_frame"],
             pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$",
@@ -379,7 +384,7 @@ class LidarSensor(OpenralModel):
 
 
 MountQuatWxyzItem = TypeAliasType(
-    "MountQuatWxyzItem", Annotated[float, Field(ge=-1.0, le=1.0)]
+    "MountQuatWxyzItem", Annotated[StrictFloat, Field(ge=-1.0, le=1.0)]
 )
 
 
@@ -399,15 +404,15 @@ class DriveAxes(OpenralModel):
     model_config = ConfigDict(
         extra="forbid",
     )
-    x: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
+    x: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
     """
     Forward, along the base frame's x axis.
     """
-    y: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
+    y: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
     """
     Sideways, along the base frame's y axis (to the left).
     """
-    yaw: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
+    yaw: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
     """
     About the vertical (counter-clockwise seen from above).
     """
@@ -422,7 +427,7 @@ class MobileBase(OpenralModel):
         extra="forbid",
     )
     mjcf_uri: Annotated[
-        str,
+        StrictStr,
         Field(
             examples=["robosuite:bases/omron_mobile_base.xml"],
             pattern="^(file|pkg|robosuite):[A-Za-z0-9_./-]+$",
@@ -432,7 +437,8 @@ class MobileBase(OpenralModel):
     Where the base's MJCF model is found, resolved offline like `sim.mjcf_uri` (the same schemes `file:`, `pkg:` and `robosuite:`, and the same confinement: the model and every file it loads stay in the robot's folder or in the installed distribution).
     """
     mount_body: Annotated[
-        str, Field(examples=["support"], pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+        StrictStr,
+        Field(examples=["support"], pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$"),
     ]
     """
     Body of the base's model the robot's model is attached to: the robot's root bodies become its children.
@@ -483,37 +489,43 @@ class MobileBase(OpenralModel):
     """
     MJCF velocity actuators of the base's model (native names), one driving each of `joints`: ctrl is the joint's velocity [m/s, rad/s].
     """
-    max_linear_velocity_m_s: Annotated[float, Field(examples=[0.5], gt=0.0, le=10.0)]
+    max_linear_velocity_m_s: Annotated[
+        StrictFloat, Field(examples=[0.5], gt=0.0, le=10.0)
+    ]
     """
     Fastest planar speed of the base [m/s]: a command whose (vx, vy) is longer is scaled down to it, keeping its direction.
     """
-    max_angular_velocity_rad_s: Annotated[float, Field(examples=[1.0], gt=0.0, le=20.0)]
+    max_angular_velocity_rad_s: Annotated[
+        StrictFloat, Field(examples=[1.0], gt=0.0, le=20.0)
+    ]
     """
     Fastest turn about the vertical [rad/s]: a command's wz is clamped to it.
     """
     max_linear_acceleration_m_s2: Annotated[
-        float, Field(examples=[1.0], gt=0.0, le=50.0)
+        StrictFloat, Field(examples=[1.0], gt=0.0, le=50.0)
     ]
     """
     Largest change of the planar velocity [m/s²]: the velocity in force moves towards the command by at most this much per second, speeding up and slowing down.
     """
     max_angular_acceleration_rad_s2: Annotated[
-        float, Field(examples=[2.0], gt=0.0, le=100.0)
+        StrictFloat, Field(examples=[2.0], gt=0.0, le=100.0)
     ]
     """
     Largest change of the turn rate [rad/s²], as for max_linear_acceleration_m_s2.
     """
-    command_timeout_s: Annotated[float, Field(gt=0.0, le=60.0)] = 0.5
+    command_timeout_s: Annotated[StrictFloat, Field(gt=0.0, le=60.0)] = 0.5
     """
     Time [s] (simulated time in a scene) after the last velocity command at which the base is told to stop (it slows down at its acceleration limits), so a client that dies never leaves it driving.
     """
-    odom_frame: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")] = "odom"
+    odom_frame: Annotated[
+        StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")
+    ] = "odom"
     """
     TF frame of the odometry (REP 105): fixed in the world, where the base's frame was when the scene was reset.
     """
-    base_frame: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")] = (
-        "base_link"
-    )
+    base_frame: Annotated[
+        StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")
+    ] = "base_link"
     """
     TF frame of the base (REP 105), the child frame of the odometry: on the floor plane at the yaw joint's axis, turning with the base; velocity commands are given in it.
     """
@@ -532,13 +544,14 @@ class RobotDescription(OpenralModel):
     Version of this contract. Only "0.1" exists; additive fields keep the version.
     """
     name: Annotated[
-        str, Field(examples=["franka_panda", "ur5e"], pattern="^[a-z][a-z0-9_]{1,62}$")
+        StrictStr,
+        Field(examples=["franka_panda", "ur5e"], pattern="^[a-z][a-z0-9_]{1,62}$"),
     ]
     """
     Robot id: lower-case snake case, equal to the name of the folder under robots/ that holds this file. Used on the command line (`openral robot show <name>`) and as the default ROS namespace.
     """
     display_name: Annotated[
-        str, Field(examples=["Franka Emika Panda"], max_length=80, min_length=1)
+        StrictStr, Field(examples=["Franka Emika Panda"], max_length=80, min_length=1)
     ]
     """
     Human-readable name shown in tables and docs.

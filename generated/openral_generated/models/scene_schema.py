@@ -2,15 +2,15 @@
 
 from __future__ import annotations
 
+from pydantic import ConfigDict, Field, StrictBool, StrictFloat, StrictInt, StrictStr
 from typing import Annotated, Literal
-from pydantic import ConfigDict, Field
 from openral_base import OpenralModel
 from typing_extensions import TypeAliasType
 from enum import StrEnum
 
 
 PositionMItem = TypeAliasType(
-    "PositionMItem", Annotated[float, Field(ge=-100.0, le=100.0)]
+    "PositionMItem", Annotated[StrictFloat, Field(ge=-100.0, le=100.0)]
 )
 
 
@@ -30,11 +30,11 @@ class BasePose(OpenralModel):
     """
     Base position x, y, z [m].
     """
-    yaw_deg: Annotated[float, Field(ge=-360.0, le=360.0)] = 0.0
+    yaw_deg: Annotated[StrictFloat, Field(ge=-360.0, le=360.0)] = 0.0
     """
     Base rotation about the world z axis [deg].
     """
-    weld: bool = False
+    weld: StrictBool = False
     """
     Floating-base robots only: hold the root body at this pose with a weld constraint, as a gantry or a stand holds a humanoid that has no balance controller. The free joint stays in the model, so no joint address changes. An error on a fixed-base robot.
     """
@@ -48,11 +48,11 @@ class Observation(OpenralModel):
     model_config = ConfigDict(
         extra="forbid",
     )
-    width: Annotated[int, Field(ge=16, le=4096)]
+    width: Annotated[StrictInt, Field(ge=16, le=4096)]
     """
     Image width [px], 16 to 4096.
     """
-    height: Annotated[int, Field(ge=16, le=4096)]
+    height: Annotated[StrictInt, Field(ge=16, le=4096)]
     """
     Image height [px], 16 to 4096.
     """
@@ -68,10 +68,10 @@ class Shape(StrEnum):
     cylinder = "cylinder"
 
 
-SizeMItem = TypeAliasType("SizeMItem", Annotated[float, Field(gt=0.0, le=10.0)])
+SizeMItem = TypeAliasType("SizeMItem", Annotated[StrictFloat, Field(gt=0.0, le=10.0)])
 
 
-RgbaItem = TypeAliasType("RgbaItem", Annotated[float, Field(ge=0.0, le=1.0)])
+RgbaItem = TypeAliasType("RgbaItem", Annotated[StrictFloat, Field(ge=0.0, le=1.0)])
 
 
 class SceneObject(OpenralModel):
@@ -82,7 +82,7 @@ class SceneObject(OpenralModel):
     model_config = ConfigDict(
         extra="forbid",
     )
-    name: Annotated[str, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
+    name: Annotated[StrictStr, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
     """
     Body name of the object in the composed model.
     """
@@ -107,11 +107,11 @@ class SceneObject(OpenralModel):
     """
     Colour, each channel in [0, 1].
     """
-    mass_kg: Annotated[float, Field(gt=0.0, le=1000.0)] = 0.1
+    mass_kg: Annotated[StrictFloat, Field(gt=0.0, le=1000.0)] = 0.1
     """
     Mass [kg].
     """
-    free: bool = True
+    free: StrictBool = True
     """
     True: the object is loose (free joint); false: fixed to the world.
     """
@@ -125,21 +125,21 @@ class SceneOptions(OpenralModel):
     model_config = ConfigDict(
         extra="forbid",
     )
-    control_freq_hz: Annotated[float, Field(ge=1.0, le=2000.0)] = 20.0
+    control_freq_hz: Annotated[StrictFloat, Field(ge=1.0, le=2000.0)] = 20.0
     """
     How often an action is applied [Hz], 1 to 2000; each env.step advances 1/control_freq_hz seconds of physics.
     """
-    horizon: Annotated[int | None, Field(ge=1, le=100000000)] = None
+    horizon: Annotated[StrictInt | None, Field(ge=1, le=100000000)] = None
     """
     Steps after which an episode is truncated (robosuite); native scenes never end on their own.
     """
-    controller: Annotated[str | None, Field(pattern="^[A-Za-z][A-Za-z0-9_]{0,62}$")] = (
-        None
-    )
+    controller: Annotated[
+        StrictStr | None, Field(pattern="^[A-Za-z][A-Za-z0-9_]{0,62}$")
+    ] = None
     """
     robosuite controller config name (robosuite only), such as `BASIC`.
     """
-    table_height_m: Annotated[float | None, Field(gt=0.0, le=3.0)] = None
+    table_height_m: Annotated[StrictFloat | None, Field(gt=0.0, le=3.0)] = None
     """
     Height of the table top [m] (native tabletop only).
     """
@@ -159,7 +159,7 @@ class Backend(StrEnum):
 
 
 Camera = TypeAliasType(
-    "Camera", Annotated[str, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
+    "Camera", Annotated[StrictStr, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
 )
 
 
@@ -173,7 +173,8 @@ class NativeAssets(StrEnum):
 
 
 RobosuiteEnvironment = TypeAliasType(
-    "RobosuiteEnvironment", Annotated[str, Field(pattern="^[A-Z][A-Za-z0-9]{0,62}$")]
+    "RobosuiteEnvironment",
+    Annotated[StrictStr, Field(pattern="^[A-Z][A-Za-z0-9]{0,62}$")],
 )
 """
 A robosuite environment name, exactly as robosuite spells it (`Lift`, `PickPlaceCan`); checked against the installed robosuite when the scene is built.
@@ -188,7 +189,9 @@ class SceneSpec(OpenralModel):
     model_config = ConfigDict(
         extra="forbid",
     )
-    id: Annotated[str, Field(examples=["tabletop"], pattern="^[a-z][a-z0-9_]{0,62}$")]
+    id: Annotated[
+        StrictStr, Field(examples=["tabletop"], pattern="^[a-z][a-z0-9_]{0,62}$")
+    ]
     """
     Scene id, used in logs and output folder names.
     """
@@ -227,12 +230,13 @@ class DeployScene(OpenralModel):
     Version of this contract. Only "0.1" exists.
     """
     robot_id: Annotated[
-        str | None, Field(examples=["franka_panda"], pattern="^[a-z][a-z0-9_]{1,62}$")
+        StrictStr | None,
+        Field(examples=["franka_panda"], pattern="^[a-z][a-z0-9_]{1,62}$"),
     ] = None
     """
     Id of the robot (a folder under robots/) placed in the scene. May be left out in a robot-agnostic scene; the caller then supplies the robot.
     """
-    seed: Annotated[int, Field(ge=0, le=2147483647)] = 0
+    seed: Annotated[StrictInt, Field(ge=0, le=2147483647)] = 0
     """
     Seed for the backend's episode reset (object placement, noise). The same seed gives the same first frame.
     """

