@@ -12,13 +12,15 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import REPO
+from tests.docs.tutorial_output import ELISION, line_matches, match_all, match_prefix
 from tests.docs.tutorial_runner import (
     Command,
     FileWrite,
     TutorialRun,
     copy_repository,
-    found,
+    created_paths,
     parse_tutorial,
+    remove_created,
     sandbox_environment,
 )
 
@@ -69,18 +71,61 @@ def test_parser_reads_commands_output_exit_status_background_and_files() -> None
     ]
 
 
-def test_output_lines_match_loosely_with_ellipsis_wildcards() -> None:
-    output = "│ kuka_iiwa14  │      7 │ front, wrist │\nwrote /tmp/a/robots/x.yaml; ok"
-    assert found("│ kuka_iiwa14 │ 7 │ front, wrist │", output)
-    assert found("wrote …/robots/x.yaml…", output)
-    assert not found("│ kuka_iiwa14 │ 8 │", output)
+def test_a_shown_line_matches_loosely_within_itself() -> None:
+    shown = "│ kuka_iiwa14 │ 7 │ front, wrist │"
+    assert line_matches(shown, "│ kuka_iiwa14  │      7 │ front, wrist │")
+    assert line_matches("wrote …/robots/x.yaml…", "wrote /tmp/a/robots/x.yaml; ok")
+    assert line_matches("┏━┳━┓", "┏━━━━━┳━━━┓")
+    assert not line_matches("│ kuka_iiwa14 │ 8 │", "│ kuka_iiwa14 │ 8 │ extra │")
+    assert not line_matches("wrote x", "so we wrote x")
+
+
+def test_output_is_shown_in_full_unless_an_elision_line_marks_the_cut() -> None:
+    printed = ["a", "b", "c", "d"]
+    assert match_all(["a", "b", "c", "d"], printed)
+    assert not match_all(["a", "b", "d"], printed), "a silently dropped line"
+    assert not match_all(["a", "b", "c"], printed), "a silently dropped tail"
+    assert not match_all(["b", "c", "d"], printed), "a silently dropped head"
+    assert match_all(["a", ELISION, "d"], printed)
+    assert match_all([ELISION, "c", "d"], printed)
+    assert match_all(["a", "b", ELISION, "c", "d"], printed), "an elision may cover nothing"
+    assert not match_all(["a", ELISION, "b", "a"], printed), "order still counts"
+    assert match_prefix(["a", "b"], printed) == 2
+    assert match_prefix(["a", ELISION, "c"], printed) == 3
+    assert match_prefix(["b"], printed) is None
+
+
+def test_a_tutorial_runs_without_the_results_a_reader_committed(tmp_path: Path) -> None:
+    page = "\n".join(
+        [
+            "```console",
+            "$ openral robot scaffold --mjcf pkg:x/y.xml --name my_arm",
+            "```",
+            '```yaml title="robots/franka_panda/scenes/mine.yaml"',
+            "a: 1",
+            "```",
+        ]
+    )
+    steps = parse_tutorial(page, "t.md")
+    assert created_paths(steps) == ["robots/franka_panda/scenes/mine.yaml", "robots/my_arm"]
+    (tmp_path / "robots" / "franka_panda" / "scenes").mkdir(parents=True)
+    (tmp_path / "robots" / "franka_panda" / "scenes" / "mine.yaml").write_text("a: 0\n")
+    (tmp_path / "robots" / "franka_panda" / "scenes" / "tabletop.yaml").write_text("b: 0\n")
+    assert remove_created(tmp_path, steps, {**os.environ}) == [
+        "robots/franka_panda/scenes/mine.yaml"
+    ]
+    assert sorted(p.name for p in (tmp_path / "robots" / "franka_panda" / "scenes").iterdir()) == [
+        "tabletop.yaml"
+    ]
 
 
 def test_run_fails_on_missing_output_and_on_unexpected_exit_status(tmp_path: Path) -> None:
     env = {**os.environ}
     run = TutorialRun(tmp_path, tmp_path, env)
-    with pytest.raises(AssertionError, match="lacks \\['goodbye'\\]"):
+    with pytest.raises(AssertionError, match="'goodbye' differs from printed line 1 'hello'"):
         run.run(parse_tutorial("```console\n$ echo hello\ngoodbye\n```\n", "t.md"))
+    with pytest.raises(AssertionError, match="printed line 2 'two' is not shown"):
+        run.run(parse_tutorial("```console\n$ printf 'one\\ntwo\\n'\none\n```\n", "t.md"))
     with pytest.raises(AssertionError, match="exited 3, expected 0"):
         run.run(parse_tutorial("```console\n$ exit 3\n```\n", "t.md"))
     run.run(parse_tutorial("```console\n$ exit 3  # exit status 3\n```\n", "t.md"))
@@ -116,4 +161,5 @@ def test_tutorial_commands_run(tutorial: Path, tmp_path: Path, ros_domain: str) 
     env = sandbox_environment(sandbox, VENV_BIN, [_just_dir()])
     env["ROS_DOMAIN_ID"] = ros_domain
     steps = parse_tutorial(tutorial.read_text(), f"docs/tutorials/{tutorial.name}")
+    remove_created(sandbox, steps, env)
     TutorialRun(sandbox, logs, env).run(steps)

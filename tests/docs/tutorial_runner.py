@@ -6,14 +6,21 @@ them for writers):
 - A fenced ``console`` block holds commands, each on a line starting with ``$ `` (a line
   ending in ``\\`` continues on the next). They run from the repository root with bash, one
   shell per command, so ``cd`` and ``export`` do not carry over.
-- The other lines of a console block are expected output of the command above them. Each
-  must appear in that command's output (stdout and stderr), with runs of white space
-  compared as one space; ``…`` stands for any text.
+- The other lines of a console block are the output of the command above them (stdout and
+  stderr), shown in full: line for line, in order, blank lines aside. Within a line runs
+  of white space (and of one box-drawing rule character) compare as one and ``…`` stands
+  for any text; a line holding only ``⋮`` stands for any number of lines, the one way to
+  leave lines out (``tests/docs/tutorial_output.py``).
 - A command must exit 0, unless it ends with a comment ``# exit status N``.
 - A command ending in ``&`` starts in the background; when lines follow it, the run waits
-  until they have all appeared in its output. ``kill -INT %N`` signals background job N
-  (numbered from 1 in start order), ``wait`` or ``wait %N`` waits for jobs (they must exit
-  0) and matches the lines after it against their output.
+  until its output begins with them. ``kill -INT %N`` signals background job N (numbered
+  from 1 in start order), ``wait`` or ``wait %N`` waits for jobs not yet waited for (they
+  must exit 0); the lines after it are the rest of their output, in job order.
+- The run starts from a copy of the repository without what the tutorial itself creates:
+  every file a titled block writes, and the folder of each robot it scaffolds
+  (``openral robot scaffold … --name <id>``), are removed from the copy and the generated
+  tree is exported again. So a reader who completed a tutorial and committed its result
+  can still run it, and its test, as written.
 - A fenced block with ``title="<path>"`` is written to that path (relative to the
   repository root) when the run reaches it; other blocks are only shown.
 """
@@ -26,8 +33,16 @@ import shutil
 import signal
 import subprocess
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from tests.docs.tutorial_output import (
+    match_all,
+    match_prefix,
+    mismatch,
+    printed_lines,
+)
 
 FOREGROUND_TIMEOUT_S = 300.0
 """Longest a foreground command may run (a full `just docs` on a loaded machine)."""
@@ -127,11 +142,41 @@ def _console_commands(body: list[str], name: str, first_line: int) -> list[Comma
     return commands
 
 
-def found(expected: str, output: str) -> bool:
-    """Whether ``expected`` (``…`` = any text) occurs in one line of ``output``."""
-    parts = " ".join(expected.split()).split("…")
-    pattern = re.compile(".*?".join(re.escape(part) for part in parts))
-    return any(pattern.search(" ".join(line.split())) for line in output.splitlines())
+_SCAFFOLD = re.compile(r"\bopenral robot scaffold\b.*\s--name[ =](\w+)")
+
+
+def created_paths(steps: list[Step]) -> list[str]:
+    """What the tutorial itself creates: titled blocks' files and scaffolded robot folders."""
+    paths = [step.path for step in steps if isinstance(step, FileWrite)]
+    for step in steps:
+        scaffold = isinstance(step, Command) and _SCAFFOLD.search(step.text)
+        if scaffold:
+            paths.append(f"robots/{scaffold.group(1)}")
+    return paths
+
+
+def remove_created(sandbox: Path, steps: list[Step], env: dict[str, str]) -> list[str]:
+    """Remove from ``sandbox`` what ``steps`` create; re-export when a robot folder went."""
+    removed = []
+    for relative in created_paths(steps):
+        target = sandbox / relative
+        if target.is_dir():
+            shutil.rmtree(target)
+        elif target.exists():
+            target.unlink()
+        else:
+            continue
+        removed.append(relative)
+    if any(path.startswith("robots/") and path.count("/") == 1 for path in removed):
+        subprocess.run(
+            ["python", "-m", "openral_codegen", "export"],
+            cwd=sandbox,
+            env=env,
+            capture_output=True,
+            check=True,
+            timeout=FOREGROUND_TIMEOUT_S,
+        )
+    return removed
 
 
 def copy_repository(source: Path, target: Path) -> Path:
@@ -151,7 +196,6 @@ def sandbox_environment(sandbox: Path, venv_bin: Path, tools: list[Path]) -> dic
         "PATH": os.pathsep.join(path),
         "PYTHONPATH": os.pathsep.join(str(s) for s in sources),
         "MUJOCO_GL": "egl",
-        "COLUMNS": "120",
         "NO_MKDOCS_2_WARNING": "1",
     }
 
@@ -161,24 +205,44 @@ class _Job:
     command: Command
     process: subprocess.Popen[bytes]
     log: Path
+    shown: int = 0
+    """Lines of its output the tutorial has accounted for so far."""
+    waited: bool = False
 
     def output(self) -> str:
         return self.log.read_text("utf-8", errors="replace")
+
+    def lines(self) -> list[str]:
+        return printed_lines(self.output())
 
 
 class TutorialRun:
     """Runs the steps of one tutorial in ``sandbox``; background jobs log to ``logs``."""
 
-    def __init__(self, sandbox: Path, logs: Path, env: dict[str, str]) -> None:
+    def __init__(
+        self,
+        sandbox: Path,
+        logs: Path,
+        env: dict[str, str],
+        *,
+        prelude: str = "",
+        report: Callable[[Step], None] | None = None,
+    ) -> None:
         self.sandbox = sandbox
         self.logs = logs
         self.env = env
+        self.prelude = prelude
+        """Shell text run before each command (e.g. ``source .venv/bin/activate``)."""
+        self.report = report
+        """Called with each step before it runs."""
         self.jobs: list[_Job] = []
 
     def run(self, steps: list[Step]) -> None:
         """Run every step; raises AssertionError at the first one that misbehaves."""
         try:
             for step in steps:
+                if self.report is not None:
+                    self.report(step)
                 if isinstance(step, FileWrite):
                     target = self.sandbox / step.path
                     target.parent.mkdir(parents=True, exist_ok=True)
@@ -195,7 +259,7 @@ class TutorialRun:
     def _foreground(self, command: Command) -> None:
         started = time.monotonic()
         result = subprocess.run(
-            ["bash", "-c", command.text],
+            ["bash", "-c", self.prelude + command.text],
             cwd=self.sandbox,
             env=self.env,
             stdout=subprocess.PIPE,
@@ -216,7 +280,7 @@ class TutorialRun:
         log = self.logs / f"job{len(self.jobs) + 1}.log"
         with log.open("wb") as sink:
             process = subprocess.Popen(
-                ["bash", "-c", command.text],
+                ["bash", "-c", self.prelude + command.text],
                 cwd=self.sandbox,
                 env=self.env,
                 stdout=sink,
@@ -226,7 +290,7 @@ class TutorialRun:
         job = _Job(command, process, log)
         self.jobs.append(job)
         deadline = time.monotonic() + READY_TIMEOUT_S
-        while not all(found(line, job.output()) for line in command.expected):
+        while (shown := match_prefix(command.expected, job.lines())) is None:
             if process.poll() is not None or time.monotonic() > deadline:
                 state = "exited" if process.poll() is not None else "timed out"
                 raise AssertionError(
@@ -234,6 +298,7 @@ class TutorialRun:
                     f"{command.expected}; output:\n{job.output()}"
                 )
             time.sleep(0.2)
+        job.shown = shown
 
     def _job_control(self, command: Command) -> None:
         match = _JOB.match(command.text)
@@ -253,8 +318,8 @@ class TutorialRun:
                 if job.process.poll() is None:
                     os.killpg(job.process.pid, number)
             return
-        outputs = []
-        for job in jobs:
+        rest: list[str] = []
+        for job in (job for job in jobs if not job.waited):
             try:
                 code = job.process.wait(timeout=WAIT_TIMEOUT_S)
             except subprocess.TimeoutExpired:
@@ -267,14 +332,16 @@ class TutorialRun:
                     f"{job.command.where}: background `{job.command.text}` exited {code}; "
                     f"output:\n{job.output()}"
                 )
-            outputs.append(job.output())
-        self._check_output(command, command.expected, "\n".join(outputs))
+            job.waited = True
+            rest += job.lines()[job.shown :]
+        self._check_output(command, command.expected, "\n".join(rest))
 
     def _check_output(self, command: Command, expected: list[str], output: str) -> None:
-        missing = [line for line in expected if not found(line, output)]
-        if missing:
+        printed = printed_lines(output)
+        if not match_all(expected, printed):
             raise AssertionError(
-                f"{command.where}: output of `{command.text}` lacks {missing}; output:\n{output}"
+                f"{command.where}: output of `{command.text}` is not what the tutorial shows: "
+                f"{mismatch(expected, printed)}; output:\n{output}"
             )
 
     def _stop_all(self) -> None:
