@@ -234,7 +234,7 @@ class DeployScene(OpenralModel):
         Field(examples=["franka_panda"], pattern="^[a-z][a-z0-9_]{1,62}$"),
     ] = None
     """
-    Id of the robot (a folder under robots/) placed in the scene. May be left out in a robot-agnostic scene; the caller then supplies the robot.
+    Id of the robot (a folder under robots/) placed in the scene. A scene file under robots/<id>/scenes/ belongs to robot <id>: there robot_id may be left out (it is then <id>) and any other value is an error. Elsewhere it names the robot; left out, the caller must supply one (`openral sim run --robot`), else the scene is refused.
     """
     seed: Annotated[StrictInt, Field(ge=0, le=2147483647)] = 0
     """

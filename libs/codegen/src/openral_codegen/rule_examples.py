@@ -130,7 +130,7 @@ RULE_BREAKS = (
         SCENE_FILE,
         "robot_id: franka_panda",
         "robot_id: franka",
-        "openral_core.registry.manifest_path",
+        "openral_core.rules.scene_findings",
     ),
     RuleBreak(
         SchemaName.SCENE,

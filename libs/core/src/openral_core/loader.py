@@ -47,15 +47,30 @@ def load_robot(file: Path, *, check_folder_name: bool = True) -> RobotDescriptio
 def load_scene(file: Path) -> DeployScene:
     """Load and validate a deploy-scene file (the ``--config`` of sim run / deploy sim).
 
+    A file under ``robots/<id>/scenes/`` belongs to robot ``<id>``: its ``robot_id`` may be
+    left out (it is then ``<id>``) and any other value is refused at its line and column.
+
     Raises:
         ManifestError: With every problem found in the file.
     """
     document = load_located(file)
     scene = _build(document, SchemaName.SCENE, DeployScene)
-    findings = scene_findings(scene)
+    folder_robot = scene_folder_robot(file)
+    findings = scene_findings(scene, folder_robot)
     if findings:
         raise ManifestError(file, [document.issue(path, msg) for path, msg in findings])
+    if scene.robot_id is None and folder_robot is not None:
+        scene.robot_id = folder_robot
     return scene
+
+
+def scene_folder_robot(file: Path) -> str | None:
+    """``<id>`` when ``file`` (resolved: links and ``..`` followed) is
+    ``robots/<id>/scenes/<name>``, else None."""
+    parts = file.resolve().parts
+    if len(parts) >= 4 and parts[-2] == "scenes" and parts[-4] == "robots":
+        return parts[-3]
+    return None
 
 
 def validate_robot_file(file: Path, *, check_folder_name: bool = True) -> list[Issue]:

@@ -57,16 +57,32 @@ def robot_findings(robot: RobotDescription, folder_name: str | None) -> list[Fin
     ]
 
 
-def scene_findings(scene: DeployScene) -> list[Finding]:
+def scene_findings(scene: DeployScene, folder_robot: str | None = None) -> list[Finding]:
     """Every cross-field rule violation of a deploy scene that needs no robot manifest.
 
     Args:
         scene: A scene that already passed schema validation.
+        folder_robot: ``<id>`` when the file is under ``robots/<id>/scenes/``, else None.
     """
     options = scene.scene.options
     objects = options.objects if options is not None and options.objects else []
     located = [(("scene", "options", "objects", i, "name"), o.name) for i, o in enumerate(objects)]
-    return [*_unique(located, "object name"), *_object_sizes(objects)]
+    return [
+        *_robot_matches_folder(scene, folder_robot),
+        *_unique(located, "object name"),
+        *_object_sizes(objects),
+    ]
+
+
+def _robot_matches_folder(scene: DeployScene, folder_robot: str | None) -> Iterator[Finding]:
+    """A scene under ``robots/<id>/scenes/`` is for robot ``<id>`` (a copied robot folder
+    must not drive the robot it was copied from)."""
+    if folder_robot is not None and scene.robot_id not in (None, folder_robot):
+        yield (
+            ("robot_id",),
+            f"must be {folder_robot!r}, the robot whose folder robots/{folder_robot}/scenes/ "
+            f"holds this scene, or be left out; got {scene.robot_id!r}",
+        )
 
 
 SIZE_VALUES = {Shape.box: 3, Shape.sphere: 1, Shape.cylinder: 2}

@@ -27,11 +27,15 @@ def scene_robot(scene: DeployScene, robot_id_fallback: str | None = None) -> Loa
     """Load the robot ``scene`` names (else ``robot_id_fallback``) from ``robots/``.
 
     Raises:
-        ManifestError: The scene names no robot and none was given, or an unknown one
-            (located at the scene's ``robot_id``); or the robot's manifest is invalid.
+        ManifestError: The scene names no robot and none was given, another robot than
+            the one given, or an unknown one (located at the scene's ``robot_id``); or the
+            robot's manifest is invalid.
         StaleTables: The robot's generated tables were made from another manifest.
     """
     robot_id = scene.robot_id or robot_id_fallback
+    if robot_id_fallback is not None and robot_id != robot_id_fallback:
+        message = f"the scene is for {robot_id}, not {robot_id_fallback}"
+        raise error_at(scene, ("robot_id",), message)
     if robot_id is None:
         raise error_at(scene, (), "the scene names no robot and none was given; add robot_id")
     try:
