@@ -34,7 +34,10 @@ if TYPE_CHECKING:
     from openral_hal.protocol import RobotHal
 
 StageHook = Callable[[str], None]
-_SUMMARY = re.compile(r"^\d+ of \d+ robot\(s\) do not match their model$")
+_SUMMARY = re.compile(
+    r"^\d+ of \d+ robot\(s\) "
+    r"(do not match their model(; \d+ could not be checked)?|could not be checked)$"
+)
 _ANSI = re.compile(r"\x1b\[[0-9;]*m")
 
 

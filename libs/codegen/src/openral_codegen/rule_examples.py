@@ -138,7 +138,7 @@ RULE_BREAKS = (
         SCENE_FILE,
         "cameras: [agentview, wrist, front_depth]",
         "cameras: [agentview, wrist_cam, front_depth]",
-        "openral_sim.scene_cameras.camera_sensors",
+        "openral_sim.scene_checks.check_scene_cameras",
     ),
     RuleBreak(
         SchemaName.SCENE,

@@ -6,7 +6,8 @@ into one clear message and exit code instead of a traceback.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import difflib
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,6 +32,26 @@ def parse_field(text: str) -> PathKey:
             path.append(name)
         path.extend(int(index.rstrip("]")) for index in indices)
     return tuple(path)
+
+
+def did_you_mean(name: str, candidates: Iterable[str]) -> str:
+    """`` (did you mean joint1?)`` naming the closest of ``candidates`` to a misspelt
+    ``name`` (difflib's ratio of at least 0.6; up to three within 0.05 of the best), else ``''``.
+
+    The one helper every "not found" message uses: unknown keys, joints, cameras, bodies,
+    sites and scene cameras.
+    """
+    close = difflib.get_close_matches(name, [c for c in candidates if c != name], n=3)
+    if not close:
+        return ""
+    best = _likeness(name, close[0])
+    close = [c for c in close if _likeness(name, c) >= best - 0.05]
+    names = close[0] if len(close) == 1 else f"{', '.join(close[:-1])} or {close[-1]}"
+    return f" (did you mean {names}?)"
+
+
+def _likeness(a: str, b: str) -> float:
+    return difflib.SequenceMatcher(None, a, b).ratio()
 
 
 class OpenralError(Exception):

@@ -11,7 +11,7 @@ from typing import Any
 
 from jsonschema.exceptions import ValidationError
 
-from openral_core.errors import Issue
+from openral_core.errors import Issue, did_you_mean
 from openral_core.schemas import SchemaName, validator
 from openral_core.yaml_source import LocatedDocument, PathKey
 
@@ -87,7 +87,8 @@ def _explain(error: ValidationError, because: str = "") -> Iterable[tuple[PathKe
         for key in instance:
             if key not in known:
                 expected = f"; expected one of: {', '.join(known)}" if known else ""
-                yield (*path, key), f"unknown field {key!r}{expected}{because}"
+                hint = did_you_mean(key, known)
+                yield (*path, key), f"unknown field {key!r}{hint}{expected}{because}"
         return
     if kind == "required" and isinstance(instance, dict):
         for key in value:

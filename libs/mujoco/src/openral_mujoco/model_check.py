@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
-from openral_core.errors import ManifestError, OpenralError, parse_field
+from openral_core.errors import Issue, ManifestError, OpenralError, did_you_mean, parse_field
 from openral_core.located import error_at, issue_at
 from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
 from openral_core.tables import HalWiring, hal_wiring, mobile_base_wiring
@@ -125,11 +125,11 @@ def _joint_rows(
         native = joint.sim_joint_name or joint.name
         name_field = "sim_joint_name" if joint.sim_joint_name else "name"
         jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, native)
+        missing = "no such joint in the model" + did_you_mean(
+            native, model_names([model], mujoco.mjtObj.mjOBJ_JOINT)
+        )
         yield CheckRow(
-            f"joints[{index}].{name_field}",
-            native,
-            "found" if jid >= 0 else "no such joint in the model",
-            ok=jid >= 0,
+            f"joints[{index}].{name_field}", native, "found" if jid >= 0 else missing, ok=jid >= 0
         )
         if jid < 0:
             continue
@@ -229,7 +229,8 @@ def _mobile_base_rows(description: RobotDescription, model: mujoco.MjModel) -> I
         actuator = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
         jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)
         if actuator < 0:
-            actual, ok = "no such actuator", False
+            kind = mujoco.mjtObj.mjOBJ_ACTUATOR
+            actual, ok = "no such actuator" + did_you_mean(name, model_names([model], kind)), False
         elif jid < 0 or actuator_joints(model, actuator) != (jid,):
             actual, ok = "it drives another joint", False
         else:
@@ -263,7 +264,34 @@ def _sensor_rows(description: RobotDescription, models: list[mujoco.MjModel]) ->
 
 def _exists(field: str, name: str, kind: mujoco.mjtObj, models: list[mujoco.MjModel]) -> CheckRow:
     found = any(mujoco.mj_name2id(model, kind, name) >= 0 for model in models)
-    return CheckRow(field, name, "found" if found else "not in the model", ok=found)
+    missing = "not in the model" + did_you_mean(name, model_names(models, kind))
+    return CheckRow(field, name, "found" if found else missing, ok=found)
+
+
+_COUNTS = {
+    mujoco.mjtObj.mjOBJ_JOINT: "njnt",
+    mujoco.mjtObj.mjOBJ_CAMERA: "ncam",
+    mujoco.mjtObj.mjOBJ_BODY: "nbody",
+    mujoco.mjtObj.mjOBJ_SITE: "nsite",
+    mujoco.mjtObj.mjOBJ_ACTUATOR: "nu",
+}
+"""The ``MjModel`` count of each kind of element a check looks a name up in."""
+
+
+def model_names(models: list[mujoco.MjModel], kind: mujoco.mjtObj) -> list[str]:
+    """Every named element of ``kind`` (a key of :data:`_COUNTS`) in ``models``."""
+    names = (
+        mujoco.mj_id2name(model, kind, index)
+        for model in models
+        for index in range(int(getattr(model, _COUNTS[kind])))
+    )
+    return [name for name in names if name]
+
+
+def row_location(description: RobotDescription, row: CheckRow) -> Issue:
+    """Where in the manifest ``row`` points: the line and column of its field (of the
+    nearest field the file spells out, for a value derived from it)."""
+    return issue_at(description, parse_field(row.field), row.actual)
 
 
 def _equal(field: str, expected: int, actual: int) -> CheckRow:

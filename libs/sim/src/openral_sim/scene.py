@@ -21,6 +21,7 @@ from openral_core.located import error_at
 from openral_core.models import Backend, DeployScene
 
 from openral_sim.rollout import SimRollout
+from openral_sim.scene_checks import check_scene_cameras
 
 
 def scene_robot(scene: DeployScene, robot_id_fallback: str | None = None) -> LoadedRobot:
@@ -78,6 +79,7 @@ def build_scene(
         return build_robosuite_rollout(scene, robot.description)
     from openral_sim.native_scene import NativeScene
 
+    check_scene_cameras(scene, robot.description)
     return NativeScene(scene, robot, render_observations=render_observations)
 
 

@@ -7,8 +7,9 @@ such as unique object names, the loader already checked).
 from __future__ import annotations
 
 import mujoco
+from openral_core.errors import did_you_mean
 from openral_core.located import error_at
-from openral_core.models import DeployScene, RobotDescription
+from openral_core.models import DeployScene, DepthSensor, RgbSensor, RobotDescription
 
 MAX_PHYSICS_STEPS_PER_CONTROL = 1_000
 """Most physics steps one control period may take. A period runs in one callback of the
@@ -67,3 +68,21 @@ def check_weld(scene: DeployScene, robot: RobotDescription) -> None:
             f"robot {robot.name!r} has a fixed base; only a floating base can be welded in place"
         )
         raise error_at(scene, ("base_pose", "weld"), message)
+
+
+def check_scene_cameras(scene: DeployScene, robot: RobotDescription) -> None:
+    """Refuse a name in ``scene.cameras`` that is no camera sensor (rgb or depth) of
+    ``robot``, at that list item, with the closest names (a native scene's rule).
+
+    Raises:
+        ManifestError: At ``scene.cameras[i]``.
+    """
+    known = [s.name for s in robot.sensors if isinstance(s, RgbSensor | DepthSensor)]
+    for index, name in enumerate(scene.scene.cameras):
+        if name not in known:
+            message = (
+                f"{name!r} is not a camera sensor of robot {robot.name!r}"
+                f"{did_you_mean(name, known)}; its camera sensors are: "
+                f"{', '.join(known) or '(none)'}"
+            )
+            raise error_at(scene, ("scene", "cameras", index), message)

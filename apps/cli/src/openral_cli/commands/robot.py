@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import shlex
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from openral_core import (
@@ -26,11 +26,14 @@ from openral_core import (
     robot_ids,
     robot_tables,
 )
-from openral_core.errors import OpenralError
+from openral_core.errors import OpenralError, one_line
 from openral_core.models import LimitedJoint
 from openral_core.registry import MANIFEST_NAME
 
 from openral_cli.console import err, highlighted, line, out, styled
+
+if TYPE_CHECKING:
+    from rich.table import Table
 
 app = typer.Typer(help="Inspect and validate robot manifests.", no_args_is_help=True)
 
@@ -47,14 +50,13 @@ def list_robots() -> None:
     table.add_column("cameras")
     table.add_column("floating base", no_wrap=True)
     table.add_column("model", overflow="fold", min_width=20)
-    invalid = 0
+    invalid: list[ManifestError] = []
     for robot_id in robot_ids():
         try:
             robot = load_robot_by_id(robot_id)
         except ManifestError as error:
-            invalid += 1
-            problems = f"INVALID ({len(error.issues)} problem(s)); run `openral robot validate`"
-            table.add_row(robot_id, styled(problems, "red"), "", "", "", "")
+            invalid.append(error)
+            table.add_row(styled(f"{robot_id} (invalid)", "red"), "-", "-", "-", "-", "-")
             continue
         sim = robot.sim
         cameras = [s.name for s in robot.sensors if s.kind == "rgb"]
@@ -67,6 +69,10 @@ def list_robots() -> None:
             _short_uri(sim.mjcf_uri) if sim else "-",
         )
     out.print(table)
+    for problem in invalid:  # the first issue, where it is; validate lists them all
+        more = len(problem.issues) - 1
+        rest = f" (and {more} more: `openral robot validate {problem.file}`)" if more else ""
+        err.print(line(("✗", "red"), f" {problem.issues[0].format()}{rest}"))
     if invalid:
         raise typer.Exit(1)
 
@@ -217,48 +223,69 @@ def check(
     """Load each robot's MJCF and verify the manifest's wiring against it.
 
     Checks joint names, qpos/qvel addresses, which joint each actuator drives, gripper
-    control ranges, the keyframe, the floating base and sensor cameras/bodies/sites.
-    Exits 1 on any mismatch, 2 when nothing was named.
+    control ranges, the keyframe, the floating base and sensor cameras/bodies/sites. Each
+    row names the manifest's file:line:col of its field. Exits 1 on any mismatch or any
+    robot that could not be checked, 2 when nothing was named.
     """
-    from openral_mujoco.mjcf_uri import robot_model_file
-    from openral_mujoco.model_check import check_robot, compile_robot_model
     from rich.table import Table
 
     files = _named_manifests(targets, all_robots, "check")
     summary = Table(title="robot check")
     for column in ("robot", "model", "checks", "failed"):
         summary.add_column(column)
-    failed_robots = 0
-    for file in files:
-        try:
-            robot = load_robot(file, check_folder_name=file.name == MANIFEST_NAME)
-            path = robot_model_file(robot, file.parent)  # located error without a sim block
-            model = compile_robot_model(robot, path)
-        except OpenralError as error:  # each names its manifest file already
-            failed_robots += 1
-            err.print(line(("✗", "red"), f" {error}"))
-            summary.add_row(file.parent.name, "-", "-", styled("cannot load", "red"))
-            continue
-        rows = check_robot(robot, model)
-        failures = [row for row in rows if not row.ok]
-        shown = rows if verbose else failures
-        if shown:
-            table = Table(title=f"{robot.name}: {path.name}")
-            for column in ("field", "manifest", "model", ""):
-                table.add_column(column)
-            for row in shown:
-                mark = styled("ok", "green") if row.ok else styled("MISMATCH", "red")
-                table.add_row(row.field, row.expected, row.actual, mark)
-            out.print(table)
-        failed_robots += bool(failures)
-        status = styled(str(len(failures)), "red" if failures else "green")
-        summary.add_row(robot.name, path.name, str(len(rows)), status)
+    outcomes = [_check_one(file, verbose, summary) for file in files]
     out.print(summary)
-    if failed_robots:
-        err.print(
-            f"{failed_robots} of {len(files)} robot(s) do not match their model", highlight=True
-        )
+    mismatched, unchecked = outcomes.count("mismatch"), outcomes.count("unchecked")
+    if mismatched or unchecked:
+        err.print(_check_verdict(mismatched, unchecked, len(files)), highlight=True)
         raise typer.Exit(1)
+
+
+def _check_one(file: Path, verbose: bool, summary: Table) -> str:
+    """Check one manifest: print its table of rows (failed ones, all with ``verbose``) and
+    add its summary row; ``"ok"``, ``"mismatch"`` or ``"unchecked"`` (it did not load)."""
+    from openral_mujoco.mjcf_uri import robot_model_file
+    from openral_mujoco.model_check import check_robot, compile_robot_model, row_location
+    from rich.table import Table
+
+    try:
+        robot = load_robot(file, check_folder_name=file.name == MANIFEST_NAME)
+        path = robot_model_file(robot, file.parent)  # located error without a sim block
+        model = compile_robot_model(robot, path)
+    except OpenralError as error:  # each names its manifest file already
+        issues = error.issues if isinstance(error, ManifestError) else ()
+        for text in [issue.format() for issue in issues] or [one_line(str(error))]:
+            err.print(line(("✗", "red"), f" {text}"))
+        summary.add_row(file.parent.name, "-", "-", styled("could not be checked", "red"))
+        return "unchecked"
+    rows = check_robot(robot, model)
+    failures = [row for row in rows if not row.ok]
+    shown = rows if verbose else failures
+    if shown:
+        table = Table(title=f"{robot.name}: {file} against {path.name}")
+        for column in ("at", "field", "manifest"):
+            table.add_column(column, no_wrap=True)
+        table.add_column("model")
+        table.add_column("", no_wrap=True)
+        for row in shown:
+            at = row_location(robot, row)
+            mark = styled("ok", "green") if row.ok else styled("MISMATCH", "red")
+            table.add_row(
+                f"{at.file.name}:{at.line}:{at.column}", row.field, row.expected, row.actual, mark
+            )
+        out.print(table)
+    status = styled(str(len(failures)), "red" if failures else "green")
+    summary.add_row(robot.name, path.name, str(len(rows)), status)
+    return "mismatch" if failures else "ok"
+
+
+def _check_verdict(mismatched: int, unchecked: int, total: int) -> str:
+    """The last line of a failed ``robot check``: robots that do not match their model, and
+    robots whose manifest or model did not load (never counted as mismatches)."""
+    if not mismatched:
+        return f"{unchecked} of {total} robot(s) could not be checked"
+    verdict = f"{mismatched} of {total} robot(s) do not match their model"
+    return f"{verdict}; {unchecked} could not be checked" if unchecked else verdict
 
 
 @app.command("scaffold")
