@@ -85,17 +85,6 @@ def unloadable_base(robot: RobotDescription, path: Path, error: Exception) -> Ma
     return error_at(robot, ("mobile_base", "mjcf_uri"), message)
 
 
-def mount_origin(model: mujoco.MjModel, wiring: MobileBaseWiring) -> FloatArray:
-    """Where the robot's model sits in the base's frame [m] at the base's rest pose (qpos0):
-    the mount body's position plus the mount offset (checked to exist beforehand)."""
-    data = mujoco.MjData(model)
-    mujoco.mj_kinematics(model, data)
-    body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, wiring.mount_body)
-    rotation = data.xmat[body].reshape(3, 3)
-    origin: FloatArray = data.xpos[body] + rotation @ np.asarray(wiring.mount_position_m)
-    return origin
-
-
 @dataclass(frozen=True)
 class DriveGeometry:
     """Where a holonomic base's joints and actuators are in a model, and its planar frame.

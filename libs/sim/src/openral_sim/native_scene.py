@@ -27,7 +27,6 @@ from any ``MjData`` of this model (``deploy sim`` renders snapshots on a thread 
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Iterable
 
@@ -49,8 +48,8 @@ from openral_sim.range_sensors import RangeSensors
 from openral_sim.rollout import Observation, StepResult
 from openral_sim.scene_cameras import camera_sensors
 from openral_sim.scene_checks import physics_steps_per_control
-from openral_sim.scene_compose import BASE_WELD, compose, yaw_quat
-from openral_sim.scene_geometry import robot_bodies, root_body
+from openral_sim.scene_compose import BASE_WELD, compose
+from openral_sim.scene_geometry import place_floating_base, robot_bodies, root_body
 
 
 class NativeScene:
@@ -307,14 +306,6 @@ class NativeScene:
         self.model.eq_data[weld, 6:10] = inverse
 
     def _place_floating_base(self) -> None:
-        """Keyframe free-joint poses are world poses: move them to the scene's base pose."""
-        pose = self.scene.base_pose
-        if pose is None:
-            return
-        position = np.asarray(pose.position_m or [0.0, 0.0, 0.0])
-        yaw = math.radians(pose.yaw_deg or 0.0)
-        free = self._root_qpos  # the robot's free joint (objects may have their own)
-        self.data.qpos[free : free + 3] += position
-        quat = np.empty(4)
-        mujoco.mju_mulQuat(quat, yaw_quat(yaw), self.data.qpos[free + 3 : free + 7].copy())
-        self.data.qpos[free + 3 : free + 7] = quat
+        """Keyframe free-joint poses are world poses: move them to the scene's base pose
+        (the robot's free joint; objects may have their own)."""
+        place_floating_base(self.data, self._root_qpos, self.scene.base_pose)

@@ -15,13 +15,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
-import numpy as np
 from openral_core.models import LidarSensor, RobotDescription
 from openral_core.tables import mobile_base_wiring
 from openral_mujoco.mjcf_uri import robot_model_file
-from openral_mujoco.mobile_base import base_model_file, base_spec, cached_base_model, mount_origin
+from openral_mujoco.mobile_base import base_model_file, base_spec, cached_base_model
 from openral_mujoco.model_check import cached_robot_model
-from openral_mujoco.state import FloatArray
 
 
 @dataclass(frozen=True)
@@ -77,15 +75,6 @@ def attach_robot(
     assert mount is not None, "require_agreement checks the mount body before composing"
     on_base = mount.add_frame(pos=list(wiring.mount_position_m), quat=list(wiring.mount_quat_wxyz))
     spec.attach(child, frame=on_base, prefix="")
-
-
-def robot_offset(robot: RobotDescription, models: RobotModels) -> FloatArray:
-    """Where the robot's model sits in the frame of the base pose [m]: on its mobile base's
-    mount, else at the pose itself."""
-    wiring = mobile_base_wiring(robot)
-    if wiring is None or models.base_model is None:
-        return np.zeros(3)
-    return mount_origin(models.base_model, wiring)
 
 
 def add_lidar_sites(spec: mujoco.MjSpec, robot: RobotDescription) -> None:

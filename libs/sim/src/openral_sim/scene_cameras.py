@@ -4,7 +4,8 @@
 - a sensor with ``mount_body`` gets a camera fixed to that body, looking forward (+x) on a
   torso, head, pelvis or base body and along the body's +z (the tool axis) on any other, or
   along the ``mount_axis`` the manifest names;
-- any other sensor is a fixed camera in front of the robot, framed by the robot's reach.
+- any other sensor is a fixed camera in front of the robot that shows all of it and the
+  objects around it (:mod:`openral_sim.camera_framing`).
 """
 
 from __future__ import annotations
@@ -83,37 +84,16 @@ def looking_along(axis: str) -> tuple[list[float], list[float]]:
 
 
 def add_fixed_cameras(
-    spec: mujoco.MjSpec,
-    robot: RobotDescription,
-    cameras: dict[str, str],
-    target: npt.NDArray[np.float64],
-    yaw: float,
-    radius: float,
+    spec: mujoco.MjSpec, robot: RobotDescription, cameras: dict[str, str]
 ) -> None:
     """A world camera for each sensor that names neither a model camera nor a mount body,
-    framing a sphere of ``radius`` [m] around ``target`` (world frame) from the front."""
+    with the sensor's field of view (default 45 degrees); where it stands is set once the
+    scene is compiled (:func:`openral_sim.camera_framing.place_fixed_cameras`)."""
     for sensor in robot.sensors:
         if not isinstance(sensor, RgbSensor | DepthSensor) or sensor.name not in cameras:
             continue
         if sensor.camera is None and sensor.mount_body is None:
-            fovy = sensor.fovy_deg or 45.0
-            add_fixed_camera(spec, cameras[sensor.name], target, yaw, radius, fovy)
-
-
-def add_fixed_camera(
-    spec: mujoco.MjSpec, name: str, target: np.ndarray, yaw: float, radius: float, fovy: float
-) -> None:
-    """A world camera in front of the robot, above and to one side, that fits a sphere of
-    ``radius`` around ``target`` into its field of view."""
-    direction = rotate_about_z(yaw, np.array([1.0, 0.3, 0.55]))
-    direction /= np.linalg.norm(direction)
-    distance = 1.1 * radius / math.sin(math.radians(fovy) / 2)
-    eye = target + distance * direction
-    forward = -direction
-    right = np.cross(forward, [0.0, 0.0, 1.0])
-    right /= np.linalg.norm(right)
-    up = np.cross(right, forward)
-    spec.worldbody.add_camera(name=name, pos=eye.tolist(), xyaxes=[*right, *up], fovy=fovy)
+            spec.worldbody.add_camera(name=cameras[sensor.name], fovy=sensor.fovy_deg or 45.0)
 
 
 def rotate_about_z(yaw: float, vector: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:

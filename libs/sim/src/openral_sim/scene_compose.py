@@ -17,7 +17,6 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-import numpy.typing as npt
 from openral_core.located import error_at
 from openral_core.models import (
     DeployScene,
@@ -29,16 +28,17 @@ from openral_core.models import (
 from openral_mujoco.model_cache import cached_model, code_digest
 from openral_mujoco.model_check import require_agreement, unloadable_model
 
+from openral_sim.camera_framing import place_fixed_cameras
 from openral_sim.scene_base import (
     RobotModels,
     add_lidar_sites,
     attach_robot,
     robot_models,
-    robot_offset,
 )
 from openral_sim.scene_cameras import add_fixed_cameras, add_mounted_cameras, rotate_about_z
 from openral_sim.scene_checks import check_object_names, check_weld
-from openral_sim.scene_geometry import lowest_static_point, robot_extent, root_body
+from openral_sim.scene_geometry import lowest_static_point, root_body, yaw_quat
+from openral_sim.scene_lighting import add_scene_lights, balance_lights
 
 DEFAULT_TABLE_HEIGHT_M = 0.75
 BASE_WELD = "scene_base_weld"
@@ -128,19 +128,20 @@ def _compile(
     for obj in options.objects if options and options.objects else []:
         _add_object(spec, obj)
     frame = spec.worldbody.add_frame(pos=base.tolist(), quat=yaw_quat(yaw).tolist())
-    center, radius = robot_extent(child_model, robot)
-    center = center + robot_offset(robot, models)
     attach_robot(spec, child, robot, models, frame)
+    balance_lights(spec)
     add_mounted_cameras(spec, robot, cameras)
     add_lidar_sites(spec, robot)
     if pose is not None and pose.weld:
         _add_base_weld(spec, child_model, robot)
-    add_fixed_cameras(spec, robot, cameras, base + rotate_about_z(yaw, center), yaw, radius)
+    add_fixed_cameras(spec, robot, cameras)
     try:
-        return spec.compile()
+        model = spec.compile()
     except ValueError as error:
         message = f"scene {scene.scene.id!r} for {robot.name!r} does not compile: {error}"
         raise error_at(scene, ("scene",), message) from None
+    place_fixed_cameras(model, scene, robot, cameras)
+    return model
 
 
 def _add_tabletop(
@@ -200,8 +201,7 @@ def _add_base_weld(
 
 
 def _add_world(spec: mujoco.MjSpec, *, floor_z: float | None, sky: bool) -> None:
-    spec.worldbody.add_light(name="scene_key_light", pos=[0.5, -1.0, 3.0], dir=[0, 0.3, -1])
-    spec.worldbody.add_light(name="scene_fill_light", pos=[-1.0, 1.0, 2.5], dir=[0.4, -0.3, -1])
+    add_scene_lights(spec)
     if sky:  # a camera looking up or away sees a sky, not black
         spec.add_texture(
             name="scene_sky",
@@ -252,7 +252,3 @@ def _add_object(spec: mujoco.MjSpec, obj: SceneObject) -> None:
         rgba=list(obj.rgba or [0.8, 0.2, 0.2, 1.0]),
         mass=obj.mass_kg or 0.1,
     )
-
-
-def yaw_quat(yaw: float) -> npt.NDArray[np.float64]:
-    return np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])

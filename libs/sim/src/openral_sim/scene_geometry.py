@@ -1,14 +1,22 @@
-"""Where a robot's model puts things: its root body, its reach and its lowest fixed part.
+"""Where a robot's model puts things: its root body, its start pose, the boxes of its geoms
+and its lowest fixed part.
 
 A native scene frames its fixed cameras and places its floor with these.
 """
 
 from __future__ import annotations
 
+import math
+from collections.abc import Sequence
+
 import mujoco
 import numpy as np
-from openral_core.models import RobotDescription
+import numpy.typing as npt
+from openral_core.models import BasePose, RobotDescription
 from openral_core.tables import joint_name_map
+
+CORNERS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+"""The eight corners of a box of half-size 1."""
 
 
 def lowest_static_point(model: mujoco.MjModel) -> float:
@@ -16,16 +24,57 @@ def lowest_static_point(model: mujoco.MjModel) -> float:
     of a table that comes with the robot's file."""
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
-    lowest = 0.0
-    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
-    for geom in np.flatnonzero(model.body_weldid[model.geom_bodyid] == 0):
-        if model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_PLANE:
-            continue
-        center, half = model.geom_aabb[geom, :3], model.geom_aabb[geom, 3:]
-        local = center + corners * half
-        world = data.geom_xpos[geom] + local @ data.geom_xmat[geom].reshape(3, 3).T
-        lowest = min(lowest, float(world[:, 2].min()))
-    return lowest
+    static = np.flatnonzero(model.body_weldid[model.geom_bodyid] == 0)
+    static = static[model.geom_type[static] != mujoco.mjtGeom.mjGEOM_PLANE]
+    return min(0.0, float(geom_corners(model, data, static)[:, 2].min(initial=0.0)))
+
+
+def geom_corners(
+    model: mujoco.MjModel, data: mujoco.MjData, geoms: Sequence[int] | npt.NDArray[np.int_]
+) -> npt.NDArray[np.float64]:
+    """World positions of the 8 corners of each geom's bounding box (in the geom's frame,
+    ``geom_aabb``) as ``data`` places it: an (8 x len(geoms), 3) array."""
+    geoms = np.asarray(geoms, dtype=int)
+    local = model.geom_aabb[geoms, None, :3] + CORNERS * model.geom_aabb[geoms, None, 3:]
+    rotations = data.geom_xmat[geoms].reshape(-1, 3, 3)
+    world: npt.NDArray[np.float64] = data.geom_xpos[geoms, None] + np.einsum(
+        "gij,gcj->gci", rotations, local
+    )
+    return world.reshape(-1, 3)
+
+
+def start_pose(
+    model: mujoco.MjModel, robot: RobotDescription, pose: BasePose | None
+) -> mujoco.MjData:
+    """A fresh ``MjData`` of a composed scene in the robot's start pose, kinematics done:
+    the manifest's keyframe (if any), a floating base's moved to the scene's base pose, as
+    a reset puts it before the settle steps."""
+    data = mujoco.MjData(model)
+    key = robot.sim.keyframe_index if robot.sim is not None else None
+    if key is not None:
+        mujoco.mj_resetDataKeyframe(model, data, key)
+        if robot.sim is not None and robot.sim.floating_base:
+            root = root_body(model, robot)
+            place_floating_base(data, int(model.jnt_qposadr[model.body_jntadr[root]]), pose)
+    mujoco.mj_kinematics(model, data)
+    return data
+
+
+def place_floating_base(data: mujoco.MjData, free: int, pose: BasePose | None) -> None:
+    """Keyframe free-joint poses are world poses: move the free joint whose qpos starts at
+    ``free`` to the scene's base ``pose`` (shifted by its position, turned by its yaw)."""
+    if pose is None:
+        return
+    data.qpos[free : free + 3] += np.asarray(pose.position_m or [0.0, 0.0, 0.0])
+    quat = np.empty(4)
+    yaw = math.radians(pose.yaw_deg or 0.0)
+    mujoco.mju_mulQuat(quat, yaw_quat(yaw), data.qpos[free + 3 : free + 7].copy())
+    data.qpos[free + 3 : free + 7] = quat
+
+
+def yaw_quat(yaw: float) -> npt.NDArray[np.float64]:
+    """The quaternion (w, x, y, z) of a turn by ``yaw`` [rad] about the world z axis."""
+    return np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
 
 
 def root_body(model: mujoco.MjModel, robot: RobotDescription) -> int:
@@ -33,31 +82,6 @@ def root_body(model: mujoco.MjModel, robot: RobotDescription) -> int:
     first = next(iter(joint_name_map(robot).values()))
     joint = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, first)
     return int(model.body_rootid[model.jnt_bodyid[joint]])
-
-
-def robot_extent(model: mujoco.MjModel, robot: RobotDescription) -> tuple[np.ndarray, float]:
-    """Centre and radius (at least 0.2 m) of the robot's links in its start pose, in the
-    model's frame; only bodies moved by the manifest's joints and their bases count, so a
-    table or a prop in the robot's file does not widen the view. A floating base's
-    horizontal offset is removed (the scene puts the base at ``base_pose``)."""
-    data = mujoco.MjData(model)
-    if model.nkey:
-        mujoco.mj_resetDataKeyframe(model, data, 0)
-    mujoco.mj_kinematics(model, data)
-    joint = mujoco.mjtObj.mjOBJ_JOINT
-    mjcf_names = joint_name_map(robot).values()
-    bodies = {
-        int(model.jnt_bodyid[i])
-        for i in range(model.njnt)
-        if mujoco.mj_id2name(model, joint, i) in mjcf_names
-    }
-    bodies |= {int(model.body_parentid[b]) for b in bodies}
-    bodies.discard(0)
-    points = data.xpos[sorted(bodies)] if bodies else data.xpos[1:]
-    if robot.sim is not None and robot.sim.floating_base:
-        points = points - data.xpos[root_body(model, robot)] * np.array([1, 1, 0])
-    low, high = points.min(axis=0), points.max(axis=0)
-    return (low + high) / 2, max(0.2, float(np.linalg.norm(high - low)) / 2)
 
 
 def robot_bodies(model: mujoco.MjModel, robot: RobotDescription) -> frozenset[int]:
