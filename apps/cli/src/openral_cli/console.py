@@ -14,6 +14,7 @@ cached bytecode, ~0.15 s without): ``deploy sim`` prints nothing before its grap
 
 from __future__ import annotations
 
+import os
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -36,6 +37,10 @@ __all__ = [
 ]
 
 
+PIPED_WIDTH = 1000
+"""Columns a console has when its output is not a terminal and ``$COLUMNS`` is unset."""
+
+
 class LazyConsole:
     """A rich :class:`~rich.console.Console` (no markup, highlighting or emoji codes) made on
     first use."""
@@ -53,6 +58,10 @@ class LazyConsole:
             self._console = Console(
                 stderr=self._stderr, soft_wrap=True, markup=False, highlight=False, emoji=False
             )
+            if not self._console.is_terminal and "COLUMNS" not in os.environ:
+                # Piped or redirected: no screen to fit, so tables keep their natural
+                # width instead of rich's 80-column default (which wraps their cells).
+                self._console.width = PIPED_WIDTH
         return self._console
 
     def print(self, *objects: Any, **options: Any) -> None:
