@@ -10,9 +10,12 @@ export MUJOCO_GL := env_var_or_default("MUJOCO_GL", "egl")
 default:
     @just --list
 
+# The main job's command; `./bootstrap demo` execs it directly, so a signal to that PID reaches it.
+demo_command := "openral deploy sim --config robots/franka_panda/scenes/tabletop.yaml --no-viewer"
+
 # The main job: the Panda's default scene as a live ROS 2 graph, headless, until Ctrl-C.
 demo:
-    openral deploy sim --config robots/franka_panda/scenes/tabletop.yaml --no-viewer
+    {{demo_command}}
 
 # The whole test suite (extra arguments go to pytest).
 test *ARGS:
@@ -77,3 +80,8 @@ bench-camera *ARGS:
 # deploy sim against the wall clock: simulated/wall time, /joint_states and per-camera rates idle, under rskill at 10 and 40 Hz and a flood; writes benchmarks/results/real_time.json.
 bench-realtime *ARGS:
     python -m benchmarks.real_time {{ARGS}}
+
+# Re-resolve every dependency and write requirements.lock (names, versions, hashes; no addresses). uv.lock is uv's working file, not committed.
+lock:
+    {{justfile_directory()}}/.tools/venv/bin/uv lock --quiet
+    {{justfile_directory()}}/.tools/venv/bin/uv export --frozen --all-extras --all-groups --format requirements-txt --no-emit-project --no-header --quiet -o requirements.lock
