@@ -15,6 +15,7 @@ from openral_core.errors import OpenralError
 from openral_mujoco.display import render_offscreen_when_headless
 
 from openral_cli.console import error as print_error
+from openral_cli.help_text import command_group  # noqa: F401  (installs the help hints)
 
 render_offscreen_when_headless()  # before any command module imports mujoco
 
@@ -25,6 +26,7 @@ app = typer.Typer(
     help="Describe a robot once in robots/<id>/robot.yaml; simulate and deploy it.",
     no_args_is_help=True,
     pretty_exceptions_enable=False,
+    rich_markup_mode="markdown",
 )
 app.add_typer(robot.app, name="robot")
 app.add_typer(sim.app, name="sim")

@@ -25,13 +25,14 @@ import typer
 from openral_core.errors import OpenralError
 
 from openral_cli.console import out
+from openral_cli.help_text import command_group
 from openral_cli.ros_available import require_ros
 
 if TYPE_CHECKING:
     from openral_nodes.manifest_node import ManifestLifecycleNode
     from rclpy.context import Context
 
-app = typer.Typer(help="Run robots as ROS 2 graphs.", no_args_is_help=True)
+app = command_group("Run robots as ROS 2 graphs.")
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 

@@ -31,11 +31,12 @@ from openral_core.models import LimitedJoint
 from openral_core.registry import MANIFEST_NAME
 
 from openral_cli.console import err, highlighted, line, out, styled
+from openral_cli.help_text import command_group
 
 if TYPE_CHECKING:
     from rich.table import Table
 
-app = typer.Typer(help="Inspect and validate robot manifests.", no_args_is_help=True)
+app = command_group("Inspect and validate robot manifests.")
 
 
 @app.command("list")

@@ -23,16 +23,14 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from openral_cli.console import err, out
+from openral_cli.help_text import command_group
 from openral_cli.ros_available import require_ros
 
 if TYPE_CHECKING:
     from openral_nodes.topic_probe import Inbox
     from rclpy.node import Node
 
-app = typer.Typer(
-    help="Inspect the ROS 2 graph: topics, messages, camera frames; publish a message.",
-    no_args_is_help=True,
-)
+app = command_group("Inspect the ROS 2 graph: topics, messages, camera frames; publish a message.")
 
 DomainId = Annotated[
     int | None,

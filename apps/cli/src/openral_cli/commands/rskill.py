@@ -24,12 +24,13 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from openral_cli.console import line, out, status
+from openral_cli.help_text import command_group
 from openral_cli.ros_available import require_ros
 
 if TYPE_CHECKING:
     from openral_nodes.rskill_runner import RskillRunnerNode
 
-app = typer.Typer(help="Run robot skills (policies) on the ROS graph.", no_args_is_help=True)
+app = command_group("Run robot skills (policies) on the ROS graph.")
 
 STATUS_PERIOD_S = 0.2
 """How often the status line refreshes [s]."""

@@ -26,11 +26,12 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from openral_cli.console import out, progress
+from openral_cli.help_text import command_group
 
 if TYPE_CHECKING:
     from openral_hal.protocol import RobotHal
 
-app = typer.Typer(help="Run simulated scenes.", no_args_is_help=True)
+app = command_group("Run simulated scenes.")
 
 SWAY_RAD = 0.15
 """Amplitude of the demo motion around the start pose."""

@@ -1,0 +1,48 @@
+"""How the CLI's ``--help`` reads: reflowed Markdown paragraphs and plain type hints.
+
+Every command group is made by :func:`command_group`, so help text is written once, as
+Markdown in docstrings and ``help=`` strings (``code`` spans in backticks; a blank line
+separates paragraphs, single line breaks are reflowed). Option and argument hints follow
+click's convention: a flag shows none, a value its kind (``TEXT``, ``INTEGER``,
+``FLOAT``, ``PATH``) or its choices, a repeated argument its element's kind; the usage
+line names arguments in capitals (``TOPIC``, ``[VALUES]...``), not ``{topic}``.
+"""
+
+from __future__ import annotations
+
+import typer
+from typer.core import TyperArgument, TyperOption
+
+__all__ = ["command_group"]
+
+_KINDS = {"str": "TEXT", "int": "INTEGER", "float": "FLOAT", "Path": "PATH", "bool": "BOOLEAN"}
+
+
+def _hint(param: TyperArgument | TyperOption, ctx: object) -> str | None:
+    if isinstance(param, TyperOption) and param.is_flag:
+        return None
+    shown = TyperOption.display_type(param, ctx).strip("<>")  # type: ignore[arg-type]
+    if shown.startswith("list[") and shown.endswith("]"):
+        shown = shown[5:-1]
+    return "|".join(_KINDS.get(part, part.upper()) for part in shown.split("|"))
+
+
+def _usage_name(param: TyperArgument) -> str:
+    """``TOPIC`` for a required argument, ``[VALUES]...`` for an optional repeated one."""
+    name = param.display_name_raw.upper()
+    name = name if param.required else f"[{name}]"
+    return name + ("..." if param.nargs != 1 else "")
+
+
+def _install() -> None:
+    TyperOption.display_type_rich = _hint  # type: ignore[assignment,method-assign]
+    TyperArgument.display_type_rich = _hint  # type: ignore[assignment,method-assign]
+    TyperArgument._usage_display_name = _usage_name  # type: ignore[assignment,method-assign]
+
+
+def command_group(help_text: str) -> typer.Typer:
+    """A typer group whose help is Markdown and whose type hints are plain."""
+    return typer.Typer(help=help_text, no_args_is_help=True, rich_markup_mode="markdown")
+
+
+_install()
