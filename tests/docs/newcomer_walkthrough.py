@@ -5,9 +5,9 @@ Run from a checkout, with nothing but the system Python (no environment set up y
     python3 -m tests.docs.newcomer_walkthrough            # clone of this checkout's HEAD
     python3 -m tests.docs.newcomer_walkthrough --keep /tmp/newcomer
 
-It clones the checkout into an empty folder and works there as a new user would, with a
-clean environment (``HOME``, a system ``PATH``, nothing of the caller's virtual
-environment):
+It clones the checkout into an empty folder and works there as a new user would, in the
+environment of a new login shell (the machine's own variables; no virtual environment, no
+project variables, no PATH entry into a checkout):
 
 1. ``./bootstrap demo`` as the README prints it, until the graph is running; then SIGINT to
    that process alone, which must end it with status 0 within 2 s.
@@ -42,14 +42,21 @@ DEMO_STOP_LIMIT_S = 2.0
 
 
 def fresh_environment() -> dict[str, str]:
-    """What a new login shell has: no virtual environment, no project variables."""
+    """What a new login shell on this machine has: its certificates, proxies and locale,
+    but no virtual environment, no project variables and nothing of the caller's PATH
+    that points into a checkout (``.venv``, ``.tools``)."""
+    dropped = ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME", "MUJOCO_GL", "COLUMNS", "LINES")
     env = {
-        "HOME": os.environ.get("HOME", "/root"),
-        "PATH": "/usr/local/bin:/usr/bin:/bin",
-        "LANG": "C.UTF-8",
+        key: value
+        for key, value in os.environ.items()
+        if key not in dropped and not key.startswith(("OPENRAL_", "PYTEST_"))
     }
-    if "ROS_DOMAIN_ID" in os.environ:  # keep a caller's isolation from other graphs
-        env["ROS_DOMAIN_ID"] = os.environ["ROS_DOMAIN_ID"]
+    system = [
+        entry
+        for entry in os.environ.get("PATH", "/usr/bin:/bin").split(os.pathsep)
+        if entry and ".venv" not in entry and ".tools" not in entry
+    ]
+    env["PATH"] = os.pathsep.join(system)
     return env
 
 
