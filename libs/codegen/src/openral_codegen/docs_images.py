@@ -1,9 +1,9 @@
 """Pictures of every robot in its default scene, for the robot pages (``just docs-images``).
 
 Each robot's ``scenes/tabletop.yaml`` is built with the native scene backend and reset with
-the scene's seed; one frame is rendered offscreen (EGL on the CPU) from a free camera aimed
-at the robot's bodies. Of a few fixed viewpoints, the one that shows the most robot pixels
-(by segmentation rendering) is kept, so a table in front of a robot never hides it.
+the scene's seed; one frame is rendered offscreen (EGL on the CPU) from a free camera framed
+as the scene's fixed cameras are (``openral_sim.camera_framing``): the whole robot and every
+object near it inside the picture, from the view that sees most of them unhidden.
 
 Next to the PNGs, ``renders.json`` records a SHA-256 of each picture's inputs (manifest,
 scene file, MJCF file and the render settings) and the viewpoint used. :func:`stale_images`
@@ -16,29 +16,23 @@ import hashlib
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
 
 from openral_codegen.models import CodegenError
 
+if TYPE_CHECKING:
+    import mujoco
+    from openral_core.models import DeployScene, RobotDescription
+
 IMAGE_DIR = "docs/images/robots"
 RECORD_NAME = "renders.json"
 DEFAULT_SCENE = "scenes/tabletop.yaml"
 WIDTH, HEIGHT = 480, 360
 """Picture size [px]."""
-VIEWS = ((125.0, -25.0), (235.0, -25.0), (55.0, -25.0), (305.0, -25.0), (125.0, -45.0))
-"""Candidate (azimuth, elevation) [deg] of the free camera, in order of preference."""
-DISTANCE_PER_SIZE = 1.6
-"""Camera distance as a multiple of the diagonal of the robot's body bounding box."""
-MIN_DISTANCE_M = 0.8
-SETTINGS: dict[str, Any] = {
-    "size": [WIDTH, HEIGHT],
-    "views": [list(v) for v in VIEWS],
-    "distance_per_size": DISTANCE_PER_SIZE,
-    "min_distance_m": MIN_DISTANCE_M,
-}
+SETTINGS: dict[str, Any] = {"size": [WIDTH, HEIGHT], "framing": "openral_sim.camera_framing"}
 
 
 @dataclass(frozen=True)
@@ -61,49 +55,53 @@ def render_robot(root: Path, robot_id: str) -> Render:
     from openral_sim.scene import build_scene
 
     scene = load_scene(root / "robots" / robot_id / DEFAULT_SCENE)
-    env = build_scene(scene, open_robot_by_id(robot_id, root / "robots"))
+    robot = open_robot_by_id(robot_id, root / "robots")
+    env = build_scene(scene, robot)
     try:
         env.reset(seed=scene.seed)
         handles = env.mujoco_handles()
         if handles is None:
             raise CodegenError(f"{robot_id}: the default scene exposes no MuJoCo model")
         model, data = handles
-        robot_body = np.array(
-            [
-                i > 0
-                and not (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, i) or "").startswith(
-                    "scene_"
-                )
-                for i in range(model.nbody)
-            ]
-        )
-        points = data.xpos[robot_body]
-        low, high = points.min(axis=0), points.max(axis=0)
-        camera = mujoco.MjvCamera()
-        camera.type = mujoco.mjtCamera.mjCAMERA_FREE
-        camera.lookat[:] = (low + high) / 2
-        camera.distance = max(MIN_DISTANCE_M, DISTANCE_PER_SIZE * float(np.linalg.norm(high - low)))
+        camera = _framing_camera(model, data, scene, robot.description)
         renderer = mujoco.Renderer(model, HEIGHT, WIDTH)
         try:
-            robot_geom = robot_body[model.geom_bodyid]
-            renderer.enable_segmentation_rendering()
-            counts = []
-            for azimuth, elevation in VIEWS:
-                camera.azimuth, camera.elevation = azimuth, elevation
-                renderer.update_scene(data, camera=camera)
-                ids, types = np.moveaxis(renderer.render(), -1, 0)
-                geoms = ids[(types == int(mujoco.mjtObj.mjOBJ_GEOM)) & (ids >= 0)]
-                counts.append(int(robot_geom[geoms].sum()))
-            renderer.disable_segmentation_rendering()
-            azimuth, elevation = VIEWS[int(np.argmax(counts))]
-            camera.azimuth, camera.elevation = azimuth, elevation
             renderer.update_scene(data, camera=camera)
             image = renderer.render().copy()
         finally:
             renderer.close()
     finally:
         env.close()
-    return Render(image, azimuth, elevation)
+    return Render(image, float(camera.azimuth), float(camera.elevation))
+
+
+def _framing_camera(
+    model: mujoco.MjModel, data: mujoco.MjData, scene: DeployScene, robot: RobotDescription
+) -> mujoco.MjvCamera:
+    """A free camera framed as the scene's fixed cameras are (openral_sim.camera_framing:
+    the whole robot and every object near it in the picture, from the view that sees most
+    of them unhidden), for this picture's size and the model's free-camera field of view."""
+    import mujoco
+    from openral_sim.camera_framing import VIEWS, fit_view, framed_geoms, visible_share
+    from openral_sim.scene_cameras import rotate_about_z
+
+    names = [f"scene_{o.name}" for o in (scene.scene.options and scene.scene.options.objects) or []]
+    framed = framed_geoms(model, data, robot, names)
+    yaw = np.radians(scene.base_pose.yaw_deg or 0.0) if scene.base_pose else 0.0
+    fovy = float(model.vis.global_.fovy)
+    views = [
+        fit_view(framed.points, rotate_about_z(float(yaw), np.array(v)), fovy, WIDTH / HEIGHT)
+        for v in VIEWS
+    ]
+    eye, rotation = views[int(np.argmax([visible_share(model, data, framed, e) for e, _ in views]))]
+    forward = -rotation[:, 2]
+    camera = mujoco.MjvCamera()
+    camera.type = mujoco.mjtCamera.mjCAMERA_FREE
+    camera.distance = 1.0
+    camera.lookat[:] = eye + forward
+    camera.azimuth = float(np.degrees(np.arctan2(forward[1], forward[0])))
+    camera.elevation = float(np.degrees(np.arcsin(np.clip(forward[2], -1.0, 1.0))))
+    return camera
 
 
 def input_digest(root: Path, robot_id: str) -> str:
