@@ -155,8 +155,8 @@ def created_paths(steps: list[Step]) -> list[str]:
     return paths
 
 
-def remove_created(sandbox: Path, steps: list[Step], env: dict[str, str]) -> list[str]:
-    """Remove from ``sandbox`` what ``steps`` create; re-export when a robot folder went."""
+def remove_created(sandbox: Path, steps: list[Step]) -> list[str]:
+    """Remove from ``sandbox`` what ``steps`` create; the paths that were there."""
     removed = []
     for relative in created_paths(steps):
         target = sandbox / relative
@@ -167,16 +167,20 @@ def remove_created(sandbox: Path, steps: list[Step], env: dict[str, str]) -> lis
         else:
             continue
         removed.append(relative)
-    if any(path.startswith("robots/") and path.count("/") == 1 for path in removed):
-        subprocess.run(
-            ["python", "-m", "openral_codegen", "export"],
-            cwd=sandbox,
-            env=env,
-            capture_output=True,
-            check=True,
-            timeout=FOREGROUND_TIMEOUT_S,
-        )
     return removed
+
+
+def export_generated(sandbox: Path, env: dict[str, str]) -> None:
+    """``just schema-export`` in ``sandbox`` (``env`` must point Python at its sources):
+    after a removal under ``robots/``, as robot pages list scenes and quote them."""
+    subprocess.run(
+        ["python", "-m", "openral_codegen", "export"],
+        cwd=sandbox,
+        env=env,
+        capture_output=True,
+        check=True,
+        timeout=FOREGROUND_TIMEOUT_S,
+    )
 
 
 def copy_repository(source: Path, target: Path) -> Path:
