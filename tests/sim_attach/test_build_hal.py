@@ -88,8 +88,11 @@ class SteppingRealArm(RealArm):
 
     control_period_s = 0.02
 
-    def tick(self, action: object | None) -> bool:
+    def tick(self, action: object | None, *, glide: bool = False) -> bool:
         return True
+
+    def reset(self) -> str:
+        return "reset"
 
 
 class SimulatedArm(RealArm):

@@ -17,7 +17,8 @@ Transitions:
   (:class:`~openral_bridge.control_loop.ControlLoop`), which steps once before anything is
   published and then once per control period, publishing ``/clock`` after each step; then
   publish the latched ``/openral/action_spec`` and ``/joint_states`` (stamped in simulated
-  time), subscribe ``/openral/safe_action``, offer the E-stop services and start the
+  time), take commands (``/openral/safe_action``, ``/openral/joint_trajectory``, the E-stop
+  and ``/openral/reset`` services: :mod:`openral_nodes.command_interfaces`) and start the
   :class:`~openral_nodes.scene_bridges.SceneBridges` (cameras, depth and lidar, a mobile
   base's ``/cmd_vel`` and ``/odom``);
 - deactivate → stop all of that (the HAL stays connected and holds still);
@@ -31,11 +32,9 @@ is answered ``success=false`` with a throttled warning, never raised into the ex
 The command on ``/openral/safe_action`` (``std_msgs/Float64MultiArray``) is ``data`` = one
 value per HAL action slot, in the order and meaning ``/openral/action_spec`` announces
 (``sensor_msgs/JointState``: ``name`` = slot names, ``position`` = the hold action when
-activated). An action of the wrong width or with a non-finite value, or one sent while the
-E-stop is latched, is refused where it arrives with a warning and changes nothing. On a
-simulated robot a valid action waits for the next control tick (a newer one replaces it and
-is counted as superseded); on a real one it goes to the HAL at once. Run it on a
-single-threaded executor only.
+activated). A joint trajectory names manifest joints instead and is followed by the control
+loop. Refused commands change nothing and are reported with a throttled warning. Run it on
+a single-threaded executor only.
 
 Threads: the periodic work (control tick and ``/clock``, ``/joint_states``, camera frame
 requests, the viewer's sync) runs on one :class:`~openral_bridge.pacer.Pacer` thread per
@@ -55,30 +54,22 @@ from openral_bridge.control_loop import ControlLoop
 from openral_bridge.joint_state_publisher import JointStatePublisher, sim_stamp
 from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.sim_sensor_bridge import TopicInfo
-from openral_bridge.topics import (
-    ACTION_SPEC,
-    CLOCK,
-    ESTOP,
-    JOINT_STATES,
-    RELEASE_ESTOP,
-    SAFE_ACTION,
-)
+from openral_bridge.topics import ACTION_SPEC, CLOCK, JOINT_STATES
+from openral_bridge.trajectory_follower import TrajectoryFollower, path_limits
 from openral_core import LoadedRobot
 from openral_core.errors import OpenralError
 from openral_core.models import DeployScene, RobotDescription
-from openral_hal.errors import EStopLatched, HalError, NotConnected
+from openral_hal.errors import NotConnected
 from openral_hal.factory import build_hal, can_tick
 from openral_hal.protocol import MobileBaseHal, RobotHal
-from openral_mujoco.action import validated_action
 from openral_sim.rollout import SimRollout
 from openral_sim.scene import build_scene
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray
-from std_srvs.srv import Trigger
 
+from openral_nodes.command_interfaces import CommandInterfaces
 from openral_nodes.lifecycle_guard import guard_change_state
 from openral_nodes.node_parameters import BOUNDS, PARAMETERS, check_rates, robot_and_scene
 from openral_nodes.runtime import LATCHED
@@ -149,9 +140,9 @@ class ManifestLifecycleNode(LifecycleNode):
         self.log_boot_errors = log_boot_errors
         self.boot_error: str | None = None
         """Why the last configure failed (None after a successful one)."""
-        self.actions_accepted = 0
-        """Valid actions taken (handed to the control loop, or to a real HAL)."""
-        self.actions_refused = 0
+        self.commands: CommandInterfaces | None = None
+        """Actions, trajectories, E-stop and reset while active."""
+        self._loaded: LoadedRobot | None = None
         self._entities: list[tuple[str, Any]] = []
         self._shutdown_event = shutdown_event
         guard_change_state(self, WARN_EVERY_S)
@@ -171,7 +162,7 @@ class ManifestLifecycleNode(LifecycleNode):
             self.hal = build_hal(
                 robot, mode=str(self._param("hal_mode")), scene=scene, env_builder=_on_demand
             )
-            self.description = robot.description
+            self.description, self._loaded = robot.description, robot
         except (OpenralError, ValueError) as error:
             return self._fail_configure(str(error))
         except Exception as error:  # anything else is a bug; report it the same way
@@ -259,6 +250,7 @@ class ManifestLifecycleNode(LifecycleNode):
         ]
         if self.loop is not None:
             rows.insert(1, TopicInfo(CLOCK, "rosgraph_msgs/msg/Clock", 1.0 / self.loop.period_s))
+        rows += self.commands.topics() if self.commands is not None else []
         return rows + (self.bridge.topics() if self.bridge else [])
 
     def action_layout(self) -> tuple[tuple[str, ...], list[float]]:
@@ -267,6 +259,16 @@ class ManifestLifecycleNode(LifecycleNode):
         with self.hal_lock:
             hold: list[float] = np.asarray(hal.hold_action(), dtype=np.float64).tolist()
         return tuple(hal.action_names), hold
+
+    @property
+    def actions_accepted(self) -> int:
+        """Valid actions taken while active (handed to the control loop, or a real HAL)."""
+        return self.commands.accepted if self.commands is not None else 0
+
+    @property
+    def actions_refused(self) -> int:
+        """Actions refused while active."""
+        return self.commands.refused if self.commands is not None else 0
 
     # -- internals -------------------------------------------------------------------------
 
@@ -288,7 +290,7 @@ class ManifestLifecycleNode(LifecycleNode):
         self.boot_error = message
         if self.log_boot_errors:
             self._log().error(f"configure failed: {message}")
-        self.description = self.hal = None
+        self.description = self.hal = self._loaded = None
         return Result.FAILURE
 
     def _start_loop(self, hal: RobotHal, pacer: Pacer) -> None:
@@ -297,7 +299,17 @@ class ManifestLifecycleNode(LifecycleNode):
         self._clock_pub = self.create_publisher(Clock, CLOCK, 10)
         self._entities = [("publisher", self._clock_pub)]
         if can_tick(hal):
-            self.loop = ControlLoop(self, hal, on_tick=self._publish_clock, lock=self.hal_lock)
+            robot = self._loaded
+            joints = robot is not None and hal.action_names == hal.joint_names
+            follower = TrajectoryFollower(path_limits(robot)) if robot and joints else None
+            self.loop = ControlLoop(
+                self,
+                hal,
+                on_tick=self._publish_clock,
+                lock=self.hal_lock,
+                follower=follower,
+                on_reset=self._publish_sensors_now,
+            )
             self.loop.start(pacer)
 
     def _create_entities(self, pacer: Pacer) -> None:
@@ -318,55 +330,24 @@ class ManifestLifecycleNode(LifecycleNode):
             self, hal, self.hal_lock, rate_hz, latest=latest, base=base
         )
         self.states.start(pacer)
-        self._entities += [
-            ("publisher", spec),
-            (
-                "subscription",
-                self.create_subscription(Float64MultiArray, SAFE_ACTION, self._on_safe_action, 10),
-            ),
-            ("service", self.create_service(Trigger, ESTOP, self._on_estop)),
-            ("service", self.create_service(Trigger, RELEASE_ESTOP, self._on_release_estop)),
-        ]
+        self.commands = CommandInterfaces(
+            self, hal, self.hal_lock, self.loop, warn_every_s=WARN_EVERY_S
+        )
+        self._entities += [("publisher", spec), *self.commands.create()]
 
     def _job_failed(self, job: PacedJob, error: Exception) -> None:
         """A periodic job raised (the pacer's thread goes on)."""
         text = f"{job.name} failed ({type(error).__name__}: {error})"
         self._log().error(text, throttle_duration_sec=WARN_EVERY_S)
 
+    def _publish_sensors_now(self) -> None:
+        """After a reset: every camera and range sensor shows the start state at once."""
+        if self.bridge is not None:
+            self.bridge.publish_now()
+
     def _publish_clock(self, sim_time: float | None) -> None:
         if sim_time is not None:
             self._clock_pub.publish(Clock(clock=ros_messages.stamp(sim_time)))
-
-    def _on_safe_action(self, msg: Any) -> None:
-        hal = self._hal()
-        try:
-            values = validated_action(np.asarray(msg.data, dtype=np.float64), hal.action_names)
-            if self.loop is None:
-                with self.hal_lock:
-                    hal.send_action(values)
-            elif hal.estopped:
-                raise EStopLatched()
-            else:
-                self.loop.offer(values)
-        except HalError as error:
-            self.actions_refused += 1
-            self._log().warning(f"action refused: {error}", throttle_duration_sec=WARN_EVERY_S)
-            return
-        self.actions_accepted += 1
-
-    def _on_estop(self, request: Any, response: Any) -> Any:
-        with self.hal_lock:  # a tick in progress ends first; none follows
-            self._hal().estop()
-        self._log().warning("E-stop latched: actions are refused and the scene is frozen")
-        response.success, response.message = True, "E-stop latched"
-        return response
-
-    def _on_release_estop(self, request: Any, response: Any) -> Any:
-        with self.hal_lock:
-            self._hal().release_estop()
-        self._log().info("E-stop released")
-        response.success, response.message = True, "E-stop released"
-        return response
 
     def _stop(self) -> None:
         """Stop the periodic work (its thread joined first), then remove every entity."""
@@ -397,4 +378,4 @@ class ManifestLifecycleNode(LifecycleNode):
         if self.hal is not None and self.hal.connected:
             self.hal.disconnect()
         self.hal = None
-        self.description = None
+        self.description = self._loaded = None

@@ -69,6 +69,13 @@ class SceneBridges:
         if self.base is not None:
             self.base.start(self.pacer)
 
+    def publish_now(self) -> None:
+        """Every camera, depth camera and lidar publishes the scene as it is now (after a
+        reset); takes the HAL's lock."""
+        self.sensors.publish_now()
+        if self.range is not None:
+            self.range.publish_now()
+
     def teardown(self) -> None:
         """Stop every bridge (idempotent)."""
         if self.base is not None:

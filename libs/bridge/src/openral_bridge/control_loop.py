@@ -12,6 +12,15 @@ the scene's ``control_freq_hz``) and each tick advances the scene by exactly one
 - with no new action, holding what is commanded (:meth:`Tickable.tick` with None: the targets
   in force on a position-controlled scene, the backend's hold on a delta controller).
 
+- with no new action while a joint trajectory runs (:attr:`ControlLoop.follower`), gliding
+  to the trajectory's point at the end of the period; an offered action pre-empts the
+  trajectory, and a tick the E-stop keeps from stepping aborts it.
+
+A reset (:meth:`ControlLoop.reset`, any thread) is carried out by the next tick instead of
+a step, so it never races one: the scene is reset, stepped once with its hold (as
+:meth:`ControlLoop.start` does) and ``on_reset`` runs on the loop's thread before any other
+periodic job, so sensors can publish the start state again.
+
 Malformed actions are refused where they arrive (the node validates them), so they never
 reach, delay or stop the loop. While the E-stop is latched the HAL does not advance (time
 freezes too). A tick that is late is not made up: the loop never runs faster than real
@@ -34,17 +43,34 @@ import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
 from openral_hal.protocol import Tickable
 from openral_mujoco.state import FloatArray, JointStateSample
 
 from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.real_time import RealTimeWatch
+from openral_bridge.trajectory_follower import DesiredPoint, TrajectoryFollower
 
 if TYPE_CHECKING:
     from rclpy.node import Node
 
 WARN_EVERY_S = 2.0
 """At most one warning per this many seconds for a stream of failing ticks [s]."""
+RESET_TIMEOUT_S = 10.0
+"""Longest wait of :meth:`ControlLoop.reset` for a tick to carry the reset out [s]."""
+
+
+class ResetFailed(RuntimeError):
+    """A reset was not carried out (the loop stopped, timed out, or the HAL raised)."""
+
+
+class _ResetRequest:
+    """One reset handed to the loop's thread, and its outcome."""
+
+    def __init__(self) -> None:
+        self.done = threading.Event()
+        self.text = ""
+        self.error: str | None = None
 
 
 class ControlLoop:
@@ -57,6 +83,9 @@ class ControlLoop:
         on_tick: Callable[[float | None], None] | None = None,
         *,
         lock: threading.Lock | None = None,
+        follower: TrajectoryFollower | None = None,
+        on_sample: Callable[[DesiredPoint], None] | None = None,
+        on_reset: Callable[[], None] | None = None,
     ) -> None:
         """Nothing runs until :meth:`start`.
 
@@ -68,6 +97,11 @@ class ControlLoop:
                 lock is not held.
             lock: The HAL's lock, held while a tick steps and reads it (default: a lock of
                 the loop's own).
+            follower: The joint trajectories to follow (None: this loop follows none).
+            on_sample: Called with the desired point after each tick that followed a
+                trajectory (the HAL lock is not held).
+            on_reset: Called on the loop's thread right after a reset's tick (the HAL lock
+                is not held).
         """
         self.node = node
         self.hal = hal
@@ -86,7 +120,13 @@ class ControlLoop:
         self.state: JointStateSample | None = None
         """The HAL's state read right after the last tick that stepped (holding the lock;
         the scene does not change between ticks); None before one, or after a failed tick."""
+        self.follower = follower
+        self.on_sample = on_sample
+        self.on_reset = on_reset
+        self.followed = 0
+        """Ticks that glided along a trajectory."""
         self._pending: FloatArray | None = None
+        self._reset: _ResetRequest | None = None
         self._pending_lock = threading.Lock()
         self._job: tuple[Pacer, PacedJob] | None = None
 
@@ -114,41 +154,127 @@ class ControlLoop:
             if self._pending is not None:
                 self.superseded += 1
                 self._pending = None
+            reset, self._reset = self._reset, None
+        if reset is not None:
+            reset.error = "the control loop stopped before the reset"
+            reset.done.set()
+        if self.follower is not None:
+            self.follower.cancel()
 
-    def offer(self, action: FloatArray) -> None:
-        """Make ``action`` (already validated) the one the next tick applies (any thread)."""
+    def offer(self, action: FloatArray) -> bool:
+        """Make ``action`` (already validated) the one the next tick applies (any thread);
+        it pre-empts a joint trajectory. True when it ended one."""
+        preempted = self.follower.cancel() if self.follower is not None else False
         with self._pending_lock:
             if self._pending is not None:
                 self.superseded += 1
             self._pending = action
+        return preempted
+
+    def reset(self, timeout_s: float = RESET_TIMEOUT_S) -> str:
+        """Have the next tick reset the scene (see the module doc) and wait for it; a pending
+        action and any trajectory are dropped. Returns the HAL's account of the reset.
+
+        Raises:
+            ResetFailed: The loop is not running, the tick did not come within
+                ``timeout_s``, or the HAL's reset raised (the message says which).
+        """
+        if not self.running:
+            raise ResetFailed("the control loop is not running")
+        request = _ResetRequest()
+        with self._pending_lock:
+            if self._pending is not None:
+                self.superseded += 1
+                self._pending = None
+            self._reset = request
+        if self.follower is not None:
+            self.follower.cancel()
+        if not request.done.wait(timeout_s):
+            raise ResetFailed(f"no control tick carried the reset out within {timeout_s:g} s")
+        if request.error is not None:
+            raise ResetFailed(request.error)
+        return request.text
 
     def tick(self) -> None:
         """Advance the scene one control period (see the module doc); a HAL error is
         counted and logged, never raised (``on_tick``'s own errors are)."""
         with self._pending_lock:
             action, self._pending = self._pending, None
+            reset, self._reset = self._reset, None
+        if reset is not None:
+            self._carry_out(reset)
+            return
+        sample: DesiredPoint | None = None
         try:
             with self.lock:
-                stepped = self.hal.tick(action)
+                if action is None:
+                    action, sample = self._trajectory_step()
+                stepped = self.hal.tick(action, glide=sample is not None)
                 state = self.hal.read_state() if stepped else self.state
                 self.state = state
         except Exception as error:  # a diverged scene, or a bug: never the end of the graph
             self.state = None
+            self._abort_trajectory()
             self._failed(error)
             return
         if not stepped:  # E-stopped: time is frozen on purpose, the action is dropped
             self.watch.restart()
-            if action is not None:
+            self._abort_trajectory()
+            if action is not None and sample is None:
                 with self._pending_lock:
                     self.superseded += 1
             return
+        self._after_step(state, action is not None and sample is None, sample)
+
+    def _trajectory_step(self) -> tuple[FloatArray | None, DesiredPoint | None]:
+        """(action, desired point) of a running trajectory for this tick, else (None, None);
+        under the HAL lock."""
+        now_s = self.state.sim_time_s if self.state is not None else None
+        if self.follower is None or now_s is None:
+            return None, None
+        hold = np.asarray(self.hal.hold_action(), dtype=np.float64)
+        step = self.follower.next_action(hold, now_s, self.period_s)
+        return (None, None) if step is None else step
+
+    def _after_step(
+        self, state: JointStateSample | None, applied: bool, sample: DesiredPoint | None
+    ) -> None:
         self.ticks += 1
-        self.applied += int(action is not None)
+        self.applied += int(applied)
         sim_time = state.sim_time_s if state is not None else None
         if self.on_tick is not None:
             self.on_tick(sim_time)
+        if sample is not None:
+            self.followed += 1
+            if self.on_sample is not None:
+                self.on_sample(sample)
         if sim_time is not None:
             self._check_pace(sim_time)
+
+    def _carry_out(self, request: _ResetRequest) -> None:
+        """Reset, step once with the hold, tell ``on_tick`` and ``on_reset``; the outcome
+        goes to ``request``."""
+        try:
+            with self.lock:
+                request.text = self.hal.reset()
+                stepped = self.hal.tick(None)
+                self.state = self.hal.read_state() if stepped else None
+        except Exception as error:  # reported to the caller, never the end of the graph
+            request.error = f"the reset failed ({type(error).__name__}: {error})"
+            request.done.set()
+            return
+        self.watch.restart()
+        try:
+            if self.on_tick is not None and self.state is not None:
+                self.on_tick(self.state.sim_time_s)
+            if self.on_reset is not None:
+                self.on_reset()
+        finally:
+            request.done.set()
+
+    def _abort_trajectory(self) -> None:
+        if self.follower is not None and self.follower.cancel():
+            self._log().warning("joint trajectory aborted: the scene did not step")
 
     def _check_pace(self, sim_time: float) -> None:
         factor = self.watch.update(time.monotonic(), sim_time)

@@ -101,7 +101,12 @@ class RangeBridge:
         for name, stream in self._streams.items():
             due = partial(self._due, name)
             stream.job = pacer.every(1.0 / stream.rate_hz, due, f"range {name}")
-            due()
+        self.publish_now()
+
+    def publish_now(self) -> None:
+        """A depth frame or scan of every sensor as the scene is now; takes the HAL's lock."""
+        for name in self._streams:
+            self._due(name)
 
     def stop(self) -> None:
         """Cancel the jobs, stop the depth threads and destroy the publishers (idempotent)."""

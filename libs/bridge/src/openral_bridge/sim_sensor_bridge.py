@@ -223,6 +223,11 @@ class SimSensorBridge:
         for name, camera in self._cameras.items():
             period = 1.0 / camera.rate_hz
             camera.job = self.pacer.every(period, partial(self._due, name), f"camera {name}")
+        self.publish_now()
+
+    def publish_now(self) -> None:
+        """A frame of every camera of the scene as it is now (after a reset, say), whether
+        due or not; takes the HAL's lock."""
         for name in self._cameras:
             self._due(name)
 

@@ -207,8 +207,9 @@ class MujocoArmHAL(EStopLatch):
         """:data:`CONTROL_PERIOD_S` rounded to whole physics steps (at least one) [s]."""
         return self._control_steps() * float(self.mujoco_handles()[0].opt.timestep)
 
-    def tick(self, action: object | None) -> bool:
-        """Apply ``action`` (None: keep the targets in force) and advance one control period.
+    def tick(self, action: object | None, *, glide: bool = False) -> bool:
+        """Apply ``action`` (None: keep the targets in force) and advance one control period;
+        with ``glide`` the set point moves to it at constant speed over the period.
 
         Returns:
             True when physics advanced; False (nothing done) while E-stopped.
@@ -219,8 +220,20 @@ class MujocoArmHAL(EStopLatch):
         if self._estopped:
             return False
         if action is not None:
-            self.send_action(action)
+            _, data, driver = self._handles()
+            driver.command(action, data, glide_s=self.control_period_s if glide else None)
         return self.step(self._control_steps())
+
+    def reset(self) -> str:
+        """Back to the keyframe, held and settled as :meth:`connect` leaves it; the E-stop
+        latch is kept."""
+        model, data, driver = self._handles()
+        mujoco.mj_resetData(model, data)
+        driver.reset_to_keyframe(model, data)
+        driver.start(model, data)
+        driver.advance(model, data, self.settle_steps)
+        latch = "; the E-stop is still latched" if self._estopped else ""
+        return f"{self.description.name}: start pose restored at t={data.time:.3f} s{latch}"
 
     def step(self, n: int = 1) -> bool:
         """Advance physics ``n`` steps; returns False (and does nothing) while E-stopped.

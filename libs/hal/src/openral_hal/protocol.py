@@ -113,13 +113,20 @@ class Tickable(RobotHal, Protocol):
         """Simulated time one :meth:`tick` advances [s]."""
         ...
 
-    def tick(self, action: object | None) -> bool:
+    def tick(self, action: object | None, *, glide: bool = False) -> bool:
         """Apply ``action`` (None: hold what is commanded now) and advance one control
-        period; False (nothing done) while E-stopped.
+        period; False (nothing done) while E-stopped. With ``glide`` the action is the next
+        sample of a smooth path: the joints move to it at constant speed over the period,
+        with that speed fed forward (when the HAL's action slots are its joints).
 
         Raises:
             ActionRejected: ``action`` is malformed; nothing is changed.
         """
+        ...
+
+    def reset(self) -> str:
+        """Put the scene back where it started (its seed, the start pose, every object);
+        the E-stop latch is kept as it is. Returns what was reset, in one line."""
         ...
 
 

@@ -16,18 +16,14 @@ refused while E-stopped; the E-stop halts the base) and reports odometry.
 from __future__ import annotations
 
 import logging
-import time
 from typing import Any
 
 import mujoco
 import numpy as np
 import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
-from openral_core.located import error_at
 from openral_core.models import RgbSensor, RobotDescription
 from openral_mujoco.action import validated_action
-from openral_mujoco.mjcf_model import is_scalar_joint
-from openral_mujoco.name_resolution import resolve_joint_names
 from openral_mujoco.state import FloatArray, JointStateSample
 from openral_sim.base_drive import BaseCommand, BaseDrive, BaseOdometry
 from openral_sim.native_scene import NativeScene
@@ -41,6 +37,7 @@ from openral_sim.rollout import (
 
 from openral_hal.errors import ConfigurationError, HalError, NotConnected
 from openral_hal.protocol import EStopLatch
+from openral_hal.scene_joints import SceneJointReader
 
 _log = logging.getLogger(__name__)
 
@@ -79,7 +76,6 @@ class SimAttachedHAL(EStopLatch):
         self.env_reset_seed = env_reset_seed
         self.env_action_dim = env_action_dim
         self.joint_names = tuple(j.name for j in description.joints)
-        self._mjcf_names = tuple(robot.tables.joint_name_map[n] for n in self.joint_names)
         self._rgb = tuple(s.name for s in description.sensors if isinstance(s, RgbSensor))
         self._action_dim: int | None = None
         self._action_names: tuple[str, ...] = ()
@@ -87,9 +83,8 @@ class SimAttachedHAL(EStopLatch):
         self._last_env_action: FloatArray = np.zeros(0)
         self._episode_done = False
         self._closed = False
-        self._addr_model: mujoco.MjModel | None = None
-        self._qpos = self._dof = np.zeros(0, dtype=np.intp)
-        self._warned_width = False
+        mjcf_names = tuple(robot.tables.joint_name_map[n] for n in self.joint_names)
+        self._joints = SceneJointReader(description, mjcf_names, type(env).__name__)
 
     @property
     def description(self) -> RobotDescription:
@@ -131,7 +126,7 @@ class SimAttachedHAL(EStopLatch):
         obs = self.env.reset(seed=self.env_reset_seed)
         handles = self.env.mujoco_handles()
         if handles is not None and self._manifest_env is None:
-            self._resolve_addresses(handles[0])
+            self._joints.locate(handles[0])
         self._action_dim = width
         self._action_names = self._slot_names(width)
         self._last_env_action = np.zeros(width)
@@ -193,28 +188,7 @@ class SimAttachedHAL(EStopLatch):
         obs = self._require_obs()
         if self._manifest_env is not None:
             return self._manifest_env.joint_state()
-        handles = self.env.mujoco_handles()
-        count = len(self.joint_names)
-        if handles is None:
-            zeros = np.zeros(count)
-            return JointStateSample(
-                names=self.joint_names,
-                positions=self._positions_from_obs(obs),
-                velocities=zeros,
-                efforts=zeros.copy(),
-                stamp_ns=time.monotonic_ns(),
-            )
-        model, data = handles
-        if model is not self._addr_model:  # a backend rebuilt its model on reset
-            self._resolve_addresses(model)
-        return JointStateSample(
-            names=self.joint_names,
-            positions=data.qpos[self._qpos].astype(np.float64),
-            velocities=data.qvel[self._dof].astype(np.float64),
-            efforts=data.qfrc_actuator[self._dof].astype(np.float64),
-            stamp_ns=time.monotonic_ns(),
-            sim_time_s=float(data.time),
-        )
+        return self._joints.read(self.env.mujoco_handles(), obs)
 
     def read_images(self) -> dict[str, npt.NDArray[np.uint8]]:
         """Last frame of each manifest RGB sensor the scene renders, by sensor name."""
@@ -240,12 +214,7 @@ class SimAttachedHAL(EStopLatch):
             ActionRejected: Wrong type, width, or a non-finite value; nothing is changed.
             EStopLatched: The E-stop is latched.
         """
-        self._require_obs()
-        values = validated_action(action, self._action_names)
-        self._refuse_when_estopped()
-        self._reset_if_done()
-        self._last_env_action = self.merge(values)
-        self._step(self._last_env_action.copy())
+        self._command(action, glide=False)
 
     def merge(self, action: FloatArray) -> FloatArray:
         """The scene action to step, from a validated ``action`` and ``_last_env_action``.
@@ -260,10 +229,11 @@ class SimAttachedHAL(EStopLatch):
         """Simulated time one scene step advances [s]."""
         return self.env.control_period_s
 
-    def tick(self, action: object | None) -> bool:
-        """One scene step: with ``action`` (see :meth:`send_action`), or with
-        :meth:`hold_action` when None (the targets in force on a position-controlled scene,
-        the backend's hold on a delta controller); the commanded action is kept.
+    def tick(self, action: object | None, *, glide: bool = False) -> bool:
+        """One scene step: with ``action`` (see :meth:`send_action`; ``glide`` as
+        :meth:`Tickable.tick <openral_hal.protocol.Tickable.tick>` says, on a native scene),
+        or with :meth:`hold_action` when None (the targets in force on a position-controlled
+        scene, the backend's hold on a delta controller); the commanded action is kept.
 
         Returns:
             True when the scene stepped; False (nothing done) while E-stopped.
@@ -275,11 +245,27 @@ class SimAttachedHAL(EStopLatch):
         if self._estopped:
             return False
         if action is not None:
-            self.send_action(action)
+            self._command(action, glide=glide)
             return True
         self._reset_if_done()
         self._step(self.hold_action())
         return True
+
+    def reset(self) -> str:
+        """A new episode of the scene with the HAL's seed: start pose, objects, a mobile
+        base at its start; the E-stop latch is kept (an E-stopped scene stays frozen)."""
+        self._require_obs()
+        self._obs = self.env.reset(seed=self.env_reset_seed)
+        self._episode_done = False
+        self._last_env_action = np.zeros(self.action_dim)
+        time_s = self._obs.get("time")
+        clock = f"; simulated time {time_s:.3f} s" if isinstance(time_s, float) else ""
+        latch = "; the E-stop is still latched" if self._estopped else ""
+        return (
+            f"{self.description.name}: scene reset with seed {self.env_reset_seed} "
+            f"(start pose, objects{', mobile base' if self.base is not None else ''}){clock}"
+            f"{latch}"
+        )
 
     # -- mobile base -----------------------------------------------------------------------
 
@@ -335,34 +321,22 @@ class SimAttachedHAL(EStopLatch):
             self._obs = self.env.reset(seed=self.env_reset_seed)
             self._episode_done = False
 
-    def _step(self, action: npt.NDArray[Any]) -> StepResult:
-        result = self.env.step(action)
+    def _command(self, action: object, *, glide: bool) -> None:
+        self._require_obs()
+        values = validated_action(action, self._action_names)
+        self._refuse_when_estopped()
+        self._reset_if_done()
+        self._last_env_action = self.merge(values)
+        self._step(self._last_env_action.copy(), glide=glide)
+
+    def _step(self, action: npt.NDArray[Any], *, glide: bool = False) -> StepResult:
+        if glide and self._manifest_env is not None:
+            result = self._manifest_env.step(action, glide=True)
+        else:
+            result = self.env.step(action)
         self._obs = result.obs
         self._episode_done = bool(result.terminated or result.truncated)
         return result
-
-    def _resolve_addresses(self, model: mujoco.MjModel) -> None:
-        joint = mujoco.mjtObj.mjOBJ_JOINT
-        available = [mujoco.mj_id2name(model, joint, i) for i in range(model.njnt)]
-        try:
-            resolved = resolve_joint_names(self._mjcf_names, [n for n in available if n])
-        except HalError as error:  # the manifest's joints: say so at its joints list
-            raise error_at(self.description, ("joints",), str(error)) from None
-        ids = [mujoco.mj_name2id(model, joint, resolved[n]) for n in self._mjcf_names]
-        bad = [
-            resolved[n]
-            for n, i in zip(self._mjcf_names, ids, strict=True)
-            if not is_scalar_joint(model, i)
-        ]
-        if bad:
-            message = (
-                f"scene joints {', '.join(bad)} are not hinge or slide joints; a manifest "
-                "joint must map to a one-value joint"
-            )
-            raise error_at(self.description, ("joints",), message)
-        self._qpos = np.array([model.jnt_qposadr[i] for i in ids], dtype=np.intp)
-        self._dof = np.array([model.jnt_dofadr[i] for i in ids], dtype=np.intp)
-        self._addr_model = model
 
     def _slot_names(self, width: int) -> tuple[str, ...]:
         if isinstance(self.env, HoldingRollout) and len(self.env.action_names) == width:
@@ -370,26 +344,6 @@ class SimAttachedHAL(EStopLatch):
         if width == len(self.joint_names):
             return self.joint_names
         return tuple(f"env_action[{i}]" for i in range(width))
-
-    def _positions_from_obs(self, obs: Observation) -> FloatArray:
-        count = len(self.joint_names)
-        raw = obs.get("joint_positions")
-        if raw is None:
-            return np.zeros(count)
-        values = np.asarray(raw, dtype=np.float64).ravel()
-        if values.size != count:
-            if not self._warned_width:
-                _log.warning(
-                    "%s reports %d joint positions but the manifest of %s has %d joints; "
-                    "padding with zeros or truncating",
-                    type(self.env).__name__,
-                    values.size,
-                    self.description.name,
-                    count,
-                )
-                self._warned_width = True
-            values = np.concatenate([values, np.zeros(max(0, count - values.size))])[:count]
-        return values
 
 
 def native_scene(hal: object) -> NativeScene | None:

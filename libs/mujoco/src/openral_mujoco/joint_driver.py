@@ -12,6 +12,13 @@ An action is one value per manifest joint, in manifest order:
 * a gripper joint takes the command of its ``write_mode``, mapped through ``ctrl_range`` to
   its actuator (and negated onto its mirror actuator).
 
+A command may instead *glide* (``glide_s``): it is the next sample of a smooth path (a
+joint trajectory sampled once per control period). Then the set point moves to the targets
+at constant speed over ``glide_s`` seconds, and that speed is fed forward to the position
+servos (``ctrl = set point + kv/kp · speed``, the velocity reference a joint servo tracks
+with), so the joints follow the path instead of lagging it by ``kv/kp · speed``. A sample
+that would need more than a joint's velocity limit is slewed as any other command.
+
 A joint state reports every manifest joint in the same units: grippers through their
 ``read_mode`` (their velocities as the rate of that reading), efforts from the actuator
 forces. :class:`MujocoArmHAL` (the robot alone) and
@@ -34,7 +41,7 @@ from openral_mujoco.command_limits import CommandLimits
 from openral_mujoco.control_law import compile_pd_servos, seed_position_servos
 from openral_mujoco.errors import SimulationDiverged
 from openral_mujoco.gripper import command_map, gripper_command, reading_map
-from openral_mujoco.mjcf_model import ctrl_limits
+from openral_mujoco.mjcf_model import ctrl_limits, is_position_servo
 from openral_mujoco.robot_addresses import LocatedGripper, RobotAddresses
 from openral_mujoco.state import FloatArray
 
@@ -98,6 +105,8 @@ class JointDriver:
         self._data_views: _Views | None = None
         self._in_force = b""  # the bytes of the last applied command
         self._in_force_clamped: tuple[int, ...] = ()  # its slots outside their limits
+        self._feedforward = _velocity_gains(model, self._arm_act)
+        self._glide_left_s = 0.0  # sim time until a gliding set point lands on its targets
 
     # -- start and hold --------------------------------------------------------------------
 
@@ -119,6 +128,7 @@ class JointDriver:
         self._setpoint = self._targets.copy()
         self._speed = np.zeros(len(self._arm))
         self._moving = self._slewing = False
+        self._glide_left_s = 0.0
         self._in_force = b""  # the next command applies in full, even a repeated one
         data.ctrl[self._arm_act] = np.clip(self._setpoint, self._arm_low, self._arm_high)
 
@@ -134,8 +144,9 @@ class JointDriver:
 
     # -- command, advance, read ------------------------------------------------------------
 
-    def command(self, action: object, data: mujoco.MjData) -> None:
-        """Validate, clamp and apply one action (see the module doc).
+    def command(self, action: object, data: mujoco.MjData, *, glide_s: float | None = None) -> None:
+        """Validate, clamp and apply one action (see the module doc); with ``glide_s`` [s]
+        the set point glides to it over that long.
 
         Raises:
             ActionRejected: Wrong type, width, or a non-finite value; nothing is changed.
@@ -156,6 +167,11 @@ class JointDriver:
         targets = bounded[self._arm]
         self._targets = targets  # a set point at rest on its targets has nothing to do:
         self._slewing = self._moving or targets.tobytes() != self._setpoint.tobytes()
+        self._glide_left_s = 0.0
+        if glide_s is not None and glide_s > 0.0:
+            speed = (targets - self._setpoint) / glide_s
+            if (np.abs(speed) <= self._vmax).all():  # never faster than the manifest allows
+                self._speed, self._glide_left_s, self._slewing = speed, glide_s, False
         if self._writes:
             ctrl, commands = data.ctrl, bounded.tolist()
             for slot, actuator, offset, scale, low, high, mirror in self._writes:
@@ -172,6 +188,8 @@ class JointDriver:
         """
         bad_state = self._views(data).bad_state
         diverged_before = bad_state.tobytes()
+        if self._glide_left_s > 0.0:
+            steps = self._glide(model, data, steps)
         if self._slewing:
             self._slew(model, data, steps)
         else:
@@ -261,6 +279,26 @@ class JointDriver:
         if remaining > 0:
             mujoco.mj_step(model, data, nstep=remaining)
 
+    def _glide(self, model: mujoco.MjModel, data: mujoco.MjData, steps: int) -> int:
+        """Physics steps of a glide (see the module doc), the set point and its fed-forward
+        speed updated every :data:`SLEW_CHUNK_STEPS`; returns the steps left after it ended."""
+        ctrl, act = data.ctrl, self._arm_act
+        while steps > 0 and self._glide_left_s > 0.0:
+            chunk = min(steps, SLEW_CHUNK_STEPS)
+            dt = chunk * self._dt
+            if dt >= self._glide_left_s - 1e-12:  # lands on the targets: the speed ends
+                self._setpoint, self._glide_left_s = self._targets, 0.0
+                self._speed = np.zeros(len(self._arm))
+                ctrl[act] = self._setpoint
+            else:
+                self._setpoint = self._setpoint + self._speed * dt
+                self._glide_left_s -= dt
+                ctrl[act] = self._setpoint + self._feedforward * self._speed
+            mujoco.mj_step(model, data, nstep=chunk)
+            steps -= chunk
+        self._moving = bool(self._speed.any())
+        return steps
+
     def _command_bounds(self) -> tuple[FloatArray, FloatArray]:
         """Per slot, the range a command is clamped to in one pass: the manifest's limits
         (:class:`CommandLimits`, unlimited as the largest finite float), narrowed to the
@@ -310,6 +348,15 @@ def _gripper_read(g: LocatedGripper) -> _Read:
     w = g.wiring
     reading = reading_map(w.read_mode, len(g.finger_qpos), w.ctrl_range, w.qpos_scale)
     return (g.slot, g.finger_qpos.tolist(), g.finger_qvel.tolist(), reading.weights, reading.offset)
+
+
+def _velocity_gains(model: mujoco.MjModel, actuators: npt.NDArray[np.intp]) -> FloatArray:
+    """Per actuator, kv/kp of an affine position servo (``kp·(ctrl - q) - kv·q̇``: bias
+    ``[0, -kp, -kv]``), the set-point offset that makes it track a speed; 0 for any other."""
+    bias = model.actuator_biasprm[actuators]
+    affine = np.array([is_position_servo(model, int(a)) for a in actuators], dtype=bool)
+    usable = affine & (bias[:, 1] < 0.0)
+    return np.where(usable, bias[:, 2] / np.where(usable, bias[:, 1], -1.0), 0.0)
 
 
 def _clip(value: float, low: float, high: float) -> float:

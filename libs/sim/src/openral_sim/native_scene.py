@@ -187,14 +187,18 @@ class NativeScene:
         self._steps = 0
         return self._observe()
 
-    def step(self, action: npt.NDArray[np.floating]) -> StepResult:
-        """Apply ``action`` (one value per manifest joint) for one control period.
+    def step(self, action: npt.NDArray[np.floating], *, glide: bool = False) -> StepResult:
+        """Apply ``action`` (one value per manifest joint) for one control period; with
+        ``glide`` the arm's set point moves to it at constant speed over the period, that
+        speed fed forward (the next sample of a smooth path, see
+        :class:`~openral_mujoco.joint_driver.JointDriver`).
 
         Raises:
             ActionRejected: Wrong type, width, or a non-finite value; nothing is changed.
             SimulationDiverged: MuJoCo met a NaN/Inf state and reset it.
         """
-        self.driver.command(action, self.data)
+        glide_s = self.control_period_s if glide else None
+        self.driver.command(action, self.data, glide_s=glide_s)
         self._advance(self.substeps)
         self._steps += 1
         truncated = self.horizon is not None and self._steps >= self.horizon

@@ -96,6 +96,11 @@ class ManifestRollout(HoldingRollout, Protocol):
     A HAL attached to it delegates joint state to it instead of reading raw ``qpos``.
     """
 
+    def step(self, action: npt.NDArray[np.floating[Any]], *, glide: bool = False) -> StepResult:
+        """Apply ``action`` for one control period; with ``glide`` the set point moves to it
+        at constant speed over the period (the next sample of a smooth path)."""
+        ...
+
     def joint_state(self) -> JointStateSample:
         """Every manifest joint, in manifest order and units."""
         ...

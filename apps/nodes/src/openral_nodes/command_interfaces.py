@@ -1,0 +1,221 @@
+"""What a client commands on the manifest node while it is active.
+
+- ``/openral/safe_action`` (``std_msgs/Float64MultiArray``): one value per action slot;
+  a valid one waits for the next control tick (on a real HAL: goes to it at once) and
+  pre-empts a running joint trajectory;
+- ``/openral/joint_trajectory`` (``trajectory_msgs/JointTrajectory``): joints by manifest
+  name, followed by the control loop (:mod:`openral_bridge.joint_path` says what is
+  accepted); ``/openral/joint_trajectory/state`` (``sensor_msgs/JointState``) carries the
+  desired point after every tick that followed one, stamped in simulated time;
+- ``/openral/estop`` and ``/openral/release_estop`` (``std_srvs/Trigger``); the E-stop also
+  aborts a trajectory;
+- ``/openral/reset`` (``std_srvs/Trigger``): the scene back to its seed and start pose,
+  carried out by the control loop's next tick; the answer says what was reset.
+
+Every refusal is a throttled warning naming the topic and the reason, and changes nothing.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from openral_bridge.control_loop import ControlLoop, ResetFailed
+from openral_bridge.joint_path import PathRefused
+from openral_bridge.joint_state_publisher import sim_stamp
+from openral_bridge.sim_sensor_bridge import TopicInfo
+from openral_bridge.topics import (
+    ESTOP,
+    JOINT_TRAJECTORY,
+    JOINT_TRAJECTORY_STATE,
+    RELEASE_ESTOP,
+    RESET,
+    SAFE_ACTION,
+)
+from openral_bridge.trajectory_follower import DesiredPoint
+from openral_hal.errors import EStopLatched, HalError
+from openral_hal.protocol import RobotHal
+from openral_mujoco.action import validated_action
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Trigger
+from trajectory_msgs.msg import JointTrajectory
+
+from openral_nodes.trajectory_request import request_from_msg
+
+if TYPE_CHECKING:
+    from rclpy.node import Node
+
+Entity = tuple[str, Any]
+"""(``publisher`` | ``subscription`` | ``service``, the rclpy entity)."""
+
+
+class CommandInterfaces:
+    """The command topics and services of one active manifest node (see the module doc)."""
+
+    def __init__(
+        self,
+        node: Node,
+        hal: RobotHal,
+        lock: threading.Lock,
+        loop: ControlLoop | None,
+        *,
+        warn_every_s: float,
+    ) -> None:
+        """Nothing is created until :meth:`create`.
+
+        Args:
+            node: The node that owns the entities and logs.
+            hal: The connected HAL.
+            lock: The HAL's lock.
+            loop: The control loop of a simulated HAL (None for a real one).
+            warn_every_s: At most one warning per this long for a stream of refusals [s].
+        """
+        self.node = node
+        self.hal = hal
+        self.lock = lock
+        self.loop = loop
+        self.warn_every_s = warn_every_s
+        self.accepted = 0
+        """Valid actions taken (handed to the control loop, or to a real HAL)."""
+        self.refused = 0
+        """Actions refused."""
+        self.trajectories_accepted = 0
+        self.trajectories_refused = 0
+        self._state_pub: Any = None
+
+    def create(self) -> list[Entity]:
+        """Create the subscriptions, services and the trajectory state publisher."""
+        node = self.node
+        self._state_pub = node.create_publisher(JointState, JOINT_TRAJECTORY_STATE, 10)
+        if self.loop is not None:
+            self.loop.on_sample = self._publish_desired
+        return [
+            ("publisher", self._state_pub),
+            (
+                "subscription",
+                node.create_subscription(Float64MultiArray, SAFE_ACTION, self._on_action, 10),
+            ),
+            (
+                "subscription",
+                node.create_subscription(
+                    JointTrajectory, JOINT_TRAJECTORY, self._on_trajectory, 10
+                ),
+            ),
+            ("service", node.create_service(Trigger, ESTOP, self._on_estop)),
+            ("service", node.create_service(Trigger, RELEASE_ESTOP, self._on_release_estop)),
+            ("service", node.create_service(Trigger, RESET, self._on_reset)),
+        ]
+
+    def topics(self) -> list[TopicInfo]:
+        """The trajectory state topic (published once per tick while a trajectory runs)."""
+        rate = 1.0 / self.loop.period_s if self.loop is not None else None
+        return [TopicInfo(JOINT_TRAJECTORY_STATE, "sensor_msgs/msg/JointState", rate)]
+
+    # -- topics ----------------------------------------------------------------------------
+
+    def _on_action(self, msg: Any) -> None:
+        hal, loop = self.hal, self.loop
+        try:
+            values = validated_action(np.asarray(msg.data, dtype=np.float64), hal.action_names)
+            if loop is None:
+                with self.lock:
+                    hal.send_action(values)
+            elif hal.estopped:
+                raise EStopLatched()
+            elif loop.offer(values):
+                self._log().info("joint trajectory pre-empted by a safe_action")
+        except HalError as error:
+            self.refused += 1
+            self._warn(f"{SAFE_ACTION}: action refused: {error}")
+            return
+        self.accepted += 1
+
+    def _on_trajectory(self, msg: Any) -> None:
+        loop = self.loop
+        try:
+            follower = loop.follower if loop is not None else None
+            if loop is None or follower is None:
+                raise PathRefused(self._why_no_trajectories())
+            if self.hal.estopped:
+                raise PathRefused("the E-stop is latched")
+            request = request_from_msg(msg)
+            with self.lock:
+                hold = np.asarray(self.hal.hold_action(), dtype=np.float64)
+                now_s = loop.state.sim_time_s if loop.state is not None else None
+            if now_s is None:
+                raise PathRefused("the scene has no simulated time yet")
+            path = follower.submit(request, hold, now_s)
+        except PathRefused as error:
+            self.trajectories_refused += 1
+            self._warn(f"{JOINT_TRAJECTORY}: trajectory refused: {error}")
+            return
+        self.trajectories_accepted += 1
+        self._log().info(
+            f"following a joint trajectory over {', '.join(path.names)}: "
+            f"{len(path.times_s) - 1} points from t={path.start_s:.3f} s to "
+            f"t={path.end_s:.3f} s (simulated)"
+        )
+
+    def _publish_desired(self, point: DesiredPoint) -> None:
+        """The desired point after a tick that followed a trajectory (loop thread)."""
+        msg = JointState(
+            name=list(point.names),
+            position=point.positions.tolist(),
+            velocity=point.velocities.tolist(),
+        )
+        msg.header.stamp = sim_stamp(self.node, point.time_s)
+        self._state_pub.publish(msg)
+
+    # -- services --------------------------------------------------------------------------
+
+    def _on_estop(self, request: Any, response: Any) -> Any:
+        with self.lock:  # a tick in progress ends first; none follows
+            self.hal.estop()
+        follower = self.loop.follower if self.loop is not None else None
+        aborted = follower is not None and follower.cancel()
+        note = "; the joint trajectory is aborted" if aborted else ""
+        self._log().warning(f"E-stop latched: actions are refused and the scene is frozen{note}")
+        response.success, response.message = True, f"E-stop latched{note}"
+        return response
+
+    def _on_release_estop(self, request: Any, response: Any) -> Any:
+        with self.lock:
+            self.hal.release_estop()
+        self._log().info("E-stop released")
+        response.success, response.message = True, "E-stop released"
+        return response
+
+    def _on_reset(self, request: Any, response: Any) -> Any:
+        if self.loop is None:
+            response.success = False
+            response.message = "a real robot has no scene to reset"
+            return response
+        try:
+            text = self.loop.reset()
+        except ResetFailed as error:
+            response.success, response.message = False, str(error)
+            self._log().error(f"{RESET}: {error}")
+            return response
+        self._log().info(f"reset: {text}")
+        response.success, response.message = True, text
+        return response
+
+    # -- internals -------------------------------------------------------------------------
+
+    def _why_no_trajectories(self) -> str:
+        if self.loop is None:
+            return "a real robot's HAL follows no trajectories here; send safe_action"
+        names = self.hal.action_names
+        return (
+            f"this scene's action is its controller's ({len(names)} slots: "
+            f"{', '.join(names[:3])}…), not the manifest's joints; joint trajectories need a "
+            "native scene"
+        )
+
+    def _warn(self, text: str) -> None:
+        self._log().warning(text, throttle_duration_sec=self.warn_every_s)
+
+    def _log(self) -> Any:
+        return self.node.get_logger()  # type: ignore[no-untyped-call]

@@ -1,0 +1,241 @@
+"""Joint trajectories and the reset service of the franka tabletop, from outside the graph.
+
+``openral deploy sim`` runs as a subprocess; a client on a domain of its own sends
+``trajectory_msgs/JointTrajectory`` on ``/openral/joint_trajectory`` and calls
+``/openral/reset`` as a ROS tool would, and reads ``/joint_states``, the trajectory state
+and the wrist camera:
+
+- panda_joint1 and panda_joint4 each move +0.5 rad in 2.0 s (a two-point trajectory):
+  ``/joint_states`` is within 0.02 rad of the straight-line path at 0.5, 1.0, 1.5 and
+  2.0 s after its start; the same with velocities (a cubic) against the cubic path;
+- a trajectory over a velocity limit is refused whole (one warning naming the joint and
+  the speed) and moves nothing;
+- a ``safe_action`` pre-empts a trajectory, the E-stop aborts one;
+- after 5 s of motion ``/openral/reset`` brings ``/joint_states`` back to the start state
+  within 1e-6 rad and the cameras show the first frame of the graph again, pixel for pixel.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pytest
+from openral_bridge.topics import (
+    CLOCK,
+    ESTOP,
+    JOINT_STATES,
+    JOINT_TRAJECTORY,
+    JOINT_TRAJECTORY_STATE,
+    RELEASE_ESTOP,
+    RESET,
+    SAFE_ACTION,
+    camera_image,
+)
+from openral_nodes.runtime import Spinner, claim_domain_id, ros_session
+from openral_nodes.trajectory_request import trajectory_msg
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import Image, JointState
+from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Trigger
+from trajectory_msgs.msg import JointTrajectory
+
+from tests.ros.lifecycle_client import deploy_output, deploy_sim
+from tests.ros.ros_helpers import FRANKA_SCENE, Probe, wait_until
+
+START_WAIT_S = 90.0
+"""Longest wait for deploy sim to load its scene and publish on a loaded machine [s]."""
+JOINTS = ("panda_joint1", "panda_joint4")
+WRIST = camera_image("wrist")
+TOLERANCE_RAD = 0.02
+
+
+def stamp_s(msg: Any) -> float:
+    return float(msg.header.stamp.sec) + float(msg.header.stamp.nanosec) * 1e-9
+
+
+@dataclass
+class Client:
+    """A probe of the graph, a trajectory and an action publisher, the services."""
+
+    probe: Probe
+    logs: Any
+    trajectory: Any
+    action: Any
+    services: dict[str, Any]
+
+    def call(self, name: str) -> Any:
+        client = self.services[name]
+        assert client.wait_for_service(timeout_sec=10.0), f"{name} is not offered"
+        future = client.call_async(Trigger.Request())
+        wait_until(future.done, 15.0, f"the answer of {name}")
+        return future.result()
+
+    def positions(self, msg: Any) -> np.ndarray:
+        names = list(msg.name)
+        return np.array([msg.position[names.index(j)] for j in JOINTS])
+
+    def now_s(self) -> float:
+        return (
+            float(self.probe.latest(CLOCK).clock.sec)
+            + self.probe.latest(CLOCK).clock.nanosec * 1e-9
+        )
+
+    def state_at(self, time_s: float, after: float = 0.0) -> Any:
+        """The /joint_states message stamped ``time_s`` (waits for it)."""
+
+        def found() -> bool:
+            return any(
+                abs(stamp_s(r.msg) - time_s) < 1e-6 for r in self.probe.since(JOINT_STATES, after)
+            )
+
+        self.probe.wait(found, 15.0, f"/joint_states stamped {time_s:.3f} s")
+        return next(
+            r.msg
+            for r in self.probe.since(JOINT_STATES, after)
+            if abs(stamp_s(r.msg) - time_s) < 1e-6
+        )
+
+
+@pytest.fixture(scope="module")
+def client(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Client]:
+    logs = tmp_path_factory.mktemp("trajectory_live")
+    domain = claim_domain_id()
+    topics = {
+        JOINT_STATES: JointState,
+        CLOCK: Clock,
+        JOINT_TRAJECTORY_STATE: JointState,
+        WRIST: Image,
+    }
+    with ros_session(domain_id=domain) as context:
+        probe = Probe(context, topics, name="trajectory_client")  # before the graph: first frame
+        with Spinner(context) as spinner, deploy_sim(FRANKA_SCENE, domain, logs) as process:
+            spinner.add_node(probe.node)
+            for topic in (JOINT_STATES, CLOCK, WRIST):
+                probe.wait_count(topic, 1, timeout_s=START_WAIT_S)
+            node = probe.node
+            client = Client(
+                probe,
+                logs,
+                node.create_publisher(JointTrajectory, JOINT_TRAJECTORY, 10),
+                node.create_publisher(Float64MultiArray, SAFE_ACTION, 10),
+                {name: node.create_client(Trigger, name) for name in (RESET, ESTOP, RELEASE_ESTOP)},
+            )
+            wait_until(lambda: client.trajectory.get_subscription_count() > 0, 10.0, "a subscriber")
+            assert process.poll() is None, deploy_output(logs)
+            yield client
+        probe.node.destroy_node()  # type: ignore[no-untyped-call]
+
+
+def _send_plus_half(
+    client: Client, *, cubic: bool, lead_ticks: int = 10
+) -> tuple[float, np.ndarray]:
+    """Send +0.5 rad on both joints in 2.0 s, starting ``lead_ticks`` ticks from now (a
+    header stamp in simulated time); returns (start time, start positions)."""
+    start_positions = client.positions(client.probe.latest(JOINT_STATES))
+    msg = trajectory_msg(
+        JOINTS,
+        [0.0, 2.0],
+        [start_positions.tolist(), (start_positions + 0.5).tolist()],
+        [[0.0, 0.0], [0.0, 0.0]] if cubic else None,
+    )
+    start_s = client.now_s() + lead_ticks * 0.05  # on the tick grid: /clock is a tick's time
+    msg.header.stamp.sec = int(start_s)
+    msg.header.stamp.nanosec = round((start_s - int(start_s)) * 1e9)
+    client.trajectory.publish(msg)
+    return start_s, start_positions
+
+
+@pytest.mark.parametrize("cubic", [False, True], ids=["linear", "cubic"])
+def test_a_two_point_trajectory_is_followed_within_0_02_rad(client: Client, cubic: bool) -> None:
+    _settle(client)
+    now = time.monotonic()
+    start_s, q0 = _send_plus_half(client, cubic=cubic)
+    for offset in (0.5, 1.0, 1.5, 2.0):
+        s = offset / 2.0
+        shape = 3 * s**2 - 2 * s**3 if cubic else s
+        expected = q0 + 0.5 * shape
+        reached = client.positions(client.state_at(start_s + offset, now))
+        error = reached - expected
+        kind = "cubic" if cubic else "linear"
+        print(f"{kind} t={offset:.1f} s: error {error.round(4).tolist()} rad")
+        assert np.abs(error).max() < TOLERANCE_RAD
+    desired = client.probe.since(JOINT_TRAJECTORY_STATE, now)
+    assert desired and list(desired[-1].msg.name) == list(JOINTS)
+    assert np.allclose(desired[-1].msg.position, q0 + 0.5, atol=1e-9)
+    _back(client, q0)
+
+
+def test_a_trajectory_over_the_velocity_limit_is_refused_and_moves_nothing(client: Client) -> None:
+    _settle(client)
+    before = client.positions(client.probe.latest(JOINT_STATES))
+    msg = trajectory_msg(JOINTS, [0.5], [(before + np.array([1.5, 0.0])).tolist()])  # 3 rad/s
+    now = time.monotonic()
+    client.trajectory.publish(msg)
+    time.sleep(1.5)
+    after = client.positions(client.probe.latest(JOINT_STATES))
+    assert np.abs(after - before).max() < 1e-3
+    assert not client.probe.since(JOINT_TRAJECTORY_STATE, now)
+    _, err = deploy_output(client.logs)
+    refusals = [line for line in err.splitlines() if "trajectory refused" in line]
+    assert refusals and "panda_joint1 would need 3 " in refusals[-1], refusals
+    assert "velocity_limit is 2.175" in refusals[-1]
+
+
+def test_safe_action_preempts_and_estop_aborts_a_trajectory(client: Client) -> None:
+    _settle(client)
+    q0 = client.positions(client.probe.latest(JOINT_STATES))
+    for interrupt in ("safe_action", "estop"):
+        client.trajectory.publish(trajectory_msg(JOINTS, [4.0], [(q0 + 0.4).tolist()]))
+        client.probe.wait_count(JOINT_TRAJECTORY_STATE, 3, time.monotonic())
+        if interrupt == "safe_action":
+            hold = client.probe.latest(JOINT_STATES)
+            client.action.publish(Float64MultiArray(data=list(hold.position[:8])))
+        else:
+            assert client.call(ESTOP).message.endswith("the joint trajectory is aborted")
+        time.sleep(0.3)
+        quiet_from = time.monotonic()
+        time.sleep(0.5)
+        assert not client.probe.since(JOINT_TRAJECTORY_STATE, quiet_from), interrupt
+    assert client.call(RELEASE_ESTOP).success
+    _back(client, q0)
+
+
+def test_reset_restores_the_start_state_and_the_first_frame(client: Client) -> None:
+    first = client.probe.messages[WRIST][0].msg
+    first_joints = client.probe.messages[JOINT_STATES][0].msg
+    client.trajectory.publish(
+        trajectory_msg(JOINTS, [5.0], [(client.positions(first_joints) + 0.6).tolist()])
+    )
+    time.sleep(5.0)
+    moved = client.probe.latest(JOINT_STATES)
+    assert np.abs(client.positions(moved) - client.positions(first_joints)).max() > 0.3
+    now = time.monotonic()
+    answer = client.call(RESET)
+    assert answer.success, answer.message
+    assert "seed 0" in answer.message
+    print(f"reset: {answer.message}")
+    state = client.state_at(stamp_s(first_joints), now)
+    assert np.abs(np.array(state.position) - np.array(first_joints.position)).max() < 1e-6
+
+    def same_stamp() -> bool:
+        return any(stamp_s(r.msg) == stamp_s(first) for r in client.probe.since(WRIST, now))
+
+    client.probe.wait(same_stamp, 15.0, "the wrist frame of the start state")
+    again = next(r.msg for r in client.probe.since(WRIST, now) if stamp_s(r.msg) == stamp_s(first))
+    assert bytes(again.data) == bytes(first.data)
+
+
+def _settle(client: Client) -> None:
+    """Let an earlier test's motion die down."""
+    time.sleep(0.5)
+
+
+def _back(client: Client, q0: np.ndarray) -> None:
+    """Return the two joints to ``q0`` over 2 s and wait for it."""
+    here = client.positions(client.probe.latest(JOINT_STATES))
+    client.trajectory.publish(trajectory_msg(JOINTS, [0.0, 2.0], [here.tolist(), q0.tolist()]))
+    time.sleep(2.8)
