@@ -19,115 +19,27 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterator
-from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pytest
 from openral_bridge.topics import (
-    CLOCK,
     ESTOP,
     JOINT_STATES,
-    JOINT_TRAJECTORY,
     JOINT_TRAJECTORY_STATE,
     RELEASE_ESTOP,
     RESET,
-    SAFE_ACTION,
-    camera_image,
 )
-from openral_nodes.runtime import Spinner, claim_domain_id, ros_session
 from openral_nodes.trajectory_request import trajectory_msg
-from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float64MultiArray
-from std_srvs.srv import Trigger
-from trajectory_msgs.msg import JointTrajectory
 
-from tests.ros.lifecycle_client import deploy_output, deploy_sim
-from tests.ros.ros_helpers import FRANKA_SCENE, Probe, wait_until
+from tests.ros.trajectory_client import JOINTS, WRIST, Client, franka_graph, stamp_s
 
-START_WAIT_S = 90.0
-"""Longest wait for deploy sim to load its scene and publish on a loaded machine [s]."""
-JOINTS = ("panda_joint1", "panda_joint4")
-WRIST = camera_image("wrist")
 TOLERANCE_RAD = 0.02
-
-
-def stamp_s(msg: Any) -> float:
-    return float(msg.header.stamp.sec) + float(msg.header.stamp.nanosec) * 1e-9
-
-
-@dataclass
-class Client:
-    """A probe of the graph, a trajectory and an action publisher, the services."""
-
-    probe: Probe
-    logs: Any
-    trajectory: Any
-    action: Any
-    services: dict[str, Any]
-
-    def call(self, name: str) -> Any:
-        client = self.services[name]
-        assert client.wait_for_service(timeout_sec=10.0), f"{name} is not offered"
-        future = client.call_async(Trigger.Request())
-        wait_until(future.done, 15.0, f"the answer of {name}")
-        return future.result()
-
-    def positions(self, msg: Any) -> np.ndarray:
-        names = list(msg.name)
-        return np.array([msg.position[names.index(j)] for j in JOINTS])
-
-    def now_s(self) -> float:
-        return (
-            float(self.probe.latest(CLOCK).clock.sec)
-            + self.probe.latest(CLOCK).clock.nanosec * 1e-9
-        )
-
-    def state_at(self, time_s: float, after: float = 0.0) -> Any:
-        """The /joint_states message stamped ``time_s`` (waits for it)."""
-
-        def found() -> bool:
-            return any(
-                abs(stamp_s(r.msg) - time_s) < 1e-6 for r in self.probe.since(JOINT_STATES, after)
-            )
-
-        self.probe.wait(found, 15.0, f"/joint_states stamped {time_s:.3f} s")
-        return next(
-            r.msg
-            for r in self.probe.since(JOINT_STATES, after)
-            if abs(stamp_s(r.msg) - time_s) < 1e-6
-        )
 
 
 @pytest.fixture(scope="module")
 def client(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Client]:
-    logs = tmp_path_factory.mktemp("trajectory_live")
-    domain = claim_domain_id()
-    topics = {
-        JOINT_STATES: JointState,
-        CLOCK: Clock,
-        JOINT_TRAJECTORY_STATE: JointState,
-        WRIST: Image,
-    }
-    with ros_session(domain_id=domain) as context:
-        probe = Probe(context, topics, name="trajectory_client")  # before the graph: first frame
-        with Spinner(context) as spinner, deploy_sim(FRANKA_SCENE, domain, logs) as process:
-            spinner.add_node(probe.node)
-            for topic in (JOINT_STATES, CLOCK, WRIST):
-                probe.wait_count(topic, 1, timeout_s=START_WAIT_S)
-            node = probe.node
-            client = Client(
-                probe,
-                logs,
-                node.create_publisher(JointTrajectory, JOINT_TRAJECTORY, 10),
-                node.create_publisher(Float64MultiArray, SAFE_ACTION, 10),
-                {name: node.create_client(Trigger, name) for name in (RESET, ESTOP, RELEASE_ESTOP)},
-            )
-            wait_until(lambda: client.trajectory.get_subscription_count() > 0, 10.0, "a subscriber")
-            assert process.poll() is None, deploy_output(logs)
-            yield client
-        probe.node.destroy_node()  # type: ignore[no-untyped-call]
+    yield from franka_graph(tmp_path_factory.mktemp("trajectory_live"))
 
 
 def _send_plus_half(
@@ -179,7 +91,7 @@ def test_a_trajectory_over_the_velocity_limit_is_refused_and_moves_nothing(clien
     after = client.positions(client.probe.latest(JOINT_STATES))
     assert np.abs(after - before).max() < 1e-3
     assert not client.probe.since(JOINT_TRAJECTORY_STATE, now)
-    _, err = deploy_output(client.logs)
+    err = client.stderr()
     refusals = [line for line in err.splitlines() if "trajectory refused" in line]
     assert refusals and "panda_joint1 would need 3 " in refusals[-1], refusals
     assert "velocity_limit is 2.175" in refusals[-1]

@@ -154,7 +154,7 @@ class CommandInterfaces:
         self.trajectories_accepted += 1
         self._log().info(
             f"following a joint trajectory over {', '.join(path.names)}: "
-            f"{len(path.times_s) - 1} points from t={path.start_s:.3f} s to "
+            f"{len(path.times_s) - 1} point(s) from t={path.start_s:.3f} s to "
             f"t={path.end_s:.3f} s (simulated)"
         )
 

@@ -33,6 +33,7 @@ DECODABLE_PACKAGES = (
     "rosgraph_msgs",
     "sensor_msgs",
     "std_msgs",
+    "trajectory_msgs",
 )
 """ROS message packages whose types are decoded (the ``ros`` extra and rclpy's own)."""
 MESSAGE_NAME = re.compile(r"[A-Z][A-Za-z0-9]*")

@@ -6,6 +6,7 @@ Examples::
     openral ros echo /joint_states --once
     openral ros snapshot /openral/cameras/agentview/image --out agentview.png
     openral ros pub /cmd_vel geometry_msgs/msg/Twist "{linear: {x: 0.3}}" --count 40 --rate 20
+    openral ros reset
 
 rclpy is imported only when a command runs, so the rest of the CLI works without the
 ``ros`` extra.
@@ -246,3 +247,27 @@ def pub(
             publisher.publish(msg)
         time.sleep(0.2)  # let the last message leave before the node goes
     out.print(f"published {count} {type_name} on {name} at {rate:g} Hz", markup=False)
+
+
+@app.command("reset")
+def reset(
+    timeout: Annotated[
+        float,
+        typer.Option(
+            "--timeout", min=0.0, help="Seconds to wait for the service, then its answer."
+        ),
+    ] = 10.0,
+    domain_id: DomainId = None,
+) -> None:
+    """Reset the simulated scene through ``/openral/reset``: its seed, the start pose and
+    every object, while the graph keeps running (the E-stop stays as it is)."""
+    require_ros()
+    from openral_bridge.topics import RESET
+    from openral_core.errors import OpenralError
+    from openral_nodes.service_call import call_trigger
+
+    with _probe_node(domain_id) as node:
+        answer = call_trigger(node, RESET, timeout)
+    if not answer.success:
+        raise OpenralError(f"{RESET}: {answer.message}")
+    out.print(answer.message, markup=False)

@@ -4,6 +4,7 @@ Example (with ``openral deploy sim`` running in another terminal)::
 
     openral rskill run --robot franka_panda --policy wave --duration 10
     openral rskill run --robot franka_panda -p amplitude=0.3 -p action_slots=panda_joint1
+    openral rskill trajectory --move panda_joint1=0.5 --move panda_joint4=0.5 --relative
 
 The runner realigns camera frames to VLA slots, calls the policy at ``--rate`` and
 publishes on ``/openral/safe_action``. It exits 0 on Ctrl-C, SIGTERM or after
@@ -23,12 +24,13 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from openral_cli.console import line, out, status
+from openral_cli.console import line, out, progress, status
 from openral_cli.help_text import command_group
 from openral_cli.ros_available import require_ros
 
 if TYPE_CHECKING:
     from openral_nodes.rskill_runner import RskillRunnerNode
+    from openral_nodes.trajectory_sender import TrajectoryReport
 
 app = command_group("Run robot skills (policies) on the ROS graph.")
 
@@ -126,3 +128,80 @@ def _sigterm_as_interrupt() -> Iterator[None]:
         yield
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+@app.command("trajectory")
+def trajectory(
+    move: Annotated[
+        list[str],
+        typer.Option("--move", "-m", help="joint=position [rad or m] (repeatable)."),
+    ],
+    seconds: Annotated[
+        float, typer.Option("--seconds", min=0.01, help="Time to reach the goal.")
+    ] = 2.0,
+    relative: Annotated[
+        bool, typer.Option("--relative", help="Move the joints by the values, not to them.")
+    ] = False,
+    cubic: Annotated[
+        bool, typer.Option("--cubic", help="Start and stop smoothly (zero end velocities).")
+    ] = False,
+    timeout: Annotated[
+        float, typer.Option("--timeout", min=0.1, help="Seconds to wait for the graph.")
+    ] = 10.0,
+    domain_id: Annotated[
+        int | None,
+        typer.Option(
+            "--domain-id", min=0, max=232, help="ROS domain.", show_default="$ROS_DOMAIN_ID"
+        ),
+    ] = None,
+) -> None:
+    """Send one joint trajectory on ``/openral/joint_trajectory`` (from where the joints are
+    to the goals in SECONDS), follow it and print how closely the joints tracked it."""
+    require_ros()
+    from openral_bridge.topics import JOINT_TRAJECTORY
+    from openral_nodes.runtime import Spinner, ros_session
+    from openral_nodes.trajectory_sender import TrajectorySender, parse_moves
+    from rclpy.node import Node
+
+    moves = parse_moves(move)
+    with ros_session(domain_id) as context:
+        node = Node("openral_trajectory_sender", context=context, start_parameter_services=False)
+        try:
+            with Spinner(context) as spinner, _sigterm_as_interrupt():
+                spinner.add_node(node)
+                sender = TrajectorySender(node)
+                with progress() as bar:
+                    task = bar.add_task(f"{JOINT_TRAJECTORY} ({seconds:g} s)", total=1.0)
+
+                    def advance(done: float) -> None:
+                        bar.update(task, completed=done)
+
+                    report = sender.send(
+                        moves,
+                        seconds,
+                        relative=relative,
+                        cubic=cubic,
+                        timeout_s=timeout,
+                        on_progress=advance,
+                    )
+        finally:
+            node.destroy_node()  # type: ignore[no-untyped-call]
+    _print_report(report, seconds, cubic)
+
+
+def _print_report(report: TrajectoryReport, seconds: float, cubic: bool) -> None:
+    """The joints' start, goal, end and tracking error as a table, and one summary line."""
+    from rich.table import Table
+
+    table = Table(title=f"{'cubic' if cubic else 'linear'} trajectory, {seconds:g} s")
+    for column in ("joint", "start", "goal", "reached", "max tracking error"):
+        table.add_column(column, justify="left" if column == "joint" else "right")
+    rows = zip(report.start, report.goal, report.reached, report.max_error, strict=True)
+    for name, (start, goal, reached, error) in zip(report.names, rows, strict=True):
+        table.add_row(name, f"{start:+.4f}", f"{goal:+.4f}", f"{reached:+.4f}", f"{error:.4f}")
+    out.print(table)
+    worst = max(report.max_error, default=0.0)
+    out.print(
+        f"followed {report.samples} desired points; joints within {worst:.4f} (rad or m) of "
+        "the path at every one"
+    )
