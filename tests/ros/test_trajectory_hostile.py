@@ -22,6 +22,7 @@ import pytest
 from openral_bridge.topics import JOINT_STATES, JOINT_TRAJECTORY_STATE
 from openral_nodes.trajectory_request import trajectory_msg
 
+from tests.conftest import REPO
 from tests.ros.trajectory_client import JOINTS, Client, franka_graph
 
 OPENRAL = Path(sys.executable).parent / "openral"
@@ -106,7 +107,21 @@ def test_rskill_trajectory_reports_a_refusal_in_one_line(client: Client) -> None
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1, result.stderr
     assert lines[0].startswith("error: the graph refused the trajectory: panda_joint1 would need ")
-    assert lines[0].endswith("its velocity_limit is 2.175")
+    assert lines[0].endswith("its velocity_limit is 2.175 rad/s")
+
+
+def test_the_docs_example_sends_a_trajectory_the_graph_follows(client: Client) -> None:
+    start = client.positions(client.probe.latest(JOINT_STATES))[0]
+    script = REPO / "docs" / "examples" / "send_trajectory.py"
+    result = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, env=client.env, timeout=60
+    )
+    assert result.returncode == 0, result.stderr
+    name, value = result.stdout.strip().removeprefix("last desired point: ").split(" = ")
+    assert name == "panda_joint1"
+    assert float(value.removesuffix(" rad")) == pytest.approx(start + 0.3, abs=0.01)
+    reached = client.positions(client.probe.latest(JOINT_STATES))[0]
+    assert reached == pytest.approx(start + 0.3, abs=0.01)
 
 
 def test_ros_reset_prints_what_was_reset(client: Client) -> None:

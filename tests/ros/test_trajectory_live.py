@@ -94,7 +94,7 @@ def test_a_trajectory_over_the_velocity_limit_is_refused_and_moves_nothing(clien
     err = client.stderr()
     refusals = [line for line in err.splitlines() if "trajectory refused" in line]
     assert refusals and "panda_joint1 would need 3 " in refusals[-1], refusals
-    assert "velocity_limit is 2.175" in refusals[-1]
+    assert "velocity_limit is 2.175 rad/s" in refusals[-1]
 
 
 def test_safe_action_preempts_and_estop_aborts_a_trajectory(client: Client) -> None:

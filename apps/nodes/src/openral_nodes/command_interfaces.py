@@ -108,10 +108,17 @@ class CommandInterfaces:
             ("service", node.create_service(Trigger, RESET, self._on_reset)),
         ]
 
+    @property
+    def follows_trajectories(self) -> bool:
+        """True when ``/openral/joint_trajectory`` is followed (a simulated HAL whose
+        action slots are the manifest joints)."""
+        return self.loop is not None and self.loop.follower is not None
+
     def topics(self) -> list[TopicInfo]:
         """The trajectory state topic (published once per tick while a trajectory runs)."""
         rate = 1.0 / self.loop.period_s if self.loop is not None else None
-        return [TopicInfo(JOINT_TRAJECTORY_STATE, "sensor_msgs/msg/JointState", rate)]
+        kind = "sensor_msgs/msg/JointState"
+        return [TopicInfo(JOINT_TRAJECTORY_STATE, kind, rate, "while moving")]
 
     # -- topics ----------------------------------------------------------------------------
 

@@ -72,6 +72,8 @@ class PathLimits:
     low: FloatArray
     high: FloatArray
     speed: FloatArray
+    units: tuple[str, ...] = ()
+    """Each slot's position unit (``rad``, ``m``), for messages; empty: unknown."""
 
 
 @dataclass(frozen=True)
@@ -258,9 +260,10 @@ def _check_speeds(path: JointPath, limits: PathLimits) -> None:
         if over.size:
             i = int(over[0])
             segment = "the start" if k == 0 else f"knot {k}"
+            unit = limits.units[path.slots[i]] if limits.units else "(rad or m)"
             raise PathRefused(
-                f"{path.names[i]} would need {fastest[i]:.4g} (rad or m)/s between {segment} "
-                f"and t={path.times_s[k + 1]:.3f} s; its velocity_limit is {vmax[i]:g}"
+                f"{path.names[i]} would need {fastest[i]:.4g} {unit}/s between {segment} "
+                f"and t={path.times_s[k + 1]:.3f} s; its velocity_limit is {vmax[i]:g} {unit}/s"
             )
 
 

@@ -62,6 +62,8 @@ class TopicInfo:
     name: str
     type: str
     rate_hz: float | None
+    when: str = ""
+    """When it publishes, if not always (``while moving``: while a joint trajectory runs)."""
 
 
 @dataclass

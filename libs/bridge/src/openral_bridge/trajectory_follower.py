@@ -50,6 +50,7 @@ def path_limits(robot: LoadedRobot) -> PathLimits:
         low=command.low.copy(),
         high=command.high.copy(),
         speed=np.array(speed, dtype=np.float64),
+        units=tuple("m" if j.type == "prismatic" else "rad" for j in description.joints),
     )
 
 

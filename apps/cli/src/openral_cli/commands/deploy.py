@@ -168,7 +168,14 @@ def _shut_down(node: ManifestLifecycleNode, stop: threading.Event) -> str:
 
 def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
     """What the graph offers: published topics in a table (fits 80 columns), then inputs."""
-    from openral_bridge.topics import CMD_VEL, ESTOP, RELEASE_ESTOP, SAFE_ACTION
+    from openral_bridge.topics import (
+        CMD_VEL,
+        ESTOP,
+        JOINT_TRAJECTORY,
+        RELEASE_ESTOP,
+        RESET,
+        SAFE_ACTION,
+    )
     from rich import box
     from rich.table import Table
 
@@ -183,16 +190,21 @@ def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
         table.add_column(column, overflow="fold")
     for topic in node.topics():
         rate = "latched" if topic.rate_hz is None else f"{topic.rate_hz:g} Hz"
-        table.add_row(topic.name, topic.type, rate)
+        table.add_row(topic.name, topic.type, f"{rate} {topic.when}".strip())
     out.print(table, soft_wrap=False)
     out.print(
         f"actions:  {SAFE_ACTION} (std_msgs/msg/Float64MultiArray, {len(names)} values: "
         f"{', '.join(names)})",
         soft_wrap=False,
     )
+    if node.commands is not None and node.commands.follows_trajectories:
+        kind = "trajectory_msgs/msg/JointTrajectory, joints by manifest name"
+        out.print(f"          {JOINT_TRAJECTORY} ({kind})", soft_wrap=False)
     if node.bridge is not None and node.bridge.base is not None:
         out.print(f"base:     {CMD_VEL} (geometry_msgs/msg/Twist, base frame)", soft_wrap=False)
     out.print(f"E-stop:   {ESTOP}, {RELEASE_ESTOP} (std_srvs/srv/Trigger)", soft_wrap=False)
+    if node.loop is not None:
+        out.print(f"reset:    {RESET} (std_srvs/srv/Trigger)", soft_wrap=False)
     out.print(
         "running; stop with Ctrl-C. In a second terminal: openral ros topics", soft_wrap=False
     )
