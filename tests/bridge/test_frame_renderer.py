@@ -111,6 +111,24 @@ def test_a_busy_camera_is_skipped_and_counted_never_queued(
     assert not frames.running
 
 
+def test_a_request_that_may_wait_gets_its_frame_after_the_one_in_flight(
+    tiny: tuple[mujoco.MjModel, mujoco.MjData],
+) -> None:
+    gate = Gate()
+    frames, published = make(tiny, gate)
+    try:
+        assert frames.request("a")
+        assert gate.entered.acquire(timeout=WAIT_S)  # "a" is rendering now
+        assert not frames.request("a", wait_s=0.05)  # still in flight when the wait ends
+        threading.Timer(0.1, gate.open.set).start()
+        assert frames.request("a", wait_s=WAIT_S)  # after the reset: this frame must come
+        assert [sensor for sensor, _, _ in published.wait(2)] == ["a", "a"]
+        assert frames.skipped == {"a": 1, "b": 0}
+    finally:
+        gate.open.set()
+        assert frames.stop()
+
+
 def test_the_render_thread_never_reads_the_live_data(
     tiny: tuple[mujoco.MjModel, mujoco.MjData],
 ) -> None:

@@ -106,6 +106,8 @@ class FrameRenderer(Generic[FrameT]):
         self._slots = {sensor: _Slot(sensor, model) for sensor in sensors}
         self._jobs: queue.SimpleQueue[_Slot | None] = queue.SimpleQueue()
         self._lock = threading.Lock()
+        self._idle = threading.Condition(self._lock)
+        """Notified whenever a frame leaves flight."""
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._stopping = False
         self.error: BaseException | None = None
@@ -137,10 +139,15 @@ class FrameRenderer(Generic[FrameT]):
         """Start the render thread (it creates its renderer first)."""
         self._thread.start()
 
-    def request(self, sensor: str) -> bool:
+    def request(self, sensor: str, *, wait_s: float = 0.0) -> bool:
         """Snapshot the live data for one frame of ``sensor`` and hand it to the thread.
 
         Call it where nothing steps the live data (holding the HAL's lock, between ticks).
+
+        Args:
+            sensor: The camera.
+            wait_s: How long to wait for the previous frame of ``sensor`` to leave flight
+                [s] (0: skip at once; a frame that must not be missed, after a reset, waits).
 
         Returns:
             True when a frame was queued; False when the previous frame of ``sensor`` is
@@ -153,7 +160,9 @@ class FrameRenderer(Generic[FrameT]):
         if self._stopping or self.error is not None:
             return False
         with self._lock:
-            if slot.busy:
+            if slot.busy and wait_s > 0.0:
+                self._idle.wait_for(lambda: not slot.busy or self._stopping, wait_s)
+            if slot.busy or self._stopping:
                 slot.skipped += 1
                 return False
             slot.busy = True
@@ -202,3 +211,4 @@ class FrameRenderer(Generic[FrameT]):
         finally:
             with self._lock:
                 slot.busy = False
+                self._idle.notify_all()

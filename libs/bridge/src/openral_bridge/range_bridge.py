@@ -37,7 +37,7 @@ from openral_sim.native_scene import NativeScene
 from openral_bridge import ros_messages
 from openral_bridge.frame_renderer import FrameRenderer
 from openral_bridge.pacer import PacedJob, Pacer
-from openral_bridge.sim_sensor_bridge import TopicInfo
+from openral_bridge.sim_sensor_bridge import NOW_WAIT_S, TopicInfo
 from openral_bridge.topics import camera_info, depth_image, depth_points, scan
 
 if TYPE_CHECKING:
@@ -106,7 +106,7 @@ class RangeBridge:
     def publish_now(self) -> None:
         """A depth frame or scan of every sensor as the scene is now; takes the HAL's lock."""
         for name in self._streams:
-            self._due(name)
+            self._due(name, wait_s=NOW_WAIT_S)
 
     def stop(self) -> None:
         """Cancel the jobs, stop the depth threads and destroy the publishers (idempotent)."""
@@ -202,7 +202,7 @@ class RangeBridge:
 
     # -- both --------------------------------------------------------------------------------
 
-    def _due(self, name: str) -> None:
+    def _due(self, name: str, wait_s: float = 0.0) -> None:
         """A sensor's job: request a depth frame, or cast and publish a scan."""
         frames = self._streams[name].frames
         if frames is None:
@@ -219,7 +219,7 @@ class RangeBridge:
             )
             return
         with self.lock:
-            frames.request(name)
+            frames.request(name, wait_s=wait_s)
 
     def _log(self) -> Any:
         """The node's logger (rclpy's logger is untyped)."""

@@ -51,6 +51,8 @@ from openral_bridge.topics import camera_image, camera_info
 if TYPE_CHECKING:
     from rclpy.node import Node
 
+NOW_WAIT_S = 1.0
+"""Longest wait of :meth:`SimSensorBridge.publish_now` for a frame still in flight [s]."""
 IMAGE_QUEUE_DEPTH = 5
 """Reliable queue of the image publishers: a slow subscriber drops old frames, not new."""
 
@@ -229,9 +231,10 @@ class SimSensorBridge:
 
     def publish_now(self) -> None:
         """A frame of every camera of the scene as it is now (after a reset, say), whether
-        due or not; takes the HAL's lock."""
+        due or not, waiting up to :data:`NOW_WAIT_S` for a frame still in flight; takes the
+        HAL's lock."""
         for name in self._cameras:
-            self._due(name)
+            self._due(name, wait_s=NOW_WAIT_S)
 
     def _add_camera(self, hal: CameraHal, sensor: RgbSensor) -> None:
         from sensor_msgs.msg import CameraInfo, Image
@@ -269,7 +272,7 @@ class SimSensorBridge:
         self._scene_rendered_observations = scene.render_observations
         scene.render_observations = False
 
-    def _due(self, name: str) -> None:
+    def _due(self, name: str, wait_s: float = 0.0) -> None:
         """A camera's job: request a rendered frame, or publish the last observed one."""
         frames = self._frames
         if frames is not None:
@@ -277,7 +280,7 @@ class SimSensorBridge:
                 self._camera_failed(frames.error)
             else:
                 with self.lock:
-                    frames.request(name)
+                    frames.request(name, wait_s=wait_s)
             return
         camera_hal = self._camera_hal
         if camera_hal is None:
