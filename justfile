@@ -81,6 +81,10 @@ bench-camera *ARGS:
 bench-realtime *ARGS:
     python -m benchmarks.real_time {{ARGS}}
 
+# Joint-trajectory tracking on the franka tabletop: error against the path with and without the glide, and a following tick's cost over a holding one; writes benchmarks/results/trajectory_tracking.json.
+bench-trajectory *ARGS:
+    python -m benchmarks.trajectory_tracking {{ARGS}}
+
 # Re-resolve every dependency and write requirements.lock (names, versions, hashes; no addresses). uv.lock is uv's working file, not committed.
 lock:
     {{justfile_directory()}}/.tools/venv/bin/uv lock --quiet
