@@ -275,7 +275,9 @@ def _hermite(
     if np.isnan(v0).any() or np.isnan(v1).any():
         return None
     duration = float(path.times_s[k + 1] - path.times_s[k])
-    return path.positions[k], path.positions[k + 1], v0 * duration, v1 * duration, duration
+    with np.errstate(over="ignore"):  # a huge velocity: refused by _fastest's ends
+        m0, m1 = v0 * duration, v1 * duration
+    return path.positions[k], path.positions[k + 1], m0, m1, duration
 
 
 def _segment_at(path: JointPath, k: int, time_s: float) -> tuple[FloatArray, FloatArray]:
@@ -307,15 +309,17 @@ def _fastest(path: JointPath, k: int) -> FloatArray:
     if cubic is None:
         speed: FloatArray = np.abs(p1 - p0) / duration
         return speed
+    # The ends are the knots' own velocities: v·T may overflow for a huge finite v, and
+    # NaN would pass every "faster than the limit" test.
+    ends = np.maximum(np.abs(path.velocities[k]), np.abs(path.velocities[k + 1]))
     _, _, m0, m1, _ = cubic
-    # q'(s)·T = a s² + b s + c with these coefficients (Hermite basis derivatives)
-    a = 6 * p0 + 3 * m0 - 6 * p1 + 3 * m1
-    b = -6 * p0 - 4 * m0 + 6 * p1 - 2 * m1
-    c = m0
-    ends = np.maximum(np.abs(c), np.abs(a + b + c))
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        # q'(s)·T = a s² + b s + c with these coefficients (Hermite basis derivatives)
+        a = 6 * p0 + 3 * m0 - 6 * p1 + 3 * m1
+        b = -6 * p0 - 4 * m0 + 6 * p1 - 2 * m1
+        c = m0
         vertex = np.where(a != 0.0, -b / (2 * a), -1.0)
-    inside = (vertex > 0.0) & (vertex < 1.0)
-    peak = np.abs(a * vertex**2 + b * vertex + c)
-    fastest: FloatArray = np.where(inside, np.maximum(ends, peak), ends) / duration
+        inside = (vertex > 0.0) & (vertex < 1.0)  # False where NaN (an overflowed spline)
+        peak = np.abs(a * vertex**2 + b * vertex + c) / duration
+    fastest: FloatArray = np.where(inside, np.maximum(ends, peak), ends)
     return fastest
