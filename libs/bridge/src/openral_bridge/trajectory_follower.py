@@ -139,8 +139,10 @@ class TrajectoryFollower:
             path = self._running
             if path is None:
                 return None
-            positions, velocities = path.sample(end_s)
-            if end_s >= path.end_s - SAME_TIME_S:
+            finishing = end_s >= path.end_s - SAME_TIME_S
+            # the last period ends exactly on the last point, even a rounding error early
+            positions, velocities = path.sample(path.end_s if finishing else end_s)
+            if finishing:
                 self._running = None
                 self.finished += 1
         action = np.array(hold, dtype=np.float64)
