@@ -163,6 +163,23 @@ def test_a_huge_knot_velocity_is_refused_not_turned_into_nan() -> None:
     assert "shoulder would need 1e+308 rad/s" in _refusal(request)
 
 
+def test_a_cubic_that_bulges_past_a_position_limit_between_knots_is_refused() -> None:
+    """Both knots inside [-1, 1], speeds within 2 rad/s, but leaving 0.9 at 2 rad/s to come
+    back to 0.9 a second later carries the cubic to 1.4 in between."""
+    bulge = _request(("elbow",), (1.0, (0.9,), (2.0,)), (2.0, (0.9,), (0.0,)))
+    message = _refusal(bulge)
+    assert message.startswith("elbow would reach 1.")
+    assert message.endswith("outside its limits [-1, 1]")
+    within = _request(("elbow",), (1.0, (0.5,), (0.5,)), (2.0, (0.6,), (0.0,)))
+    assert plan_path(within, LIMITS, START).end_s == NOW + 2.0
+
+
+def test_an_unlimited_joint_is_refused_an_unbounded_speed() -> None:
+    """The gripper has no speed limit, but a tangent that overflows is no speed at all."""
+    request = _request(("gripper",), (2.0, (0.03,), (1e308,)), (4.0, (0.02,), (0.0,)))
+    assert "gripper would need an unbounded speed" in _refusal(request)
+
+
 def test_a_path_exactly_at_its_limit_passes() -> None:
     request = _request(("shoulder",), (1.5, (1.6,), ()))  # 1.5 rad in 1.5 s: 1 rad/s
     path = plan_path(request, LIMITS, START)

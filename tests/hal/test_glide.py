@@ -106,11 +106,6 @@ def test_a_glide_faster_than_the_velocity_limit_is_slewed(env: NativeScene) -> N
     assert speeds.max() <= VMAX * (1 + 1e-9) and speeds.max() > 0.99 * VMAX
 
 
-@pytest.mark.xfail(
-    reason="JointDriver zeroes the set point's speed when a glide lands, so a slew that "
-    "follows a glide starts from rest: the speed drops from 2 rad/s to ~0.09 in one chunk",
-    strict=True,
-)
 def test_a_slew_after_a_glide_keeps_the_speed_it_had(env: NativeScene) -> None:
     speeds = _glide_then_too_fast(env)
     ramp = VMAX / 0.25 * 5 * env.model.opt.timestep  # RAMP_S: the most a chunk may change

@@ -365,11 +365,6 @@ def test_a_reset_no_tick_carries_out_times_out(node: Node) -> None:
     loop.stop()
 
 
-@pytest.mark.xfail(
-    reason="ControlLoop.reset leaves a timed-out request in place: the next tick resets the "
-    "scene although the caller was told the reset failed",
-    strict=True,
-)
 def test_a_reset_that_timed_out_is_not_carried_out_later(node: Node) -> None:
     hal = CountingHal()
     loop = _unticked(node, hal)

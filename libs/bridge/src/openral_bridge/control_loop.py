@@ -187,10 +187,13 @@ class ControlLoop:
                 self.superseded += 1
                 self._pending = None
             self._reset = request
-        if self.follower is not None:
-            self.follower.cancel()
         if not request.done.wait(timeout_s):
-            raise ResetFailed(f"no control tick carried the reset out within {timeout_s:g} s")
+            with self._pending_lock:
+                withdrawn = self._reset is request
+                if withdrawn:  # no later tick carries out a reset its caller gave up on
+                    self._reset = None
+            if withdrawn or not request.done.wait(timeout_s):
+                raise ResetFailed(f"no control tick carried the reset out within {timeout_s:g} s")
         if request.error is not None:
             raise ResetFailed(request.error)
         return request.text
@@ -256,6 +259,8 @@ class ControlLoop:
         goes to ``request``."""
         try:
             with self.lock:
+                if self.follower is not None:  # the old path never runs from the reset pose
+                    self.follower.cancel()
                 request.text = self.hal.reset()
                 stepped = self.hal.tick(None)
                 self.state = self.hal.read_state() if stepped else None

@@ -252,19 +252,61 @@ def _check_at_start(names: tuple[str, ...], first: FloatArray, now: FloatArray) 
 
 
 def _check_speeds(path: JointPath, limits: PathLimits) -> None:
-    """Refuse a path on which some joint would exceed its velocity limit."""
+    """Refuse a path on which some joint would exceed its velocity limit (or need an
+    unbounded speed), or leave its position limits between two knots."""
     vmax = limits.speed[path.slots]
     for k in range(len(path.times_s) - 1):
         fastest = _fastest(path, k)
-        over = np.flatnonzero(fastest > vmax * (1.0 + SPEED_SLACK))
+        over = np.flatnonzero(~np.isfinite(fastest) | (fastest > vmax * (1.0 + SPEED_SLACK)))
+        segment = "the start" if k == 0 else f"knot {k}"
         if over.size:
             i = int(over[0])
-            segment = "the start" if k == 0 else f"knot {k}"
             unit = limits.units[path.slots[i]] if limits.units else "(rad or m)"
             raise PathRefused(
                 f"{path.names[i]} would need {fastest[i]:.4g} {unit}/s between {segment} "
                 f"and t={path.times_s[k + 1]:.3f} s; its velocity_limit is {vmax[i]:g} {unit}/s"
             )
+        _check_between(path, k, limits, segment)
+
+
+def _check_between(path: JointPath, k: int, limits: PathLimits, segment: str) -> None:
+    """A cubic segment may bulge past its knots: its turning points must stay inside the
+    position limits too (a line stays between its knots, which are checked)."""
+    cubic = _hermite(path, k)
+    if cubic is None:
+        return
+    p0, p1, m0, m1, _ = cubic
+    unbounded = np.flatnonzero(~(np.isfinite(m0) & np.isfinite(m1)))
+    if unbounded.size:
+        i = int(unbounded[0])
+        raise PathRefused(
+            f"{path.names[i]} would need an unbounded speed between {segment} and the next "
+            "point (a velocity too large to interpolate)"
+        )
+    a = 6 * p0 + 3 * m0 - 6 * p1 + 3 * m1  # q'(s)·T = a s² + b s + c
+    b = -6 * p0 - 4 * m0 + 6 * p1 - 2 * m1
+    low, high = limits.low[path.slots], limits.high[path.slots]
+    for i in range(len(path.slots)):
+        for s in _roots(float(a[i]), float(b[i]), float(m0[i])):
+            q = (2 * s**3 - 3 * s**2 + 1) * p0[i] + (s**3 - 2 * s**2 + s) * m0[i]
+            q += (-2 * s**3 + 3 * s**2) * p1[i] + (s**3 - s**2) * m1[i]
+            if not low[i] <= q <= high[i]:
+                time_s = path.times_s[k] + s * (path.times_s[k + 1] - path.times_s[k])
+                raise PathRefused(
+                    f"{path.names[i]} would reach {q:.6g} at t={time_s:.3f} s between "
+                    f"{segment} and the next point (the cubic bulges past them), outside its "
+                    f"limits [{low[i]:.6g}, {high[i]:.6g}]"
+                )
+
+
+def _roots(a: float, b: float, c: float) -> list[float]:
+    """Roots of a s² + b s + c inside (0, 1)."""
+    if a == 0.0:
+        found = [-c / b] if b != 0.0 else []
+    else:
+        disc = b * b - 4 * a * c
+        found = [] if disc < 0 else [(-b - disc**0.5) / (2 * a), (-b + disc**0.5) / (2 * a)]
+    return [s for s in found if 0.0 < s < 1.0]
 
 
 def _hermite(

@@ -107,6 +107,7 @@ class JointDriver:
         self._in_force_clamped: tuple[int, ...] = ()  # its slots outside their limits
         self._feedforward = _velocity_gains(model, self._arm_act)
         self._glide_left_s = 0.0  # sim time until a gliding set point lands on its targets
+        self._gliding = False  # the set point glided in the last period (speed fed forward)
 
     # -- start and hold --------------------------------------------------------------------
 
@@ -127,7 +128,7 @@ class JointDriver:
         self._targets = data.qpos[self._arm_qpos].astype(np.float64)
         self._setpoint = self._targets.copy()
         self._speed = np.zeros(len(self._arm))
-        self._moving = self._slewing = False
+        self._moving = self._slewing = self._gliding = False
         self._glide_left_s = 0.0
         self._in_force = b""  # the next command applies in full, even a repeated one
         data.ctrl[self._arm_act] = np.clip(self._setpoint, self._arm_low, self._arm_high)
@@ -167,7 +168,7 @@ class JointDriver:
         targets = bounded[self._arm]
         self._targets = targets  # a set point at rest on its targets has nothing to do:
         self._slewing = self._moving or targets.tobytes() != self._setpoint.tobytes()
-        self._glide_left_s = 0.0
+        self._glide_left_s, self._gliding = 0.0, False  # a slew goes on from the speed
         if glide_s is not None and glide_s > 0.0:
             speed = (targets - self._setpoint) / glide_s
             if (np.abs(speed) <= self._vmax).all():  # never faster than the manifest allows
@@ -190,6 +191,8 @@ class JointDriver:
         diverged_before = bad_state.tobytes()
         if self._glide_left_s > 0.0:
             steps = self._glide(model, data, steps)
+        elif self._gliding:  # a glide landed and no sample followed it: the set point stops
+            self._stop_glide(data)
         if self._slewing:
             self._slew(model, data, steps)
         else:
@@ -286,18 +289,22 @@ class JointDriver:
         while steps > 0 and self._glide_left_s > 0.0:
             chunk = min(steps, SLEW_CHUNK_STEPS)
             dt = chunk * self._dt
-            if dt >= self._glide_left_s - 1e-12:  # lands on the targets: the speed ends
+            if dt >= self._glide_left_s - 1e-12:  # lands on the targets, still moving
                 self._setpoint, self._glide_left_s = self._targets, 0.0
-                self._speed = np.zeros(len(self._arm))
-                ctrl[act] = self._setpoint
             else:
                 self._setpoint = self._setpoint + self._speed * dt
                 self._glide_left_s -= dt
-                ctrl[act] = self._setpoint + self._feedforward * self._speed
+            ctrl[act] = self._setpoint + self._feedforward * self._speed
             mujoco.mj_step(model, data, nstep=chunk)
             steps -= chunk
-        self._moving = bool(self._speed.any())
+        self._moving = self._gliding = bool(self._speed.any())
         return steps
+
+    def _stop_glide(self, data: mujoco.MjData) -> None:
+        """The set point rests where its glide landed: no speed, no feed-forward."""
+        self._speed = np.zeros(len(self._arm))
+        self._moving = self._gliding = False
+        data.ctrl[self._arm_act] = self._setpoint
 
     def _command_bounds(self) -> tuple[FloatArray, FloatArray]:
         """Per slot, the range a command is clamped to in one pass: the manifest's limits
