@@ -383,6 +383,205 @@ class LidarSensor(OpenralModel):
     """
 
 
+class ImuSensor(OpenralModel):
+    """
+    An IMU read from MuJoCo sensors at an MJCF site; published as `sensor_msgs/Imu`.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    name: Annotated[
+        StrictStr, Field(examples=["pelvis_imu"], pattern="^[a-z][a-z0-9_]{0,62}$")
+    ]
+    """
+    Sensor name, unique within the robot. Its topic is derived from it (`/openral/imu/<name>`).
+    """
+    kind: Literal["imu"]
+    """
+    `imu`: an inertial measurement unit (orientation, angular velocity, linear acceleration).
+    """
+    site: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
+    """
+    MJCF site the sensor sits at: its frame is the sensor's frame. A site of the robot's (or its mobile base's) model, or, with `mount_body`, the name of the site a native scene creates there.
+    """
+    mount_body: Annotated[
+        StrictStr | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+    ] = None
+    """
+    MJCF body (native name) a native scene creates the sensor's `site` on, at `mount_position_m`, with the body's axes, for a model that has no site where the sensor sits. Absent: `site` is a site of the model.
+    """
+    mount_position_m: Annotated[
+        list[MountPositionMItem] | None,
+        Field(examples=[[0.0, 0.0, 0.05]], max_length=3, min_length=3),
+    ] = None
+    """
+    Position of the created site in `mount_body`'s frame [m] x, y, z (absent: the body's origin). Needs `mount_body`.
+    """
+    accelerometer: Annotated[
+        StrictStr | None,
+        Field(
+            examples=["imu-pelvis-linear-acceleration"],
+            pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$",
+        ),
+    ] = None
+    """
+    MJCF `accelerometer` sensor at `site` this IMU reads its linear acceleration from [m/s², site frame; gravity included: +9.81 up at rest]. Absent: a native scene adds one at `site`.
+    """
+    gyro: Annotated[
+        StrictStr | None,
+        Field(
+            examples=["imu-pelvis-angular-velocity"],
+            pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$",
+        ),
+    ] = None
+    """
+    MJCF `gyro` sensor at `site` this IMU reads its angular velocity from [rad/s, site frame]. Absent: a native scene adds one at `site`.
+    """
+    orientation: Annotated[
+        StrictStr | None,
+        Field(examples=["imu-pelvis-quat"], pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$"),
+    ] = None
+    """
+    MJCF `framequat` sensor of `site` this IMU reads its orientation from (in the world frame). Absent: a native scene adds one at `site`.
+    """
+    rate_hz: Annotated[StrictFloat, Field(ge=0.1, le=1000.0)]
+    """
+    Nominal publish rate [Hz] on a real robot, 0.1 to 1000. Under deploy sim a reading changes once per control step, so it is published at this rate or the control rate, whichever is lower.
+    """
+    frame_id: Annotated[
+        StrictStr,
+        Field(examples=["imu_link"], pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$"),
+    ]
+    """
+    TF frame of the sensor (the site's frame), copied into message headers.
+    """
+
+
+class ForceTorqueSensor(OpenralModel):
+    """
+    A wrist or joint force-torque sensor read from MuJoCo `force` and `torque` sensors at an MJCF site; published as `geometry_msgs/WrenchStamped`.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    name: Annotated[
+        StrictStr, Field(examples=["wrist_ft"], pattern="^[a-z][a-z0-9_]{0,62}$")
+    ]
+    """
+    Sensor name, unique within the robot. Its topic is derived from it (`/openral/wrench/<name>`).
+    """
+    kind: Literal["force_torque"]
+    """
+    `force_torque`: a six-axis force-torque sensor.
+    """
+    site: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
+    """
+    MJCF site the sensor sits at: its frame is the sensor's frame. A site of the robot's (or its mobile base's) model, or, with `mount_body`, the name of the site a native scene creates there.
+    """
+    mount_body: Annotated[
+        StrictStr | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+    ] = None
+    """
+    MJCF body (native name) a native scene creates the sensor's `site` on, at `mount_position_m`, with the body's axes, for a model that has no site where the sensor sits. Absent: `site` is a site of the model.
+    """
+    mount_position_m: Annotated[
+        list[MountPositionMItem] | None,
+        Field(examples=[[0.0, 0.0, 0.05]], max_length=3, min_length=3),
+    ] = None
+    """
+    Position of the created site in `mount_body`'s frame [m] x, y, z (absent: the body's origin). Needs `mount_body`.
+    """
+    force: Annotated[
+        StrictStr | None,
+        Field(examples=["force"], pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$"),
+    ] = None
+    """
+    MJCF `force` sensor at `site` [N, site frame]: the force the parent body exerts on the subtree of the site's body. Absent: a native scene adds one at `site`.
+    """
+    torque: Annotated[
+        StrictStr | None,
+        Field(examples=["torque"], pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$"),
+    ] = None
+    """
+    MJCF `torque` sensor at `site` [N·m, site frame], as `force` for torque. Absent: a native scene adds one at `site`.
+    """
+    rate_hz: Annotated[StrictFloat, Field(ge=0.1, le=1000.0)]
+    """
+    Nominal publish rate [Hz] on a real robot, 0.1 to 1000. Under deploy sim a reading changes once per control step, so it is published at this rate or the control rate, whichever is lower.
+    """
+    frame_id: Annotated[
+        StrictStr,
+        Field(examples=["imu_link"], pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$"),
+    ]
+    """
+    TF frame of the sensor (the site's frame), copied into message headers.
+    """
+
+
+class PoseSensor(OpenralModel):
+    """
+    The world pose of an MJCF site, read from MuJoCo `framepos` and `framequat` sensors; published as `geometry_msgs/PoseStamped` in the `world` frame.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    name: Annotated[
+        StrictStr, Field(examples=["tool_pose"], pattern="^[a-z][a-z0-9_]{0,62}$")
+    ]
+    """
+    Sensor name, unique within the robot. Its topic is derived from it (`/openral/pose/<name>`).
+    """
+    kind: Literal["pose"]
+    """
+    `pose`: the pose of a site in the world frame (a motion-capture marker, say).
+    """
+    site: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
+    """
+    MJCF site the sensor sits at: its frame is the sensor's frame. A site of the robot's (or its mobile base's) model, or, with `mount_body`, the name of the site a native scene creates there.
+    """
+    mount_body: Annotated[
+        StrictStr | None, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")
+    ] = None
+    """
+    MJCF body (native name) a native scene creates the sensor's `site` on, at `mount_position_m`, with the body's axes, for a model that has no site where the sensor sits. Absent: `site` is a site of the model.
+    """
+    mount_position_m: Annotated[
+        list[MountPositionMItem] | None,
+        Field(examples=[[0.0, 0.0, 0.05]], max_length=3, min_length=3),
+    ] = None
+    """
+    Position of the created site in `mount_body`'s frame [m] x, y, z (absent: the body's origin). Needs `mount_body`.
+    """
+    position: Annotated[
+        StrictStr | None,
+        Field(examples=["tcp_pos"], pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$"),
+    ] = None
+    """
+    MJCF `framepos` sensor of `site` [m, world frame]. Absent: a native scene adds one.
+    """
+    orientation: Annotated[
+        StrictStr | None,
+        Field(examples=["tcp_quat"], pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$"),
+    ] = None
+    """
+    MJCF `framequat` sensor of `site` (world frame). Absent: a native scene adds one.
+    """
+    rate_hz: Annotated[StrictFloat, Field(ge=0.1, le=1000.0)]
+    """
+    Nominal publish rate [Hz] on a real robot, 0.1 to 1000. Under deploy sim a reading changes once per control step, so it is published at this rate or the control rate, whichever is lower.
+    """
+    frame_id: Annotated[
+        StrictStr,
+        Field(examples=["imu_link"], pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$"),
+    ]
+    """
+    TF frame of the sensor (the site's frame), copied into message headers.
+    """
+
+
 MountQuatWxyzItem = TypeAliasType(
     "MountQuatWxyzItem", Annotated[StrictFloat, Field(ge=-1.0, le=1.0)]
 )
@@ -563,7 +762,14 @@ class RobotDescription(OpenralModel):
     The robot's controllable joints in canonical order. This order is the order of JointState messages, of HAL state vectors and of joint-space actions. A gripper is listed as one joint (its driving finger or jaw).
     """
     sensors: Annotated[
-        list[RgbSensor | DepthSensor | LidarSensor],
+        list[
+            RgbSensor
+            | DepthSensor
+            | LidarSensor
+            | ImuSensor
+            | ForceTorqueSensor
+            | PoseSensor
+        ],
         Field(max_length=32, validate_default=True),
     ] = []
     """

@@ -24,7 +24,6 @@ import numpy as np
 from openral_bridge.control_loop import ControlLoop, ResetFailed
 from openral_bridge.joint_path import PathRefused
 from openral_bridge.joint_state_publisher import sim_stamp
-from openral_bridge.sim_sensor_bridge import TopicInfo
 from openral_bridge.topics import (
     ESTOP,
     JOINT_TRAJECTORY,
@@ -32,6 +31,7 @@ from openral_bridge.topics import (
     RELEASE_ESTOP,
     RESET,
     SAFE_ACTION,
+    TopicInfo,
 )
 from openral_bridge.trajectory_follower import DesiredPoint
 from openral_hal.errors import EStopLatched, HalError

@@ -53,8 +53,7 @@ from openral_bridge import ros_messages
 from openral_bridge.control_loop import ControlLoop
 from openral_bridge.joint_state_publisher import JointStatePublisher, sim_stamp
 from openral_bridge.pacer import PacedJob, Pacer
-from openral_bridge.sim_sensor_bridge import TopicInfo
-from openral_bridge.topics import ACTION_SPEC, CLOCK, JOINT_STATES
+from openral_bridge.topics import ACTION_SPEC, CLOCK, JOINT_STATES, TopicInfo
 from openral_bridge.trajectory_follower import TrajectoryFollower, path_limits
 from openral_core import LoadedRobot
 from openral_core.errors import OpenralError

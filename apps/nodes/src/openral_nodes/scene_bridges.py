@@ -2,7 +2,8 @@
 
 - cameras and the viewer (:class:`~openral_bridge.sim_sensor_bridge.SimSensorBridge`);
 - on a native scene, its depth cameras (image, camera info, cloud) and lidars (scans)
-  (:class:`~openral_bridge.range_bridge.RangeBridge`);
+  (:class:`~openral_bridge.range_bridge.RangeBridge`), and its IMU, force-torque and pose
+  sensors (:class:`~openral_bridge.state_sensor_bridge.StateSensorBridge`);
 - for a robot with a mobile base, ``/cmd_vel`` in and ``/odom`` out
   (:class:`~openral_bridge.base_bridge.BaseBridge`, at the joint-state rate).
 
@@ -18,7 +19,9 @@ from typing import TYPE_CHECKING
 from openral_bridge.base_bridge import BaseBridge
 from openral_bridge.pacer import Pacer
 from openral_bridge.range_bridge import RangeBridge
-from openral_bridge.sim_sensor_bridge import SimSensorBridge, TopicInfo
+from openral_bridge.sim_sensor_bridge import SimSensorBridge
+from openral_bridge.state_sensor_bridge import StateSensorBridge
+from openral_bridge.topics import TopicInfo
 from openral_hal.protocol import MobileBaseHal, RobotHal
 from openral_hal.sim_attached import native_scene
 
@@ -43,9 +46,12 @@ class SceneBridges:
         """Nothing is created until :meth:`setup` (see the bridges for the arguments)."""
         scene = native_scene(hal)
         self.range = RangeBridge(node, scene, lock) if scene is not None else None
+        self.state = None
         served: frozenset[str] = frozenset()
         if scene is not None:
             served = frozenset(scene.range_sensors.depth) | frozenset(scene.range_sensors.lidars)
+            self.state = StateSensorBridge(node, scene, lock, 1.0 / scene.control_period_s)
+            served |= self.state.served
         self.base = None
         if isinstance(hal, MobileBaseHal) and hal.base is not None:
             self.base = BaseBridge(node, hal, odom_rate_hz, lock)
@@ -66,6 +72,8 @@ class SceneBridges:
         self.sensors.setup()
         if self.range is not None:
             self.range.start(self.pacer)
+        if self.state is not None:
+            self.state.start(self.pacer)
         if self.base is not None:
             self.base.start(self.pacer)
 
@@ -75,11 +83,15 @@ class SceneBridges:
         self.sensors.publish_now()
         if self.range is not None:
             self.range.publish_now()
+        if self.state is not None:
+            self.state.publish_now()
 
     def teardown(self) -> None:
         """Stop every bridge (idempotent)."""
         if self.base is not None:
             self.base.stop()
+        if self.state is not None:
+            self.state.stop()
         if self.range is not None:
             self.range.stop()
         self.sensors.teardown()
@@ -88,4 +100,5 @@ class SceneBridges:
         """What the bridges publish now, with their nominal rates."""
         rows = self.sensors.topics()
         rows += self.range.topics() if self.range is not None else []
+        rows += self.state.topics() if self.state is not None else []
         return rows + (self.base.topics() if self.base is not None else [])

@@ -31,8 +31,7 @@ from openral_sim.base_drive import BaseOdometry
 
 from openral_bridge import ros_messages
 from openral_bridge.pacer import PacedJob, Pacer
-from openral_bridge.sim_sensor_bridge import TopicInfo
-from openral_bridge.topics import CMD_VEL, ODOM
+from openral_bridge.topics import CMD_VEL, ODOM, TopicInfo
 
 if TYPE_CHECKING:
     from rclpy.node import Node

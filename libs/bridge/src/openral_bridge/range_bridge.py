@@ -37,8 +37,8 @@ from openral_sim.native_scene import NativeScene
 from openral_bridge import ros_messages
 from openral_bridge.frame_renderer import FrameRenderer
 from openral_bridge.pacer import PacedJob, Pacer
-from openral_bridge.sim_sensor_bridge import NOW_WAIT_S, TopicInfo
-from openral_bridge.topics import camera_info, depth_image, depth_points, scan
+from openral_bridge.sim_sensor_bridge import NOW_WAIT_S
+from openral_bridge.topics import TopicInfo, camera_info, depth_image, depth_points, scan
 
 if TYPE_CHECKING:
     from rclpy.node import Node

@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import numpy as np
 import numpy.typing as npt
-from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
+from openral_core.models import DepthSensor, RgbSensor, RobotDescription, SiteSensor
 from openral_hal.protocol import CameraHal, MujocoBacked, RobotHal
 from openral_hal.sim_attached import native_scene
 from openral_mujoco.display import has_display
@@ -46,7 +46,7 @@ from openral_bridge import ros_messages
 from openral_bridge.camera_messages import CameraMessages
 from openral_bridge.frame_renderer import FrameRenderer, ImageArray
 from openral_bridge.pacer import PacedJob, Pacer
-from openral_bridge.topics import camera_image, camera_info
+from openral_bridge.topics import TopicInfo, camera_image, camera_info
 
 if TYPE_CHECKING:
     from rclpy.node import Node
@@ -55,17 +55,6 @@ NOW_WAIT_S = 1.0
 """Longest wait of :meth:`SimSensorBridge.publish_now` for a frame still in flight [s]."""
 IMAGE_QUEUE_DEPTH = 5
 """Reliable queue of the image publishers: a slow subscriber drops old frames, not new."""
-
-
-@dataclass(frozen=True)
-class TopicInfo:
-    """One topic a node publishes: name, message type and nominal rate (None: on change)."""
-
-    name: str
-    type: str
-    rate_hz: float | None
-    when: str = ""
-    """When it publishes, if not always (``while moving``: while a joint trajectory runs)."""
 
 
 @dataclass
@@ -392,7 +381,7 @@ class SimSensorBridge:
         skipped = [
             f"{s.name} ({s.kind})"
             for s in self.description.sensors
-            if (isinstance(s, DepthSensor | LidarSensor) and s.name not in self.served_elsewhere)
+            if (isinstance(s, DepthSensor | SiteSensor) and s.name not in self.served_elsewhere)
             or (isinstance(s, RgbSensor) and s.name not in self._cameras)
         ]
         if skipped:

@@ -1,9 +1,12 @@
 """The ROS names of the openral graph, in one place for the node, the bridge and the runner.
 
-Pure constants (no rclpy, no MuJoCo), so any process can import them cheaply.
+Pure constants and the :class:`TopicInfo` record (no rclpy, no MuJoCo), so any process can
+import them cheaply.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 JOINT_STATES = "/joint_states"
 """sensor_msgs/JointState: every manifest joint under its canonical name."""
@@ -54,3 +57,29 @@ def depth_image(sensor: str) -> str:
 def depth_points(sensor: str) -> str:
     """sensor_msgs/PointCloud2 of one depth sensor, in the robot's base frame."""
     return f"/openral/cameras/{sensor}/points"
+
+
+def imu(sensor: str) -> str:
+    """sensor_msgs/Imu of one manifest IMU."""
+    return f"/openral/imu/{sensor}"
+
+
+def wrench(sensor: str) -> str:
+    """geometry_msgs/WrenchStamped of one manifest force-torque sensor, in its site frame."""
+    return f"/openral/wrench/{sensor}"
+
+
+def pose(sensor: str) -> str:
+    """geometry_msgs/PoseStamped of one manifest pose sensor, in the world frame."""
+    return f"/openral/pose/{sensor}"
+
+
+@dataclass(frozen=True)
+class TopicInfo:
+    """One topic a node publishes: name, message type and nominal rate (None: on change)."""
+
+    name: str
+    type: str
+    rate_hz: float | None
+    when: str = ""
+    """When it publishes, if not always (``while moving``: while a joint trajectory runs)."""

@@ -15,11 +15,12 @@ from dataclasses import dataclass
 from openral_core.models import (
     DeployScene,
     DepthSensor,
-    LidarSensor,
     LimitedJoint,
     RgbSensor,
     RobotDescription,
     Sensor,
+    SiteSensor,
+    StateSensor,
 )
 from openral_core.tables import RobotTables
 
@@ -245,7 +246,7 @@ def _sensors_section(source: RobotSource) -> str:
         cells = [
             f"`{sensor.name}`",
             sensor.kind,
-            f"{sensor.width}x{sensor.height}",
+            "-" if isinstance(sensor, StateSensor) else f"{sensor.width}x{sensor.height}",
             _num(sensor.rate_hz),
             _where(sensor),
             f"`{sensor.frame_id}`",
@@ -308,13 +309,31 @@ def _manifest_section(source: RobotSource) -> str:
 
 
 def _where(sensor: Sensor) -> str:
-    if isinstance(sensor, LidarSensor):
-        return f"site `{sensor.site}`"
+    if isinstance(sensor, SiteSensor):
+        made = f" (created on body `{sensor.mount_body}`)" if sensor.mount_body else ""
+        return f"site `{sensor.site}`{made}{_mjcf_sensors(sensor)}"
     if sensor.camera is not None:
         return f"model camera `{sensor.camera}`"
     if sensor.mount_body is not None:
         return f"mounted on body `{sensor.mount_body}`"
     return "fixed camera placed by the scene"
+
+
+def _mjcf_sensors(sensor: SiteSensor) -> str:
+    """``; reads MJCF gyro `x`, …; adds …`` for a state sensor: which quantities come from
+    the model's own sensors and which the native scene adds."""
+    if not isinstance(sensor, StateSensor):
+        return ""
+    quantities = {
+        "imu": ("accelerometer", "gyro", "orientation"),
+        "force_torque": ("force", "torque"),
+        "pose": ("position", "orientation"),
+    }[sensor.kind]
+    named = [f"{q} `{getattr(sensor, q)}`" for q in quantities if getattr(sensor, q)]
+    added = [q for q in quantities if not getattr(sensor, q)]
+    parts = [f"reads MJCF {', '.join(named)}"] if named else []
+    parts += [f"the scene adds {', '.join(added)}"] if added else []
+    return "; " + "; ".join(parts)
 
 
 def _readme_body(readme: str, heading: str) -> str:

@@ -12,9 +12,12 @@ from openral_generated.models.robot_schema import (
     DepthSensor,
     DriveAxes,
     DriveKind,
+    ForceTorqueSensor,
+    ImuSensor,
     LidarSensor,
     LimitedJoint,
     MobileBase,
+    PoseSensor,
     RgbSensor,
     RobotDescription,
 )
@@ -40,8 +43,12 @@ from openral_generated.models.sim_schema import (
 
 Joint = LimitedJoint | ContinuousJoint
 """Any joint: ``LimitedJoint`` (revolute/prismatic, with limits) or ``ContinuousJoint``."""
-Sensor = RgbSensor | DepthSensor | LidarSensor
+Sensor = RgbSensor | DepthSensor | LidarSensor | ImuSensor | ForceTorqueSensor | PoseSensor
 """Any sensor, discriminated by ``kind``."""
+StateSensor = ImuSensor | ForceTorqueSensor | PoseSensor
+"""A sensor read from MuJoCo's sensor data at a site (no rendering, no ray casting)."""
+SiteSensor = LidarSensor | ImuSensor | ForceTorqueSensor | PoseSensor
+"""A sensor that sits at an MJCF site (one of the model's, or one the scene creates)."""
 SimControl = PositionControl | TorquePdControl
 """Any control law, discriminated by ``mode``."""
 
@@ -54,14 +61,17 @@ __all__ = [
     "DepthSensor",
     "DriveAxes",
     "DriveKind",
+    "ForceTorqueSensor",
     "GripperReadMode",
     "GripperWriteMode",
+    "ImuSensor",
     "Joint",
     "LidarSensor",
     "LimitedJoint",
     "MobileBase",
     "NativeAssets",
     "Observation",
+    "PoseSensor",
     "PositionControl",
     "RgbSensor",
     "RobotDescription",
@@ -73,5 +83,7 @@ __all__ = [
     "SimControl",
     "SimDescription",
     "SimGripperDescription",
+    "SiteSensor",
+    "StateSensor",
     "TorquePdControl",
 ]

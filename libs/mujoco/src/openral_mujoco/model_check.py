@@ -9,7 +9,13 @@ from pathlib import Path
 import mujoco
 from openral_core.errors import Issue, ManifestError, OpenralError, did_you_mean, parse_field
 from openral_core.located import error_at, issue_at
-from openral_core.models import DepthSensor, LidarSensor, RgbSensor, RobotDescription
+from openral_core.models import (
+    DepthSensor,
+    RgbSensor,
+    RobotDescription,
+    SiteSensor,
+    StateSensor,
+)
 from openral_core.tables import HalWiring, hal_wiring, mobile_base_wiring
 
 from openral_mujoco.mjcf_model import actuator_joints, is_velocity_servo, root_is_free
@@ -20,6 +26,7 @@ from openral_mujoco.mobile_base import (
     mount_problem,
 )
 from openral_mujoco.model_cache import cached_mjcf
+from openral_mujoco.state_sensor_check import state_sensor_rows
 
 
 @dataclass(frozen=True)
@@ -241,8 +248,8 @@ def _mobile_base_rows(description: RobotDescription, model: mujoco.MjModel) -> I
 
 def _sensor_rows(description: RobotDescription, models: list[mujoco.MjModel]) -> Iterator[CheckRow]:
     """Cameras, mount bodies and sites, each found in one of ``models`` (the robot's, its
-    base's); a lidar with a mount body gets its site from the scene, so none may have its
-    name yet."""
+    base's); a site sensor with a mount body gets its site from the scene, so none may have
+    its name yet; the MJCF sensors an IMU, force-torque or pose sensor names."""
     body, camera, site = (
         mujoco.mjtObj.mjOBJ_BODY,
         mujoco.mjtObj.mjOBJ_CAMERA,
@@ -254,12 +261,15 @@ def _sensor_rows(description: RobotDescription, models: list[mujoco.MjModel]) ->
             yield _exists(f"{field}.camera", sensor.camera, camera, models)
         if sensor.mount_body is not None:
             yield _exists(f"{field}.mount_body", sensor.mount_body, body, models)
-        if isinstance(sensor, LidarSensor) and sensor.mount_body is None:
+        if isinstance(sensor, SiteSensor) and sensor.mount_body is None:
             yield _exists(f"{field}.site", sensor.site, site, models)
-        elif isinstance(sensor, LidarSensor):  # the scene creates it: the name must be free
+        elif isinstance(sensor, SiteSensor):  # the scene creates it: the name must be free
             taken = any(mujoco.mj_name2id(m, site, sensor.site) >= 0 for m in models)
             actual = "a site of that name already" if taken else "no site of that name"
             yield CheckRow(f"{field}.site", f"{sensor.site}, a new site", actual, ok=not taken)
+        if isinstance(sensor, StateSensor):
+            for row in state_sensor_rows(field, sensor, models):
+                yield CheckRow(*row)
 
 
 def _exists(field: str, name: str, kind: mujoco.mjtObj, models: list[mujoco.MjModel]) -> CheckRow:

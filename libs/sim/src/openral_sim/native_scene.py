@@ -50,6 +50,7 @@ from openral_sim.scene_cameras import camera_sensors
 from openral_sim.scene_checks import physics_steps_per_control
 from openral_sim.scene_compose import BASE_WELD, compose
 from openral_sim.scene_geometry import place_floating_base, robot_bodies, root_body
+from openral_sim.state_sensors import StateSensors
 
 
 class NativeScene:
@@ -100,6 +101,8 @@ class NativeScene:
             self.model, description, cameras, robot_ids, self._root_body
         )
         """Depth cameras and lidars (:class:`~openral_sim.range_sensors.RangeSensors`)."""
+        self.state_sensors = StateSensors(self.model, description)
+        """IMU, force-torque and pose sensors (:class:`~openral_sim.state_sensors.StateSensors`)."""
         depth = self.range_sensors.depth
         self._sensors = {name: cam for name, cam in cameras.items() if name not in depth}
         self._root_qpos = int(self.model.jnt_qposadr[self.model.body_jntadr[self._root_body]])

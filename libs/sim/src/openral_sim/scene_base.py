@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
-from openral_core.models import LidarSensor, RobotDescription
+from openral_core.models import RobotDescription, SiteSensor
 from openral_core.tables import mobile_base_wiring
 from openral_mujoco.mjcf_uri import robot_model_file
 from openral_mujoco.mobile_base import base_model_file, base_spec, cached_base_model
@@ -77,11 +77,12 @@ def attach_robot(
     spec.attach(child, frame=on_base, prefix="")
 
 
-def add_lidar_sites(spec: mujoco.MjSpec, robot: RobotDescription) -> None:
-    """A site for each lidar with a ``mount_body``, at its ``mount_position_m`` with the
-    body's axes (its scan plane is the body's x-y plane)."""
+def add_sensor_sites(spec: mujoco.MjSpec, robot: RobotDescription) -> None:
+    """A site for each lidar, IMU, force-torque or pose sensor with a ``mount_body``, at its
+    ``mount_position_m`` with the body's axes (a lidar's scan plane is the body's x-y
+    plane)."""
     for sensor in robot.sensors:
-        if not isinstance(sensor, LidarSensor) or sensor.mount_body is None:
+        if not isinstance(sensor, SiteSensor) or sensor.mount_body is None:
             continue
         body = spec.body(sensor.mount_body)
         assert body is not None, "require_agreement checks mount bodies before composing"

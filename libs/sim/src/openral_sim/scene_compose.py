@@ -2,7 +2,9 @@
 physics options, floor, lights and sky, an optional table and pedestal, the scene's objects
 (loose, or fixed to the world with ``free: false``), the robot attached at its base pose
 (welded if asked; on its mobile base, see :mod:`openral_sim.scene_base`), the cameras and
-the lidar sites the manifest mounts on the robot's bodies.
+the sensor sites (lidars, IMUs, force-torque and pose sensors) the manifest mounts on the
+robot's bodies, and the MuJoCo sensors a state sensor asks for
+(:mod:`openral_sim.state_sensors`).
 
 Every fault is reported at its field of the scene file or the manifest.
 """
@@ -31,7 +33,7 @@ from openral_mujoco.model_check import require_agreement, unloadable_model
 from openral_sim.camera_framing import place_fixed_cameras
 from openral_sim.scene_base import (
     RobotModels,
-    add_lidar_sites,
+    add_sensor_sites,
     attach_robot,
     robot_models,
 )
@@ -39,6 +41,7 @@ from openral_sim.scene_cameras import add_fixed_cameras, add_mounted_cameras, ro
 from openral_sim.scene_checks import check_object_names, check_weld
 from openral_sim.scene_geometry import lowest_static_point, root_body, yaw_quat
 from openral_sim.scene_lighting import add_scene_lights, balance_lights
+from openral_sim.state_sensors import add_state_sensors
 
 DEFAULT_TABLE_HEIGHT_M = 0.75
 BASE_WELD = "scene_base_weld"
@@ -131,7 +134,8 @@ def _compile(
     attach_robot(spec, child, robot, models, frame)
     balance_lights(spec)
     add_mounted_cameras(spec, robot, cameras)
-    add_lidar_sites(spec, robot)
+    add_sensor_sites(spec, robot)
+    add_state_sensors(spec, robot)
     if pose is not None and pose.weld:
         _add_base_weld(spec, child_model, robot)
     add_fixed_cameras(spec, robot, cameras)
