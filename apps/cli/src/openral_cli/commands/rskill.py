@@ -34,6 +34,10 @@ if TYPE_CHECKING:
 
 app = command_group("Run robot skills (policies) on the ROS graph.")
 
+DomainId = Annotated[
+    int | None,
+    typer.Option("--domain-id", min=0, max=232, help="ROS domain.", show_default="$ROS_DOMAIN_ID"),
+]
 STATUS_PERIOD_S = 0.2
 """How often the status line refreshes [s]."""
 
@@ -54,12 +58,7 @@ def run(
         float,
         typer.Option("--frame-timeout", min=0.1, help="Seconds a required input may be missing."),
     ] = 5.0,
-    domain_id: Annotated[
-        int | None,
-        typer.Option(
-            "--domain-id", min=0, max=232, help="ROS domain.", show_default="$ROS_DOMAIN_ID"
-        ),
-    ] = None,
+    domain_id: DomainId = None,
 ) -> None:
     """Run POLICY for ROBOT: camera frames by VLA slot in, /openral/safe_action out."""
     require_ros()
@@ -148,12 +147,7 @@ def trajectory(
     timeout: Annotated[
         float, typer.Option("--timeout", min=0.1, help="Seconds to wait for the graph.")
     ] = 10.0,
-    domain_id: Annotated[
-        int | None,
-        typer.Option(
-            "--domain-id", min=0, max=232, help="ROS domain.", show_default="$ROS_DOMAIN_ID"
-        ),
-    ] = None,
+    domain_id: DomainId = None,
 ) -> None:
     """Send one joint trajectory on ``/openral/joint_trajectory`` (from where the joints are
     to the goals in SECONDS), follow it and print how closely the joints tracked it."""
