@@ -181,7 +181,9 @@ def test_unknown_discriminator_lists_the_allowed_values(write_manifest: Manifest
     path = write_manifest(("name: tof, kind: depth", "name: tof, kind: sonar"))
     (match,) = _issues(path)
     assert match["field"] == "sensors[2].kind"
-    assert match["msg"] == "expected one of depth, lidar, rgb, got a string 'sonar'"
+    assert match["msg"] == (
+        "expected one of depth, force_torque, imu, lidar, pose, rgb, got a string 'sonar'"
+    )
 
 
 def test_continuous_joint_with_limits_is_rejected(write_manifest: ManifestWriter) -> None:
