@@ -54,7 +54,7 @@ docs-images *IDS:
 fuzz N *ARGS:
     python -m tests.fuzz.campaign {{N}} {{ARGS}}
 
-# The import layers (core -> mujoco -> sim -> hal -> bridge -> apps), as pyproject.toml declares them.
+# The import layers (core -> mujoco -> sim -> hal -> bridge | eval -> apps), as pyproject.toml declares them.
 layers:
     lint-imports --no-cache
 

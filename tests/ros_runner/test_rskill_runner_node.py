@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 import pytest
-from openral_nodes.policies import Observation
+from openral_eval.policies import Observation
 from openral_nodes.rskill_runner import (
     MissingSlots,
     RskillRunnerNode,

@@ -6,7 +6,7 @@ derived slot table of the loaded robot (``LoadedRobot.tables.vla_slots``: the ta
 ``openral robot show`` prints and ``just schema-export`` writes under ``generated/``), so
 the rule lives in one place.
 
-Each tick (``rate_hz``) the node builds an :class:`~openral_nodes.policies.Observation`
+Each tick (``rate_hz``) the node builds an :class:`~openral_eval.policies.Observation`
 from the latest frames, ``/joint_states`` and the latched ``/openral/action_spec``, calls
 the policy and publishes its action on ``/openral/safe_action``. Until ``frame_timeout_s``
 after start it waits for missing inputs; after that a missing input (or a camera slot
@@ -35,7 +35,7 @@ from rclpy.qos import (
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float64MultiArray
 
-from openral_nodes.policies import Observation, PolicyAdapter, make_policy, parse_params
+from openral_eval.policies import Observation, PolicyAdapter, make_policy, parse_params
 from openral_nodes.runtime import LATCHED
 from openral_nodes.topic_codec import image_to_rgb
 

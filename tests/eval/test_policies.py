@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from openral_nodes.policies import (
+from openral_eval.policies import (
     Observation,
     PolicyConfigError,
     WaveConfig,
