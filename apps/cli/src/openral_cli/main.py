@@ -16,6 +16,7 @@ from openral_mujoco.display import render_offscreen_when_headless
 
 from openral_cli.console import error as print_error
 from openral_cli.help_text import command_group  # noqa: F401  (installs the help hints)
+from openral_cli.optional_values import with_optional_values
 
 render_offscreen_when_headless()  # before any command module imports mujoco
 
@@ -38,7 +39,7 @@ app.add_typer(rskill.app, name="rskill")
 def run() -> None:
     """Console-script entry point."""
     try:
-        app()
+        app(args=with_optional_values(sys.argv[1:]))
     except OpenralError as error:
         print_error(str(error))  # verbatim: a message may contain [brackets]
         sys.exit(1)

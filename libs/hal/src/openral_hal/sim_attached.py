@@ -82,6 +82,7 @@ class SimAttachedHAL(EStopLatch):
         self._obs: Observation | None = None
         self._last_env_action: FloatArray = np.zeros(0)
         self._episode_done = False
+        self._info: dict[str, Any] = {}
         self._closed = False
         mjcf_names = tuple(robot.tables.joint_name_map[n] for n in self.joint_names)
         self._joints = SceneJointReader(description, mjcf_names, type(env).__name__)
@@ -196,6 +197,11 @@ class SimAttachedHAL(EStopLatch):
         return {name: images[name] for name in self._rgb if name in images}
 
     # -- commands --------------------------------------------------------------------------
+
+    @property
+    def last_step_info(self) -> dict[str, Any]:
+        """What the scene reported with its last step (a native scene: ``success``, …)."""
+        return dict(self._info)
 
     @property
     def episode_done(self) -> bool:
@@ -335,6 +341,7 @@ class SimAttachedHAL(EStopLatch):
         else:
             result = self.env.step(action)
         self._obs = result.obs
+        self._info = result.info
         self._episode_done = bool(result.terminated or result.truncated)
         return result
 

@@ -25,13 +25,15 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from openral_cli.commands.sweep import sweep
 from openral_cli.console import out, progress
 from openral_cli.help_text import command_group
 
 if TYPE_CHECKING:
     from openral_hal.protocol import RobotHal
 
-app = command_group("Run simulated scenes.")
+app = command_group("Run simulated scenes, or sweep a policy over scenes and seeds.")
+app.command("sweep")(sweep)
 
 SWAY_RAD = 0.15
 """Amplitude of the demo motion around the start pose."""

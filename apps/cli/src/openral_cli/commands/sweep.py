@@ -1,0 +1,212 @@
+"""``openral sim sweep``: a policy over scenes and seeds, with success rates and intervals.
+
+Example::
+
+    openral sim sweep --config robots/franka_panda/scenes/tabletop.yaml --seeds 0:20 \\
+        --policy scripted_lift --out o/
+
+Writes ``o/episodes.jsonl`` (one line per episode: scene, seed, policy, params, success,
+steps, sim time, wall time, error, trajectory digest, video) and ``o/summary.json``, and
+prints each scene's success rate with its 95 % Wilson interval. Videos go to
+``o/videos/``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+from openral_core.errors import OpenralError
+
+from openral_cli.console import out, progress
+
+if TYPE_CHECKING:
+    from openral_eval.episode import EpisodeResult, EpisodeSpec
+
+VIDEO_CHOICES = ("first", "failures", "all", "none")
+MAX_EPISODES = 100_000
+
+
+def parse_seeds(text: str) -> list[int]:
+    """``0:100`` (start:stop, stop excluded), ``7``, or ``1,5,9``.
+
+    Raises:
+        typer.BadParameter: Anything else, an empty range, or over :data:`MAX_EPISODES`.
+    """
+    try:
+        if ":" in text:
+            start, stop = (int(part) for part in text.split(":", 1))
+            seeds = list(range(start, stop)) if stop - start <= MAX_EPISODES else []
+            if stop - start > MAX_EPISODES:
+                raise typer.BadParameter(f"at most {MAX_EPISODES} seeds", param_hint="--seeds")
+        else:
+            seeds = [int(part) for part in text.split(",")]
+    except ValueError:
+        raise typer.BadParameter(
+            f"{text!r}: expected START:STOP (0:100), a seed (7) or a list (1,5,9)",
+            param_hint="--seeds",
+        ) from None
+    if not seeds or min(seeds) < 0:
+        raise typer.BadParameter(f"{text!r} gives no non-negative seed", param_hint="--seeds")
+    return seeds
+
+
+def sweep(
+    config: Annotated[
+        list[Path], typer.Option("--config", help="Scene file (repeat for several scenes).")
+    ],
+    seeds: Annotated[str, typer.Option("--seeds", help="START:STOP, a seed, or 1,5,9.")],
+    policy: Annotated[str, typer.Option("--policy", help="Policy name (registered).")],
+    out_dir: Annotated[Path, typer.Option("--out", help="Directory for the results.")],
+    params: Annotated[
+        list[str] | None, typer.Option("--param", "-p", help="Policy parameter key=value.")
+    ] = None,
+    steps: Annotated[
+        int | None, typer.Option("--steps", min=1, help="Step limit (default: the scene's).")
+    ] = None,
+    workers: Annotated[
+        int | None, typer.Option("--workers", min=1, max=512, help="Local processes.")
+    ] = None,
+    ray: Annotated[
+        str | None,
+        typer.Option("--ray", help="Run on Ray: alone, a local instance; or a cluster ADDRESS."),
+    ] = None,
+    video: Annotated[
+        str, typer.Option("--video", help="MP4s of the first camera: first|failures|all|none.")
+    ] = "first",
+    resume: Annotated[
+        bool, typer.Option("--resume", help="Keep finished episodes, run the rest.")
+    ] = False,
+) -> None:
+    """Run POLICY on every (scene, seed) episode through the same HAL contract as deploy
+    sim, in parallel; write ``episodes.jsonl`` and ``summary.json`` and print each scene's
+    success rate with its 95 % Wilson interval."""
+    from openral_eval.policies import make_policy, parse_params
+    from openral_eval.results import EpisodeLog
+
+    if video not in VIDEO_CHOICES:
+        raise typer.BadParameter(
+            f"expected one of {', '.join(VIDEO_CHOICES)}", param_hint="--video"
+        )
+    pairs = tuple(sorted(parse_params(params or []).items()))
+    make_policy(policy, dict(pairs))  # a bad name or parameter stops here, before any episode
+    for path in config:
+        _check_scene(path)
+    plan = _plan(config, parse_seeds(seeds), policy, pairs, steps, video, out_dir)
+    log = EpisodeLog(out_dir / "episodes.jsonl")
+    if log.path.exists() and log.path.stat().st_size and not resume:
+        raise OpenralError(
+            f"{log.path} already holds results: add --resume to finish that sweep, or "
+            "choose another --out"
+        )
+    log.start(resume=resume)
+    done = log.done()
+    todo = [spec for spec in plan if spec.key not in done]
+    count = workers or os.cpu_count() or 1
+    _run(todo, len(plan) - len(todo), len(plan), count, ray, log, video, out_dir)
+    _report(log.sort(plan), policy, out_dir)
+
+
+def _check_scene(path: Path) -> None:
+    """Load the scene file now, so a bad one is one located error before any episode."""
+    from openral_core.loader import load_scene
+    from openral_sim.scene import scene_robot
+
+    scene_robot(load_scene(path))
+
+
+def _plan(
+    config: list[Path],
+    seeds: list[int],
+    policy: str,
+    pairs: tuple[tuple[str, str], ...],
+    steps: int | None,
+    video: str,
+    out_dir: Path,
+) -> list[EpisodeSpec]:
+    """Every episode, scene by scene, seed by seed (with its video path, if any)."""
+    from openral_eval.episode import EpisodeSpec
+
+    if len(config) * len(seeds) > MAX_EPISODES:
+        raise typer.BadParameter(f"at most {MAX_EPISODES} episodes", param_hint="--seeds")
+    plan = []
+    for path in config:
+        slug = "_".join(Path(path).with_suffix("").parts[-3:]).replace(".", "")
+        for index, seed in enumerate(seeds):
+            wanted = video in ("all", "failures") or (video == "first" and index == 0)
+            movie = str(out_dir / "videos" / f"{slug}_seed{seed}.mp4") if wanted else None
+            plan.append(EpisodeSpec(str(path), seed, policy, pairs, steps, movie))
+    return plan
+
+
+def _run(
+    todo: list[EpisodeSpec],
+    already: int,
+    total: int,
+    workers: int,
+    ray: str | None,
+    log: object,
+    video: str,
+    out_dir: Path,
+) -> None:
+    """Run ``todo`` with a progress bar; every result is written as it arrives."""
+    from dataclasses import replace
+
+    from openral_eval.results import EpisodeLog
+    from openral_eval.sweep import run_pool, run_ray, run_serial
+
+    assert isinstance(log, EpisodeLog)
+    with progress() as bar:
+        task = bar.add_task("episodes", total=total, completed=already)
+        wins = [0]
+
+        def record(result: EpisodeResult) -> None:
+            if video == "failures" and result.success and result.video:
+                Path(result.video).unlink(missing_ok=True)
+                result = replace(result, video=None)
+            if result.video:  # as the directory's own path, whichever --out named it
+                result = replace(result, video=str(Path(result.video).relative_to(out_dir)))
+            log.append(result)
+            wins[0] += int(result.success)
+            bar.update(task, advance=1, description=f"episodes · {wins[0]} succeeded")
+
+        if ray is not None:
+            run_ray(todo, ray, workers, record)
+        elif workers == 1 or len(todo) <= 1:
+            run_serial(todo, record)
+        else:
+            run_pool(todo, min(workers, len(todo)), record)
+
+
+def _report(lines: list[dict[str, object]], policy: str, out_dir: Path) -> None:
+    """The per-scene table, ``summary.json`` and where everything is."""
+    from openral_eval.summary import summarise, summary_json
+    from rich.table import Table
+
+    rows = summarise(lines)
+    (out_dir / "summary.json").write_text(json.dumps(summary_json(rows, policy), indent=2) + "\n")
+    table = Table(title=f"{policy}: success rate per scene (95 % Wilson interval)")
+    for column in ("scene", "episodes", "success", "rate", "95 % interval", "mean steps", "errors"):
+        table.add_column(column, justify="left" if column == "scene" else "right")
+    for row in rows:
+        interval = f"{row.ci95_low:.2f} to {row.ci95_high:.2f}"
+        table.add_row(
+            row.scene,
+            str(row.episodes),
+            str(row.successes),
+            f"{row.success_rate:.2f}",
+            interval,
+            f"{row.mean_steps:.0f}",
+            str(row.errors),
+        )
+    out.print(table)
+    errors = [line for line in lines if line.get("error")]
+    if errors:
+        first = errors[0]
+        out.print(f"first error (seed {first['seed']}): {first['error']}", markup=False)
+    out.print(
+        f"wrote {out_dir / 'episodes.jsonl'} ({len(lines)} episodes) and {out_dir / 'summary.json'}"
+    )

@@ -1,0 +1,128 @@
+"""Running many episodes: in this process, in a local process pool, or as Ray tasks.
+
+All three run the same :func:`~openral_eval.episode.run_episode` on the same specs, so the
+same (scene, seed, policy) gives the same result anywhere; only the wall times differ.
+
+- ``workers == 1``: one after another in this process.
+- ``workers > 1``: a pool of that many processes (started with ``spawn``: no MuJoCo, EGL
+  or thread state is inherited); each builds each scene once and renders offscreen on its
+  own. A worker that dies takes the pool with it: the episodes it had not finished are run
+  again in a new pool, at most :data:`RETRIES` times, then recorded with an error.
+- Ray (the optional ``ray`` extra): ``address`` ``local`` starts a Ray instance on this
+  machine with ``workers`` CPUs; any other address joins that cluster (whose nodes must
+  have openral installed). Each episode is one task of one CPU, retried
+  :data:`RETRIES` times when its worker dies.
+
+Every finished episode goes to ``on_result`` on this process's main thread, as soon as it
+ends, in whatever order episodes end.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+from collections.abc import Callable, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+
+from openral_core.errors import OpenralError
+
+from openral_eval.episode import EpisodeResult, EpisodeSpec, run_episode
+
+RETRIES = 2
+"""Extra attempts of an episode whose worker process died."""
+OnResult = Callable[[EpisodeResult], None]
+
+
+class SweepError(OpenralError):
+    """A sweep could not start (Ray missing or unreachable)."""
+
+
+def run_serial(specs: Sequence[EpisodeSpec], on_result: OnResult) -> None:
+    """Every episode in this process, in order."""
+    for spec in specs:
+        on_result(run_episode(spec))
+
+
+def run_pool(specs: Sequence[EpisodeSpec], workers: int, on_result: OnResult) -> None:
+    """Every episode in a pool of ``workers`` processes (see the module doc)."""
+    pending, attempts = list(specs), 0
+    while pending and attempts <= RETRIES:
+        pending = _pool_pass(pending, workers, on_result)
+        attempts += 1
+    for spec in pending:
+        on_result(_died(spec, "its worker process died, every time it ran"))
+
+
+def _pool_pass(specs: list[EpisodeSpec], workers: int, on_result: OnResult) -> list[EpisodeSpec]:
+    """Run ``specs`` in one pool; returns those whose worker died with the pool."""
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+        running: dict[Future[EpisodeResult], EpisodeSpec] = {}
+        queue = list(reversed(specs))
+        broken: list[EpisodeSpec] = []
+        while queue or running:
+            while queue and len(running) < 2 * workers:  # a little ahead, never all at once
+                spec = queue.pop()
+                running[pool.submit(run_episode, spec)] = spec
+            finished, _ = wait(running, return_when=FIRST_COMPLETED)
+            for future in finished:
+                spec = running.pop(future)
+                try:
+                    on_result(future.result())
+                except BrokenProcessPool:
+                    broken.append(spec)
+            if broken:
+                return broken + [running[f] for f in running] + list(reversed(queue))
+    return []
+
+
+def run_ray(specs: Sequence[EpisodeSpec], address: str, workers: int, on_result: OnResult) -> None:
+    """Every episode as a Ray task (see the module doc).
+
+    Raises:
+        SweepError: Ray is not installed, or the cluster at ``address`` cannot be joined.
+    """
+    try:
+        import ray
+        from ray.exceptions import RayError
+    except ImportError:
+        raise SweepError(
+            "--ray needs Ray: install openral with the 'ray' extra (pip install 'openral[ray]')"
+        ) from None
+    try:
+        if address == "local":
+            ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
+        else:
+            ray.init(address=address, log_to_driver=False)
+    except (ConnectionError, RuntimeError, ValueError) as error:
+        raise SweepError(f"cannot start or join Ray at {address!r}: {error}") from None
+    try:
+        task = ray.remote(num_cpus=1, max_retries=RETRIES)(run_episode)
+        waiting = {task.remote(spec): spec for spec in specs}
+        while waiting:
+            finished, _ = ray.wait(list(waiting), num_returns=1)
+            for ref in finished:
+                spec = waiting.pop(ref)
+                try:
+                    on_result(ray.get(ref))
+                except RayError as error:
+                    on_result(_died(spec, f"Ray gave up on it: {type(error).__name__}"))
+    finally:
+        ray.shutdown()
+
+
+def _died(spec: EpisodeSpec, why: str) -> EpisodeResult:
+    """The result of an episode that never finished."""
+    return EpisodeResult(
+        scene=spec.scene,
+        seed=spec.seed,
+        policy=spec.policy,
+        params=dict(spec.params),
+        success=False,
+        steps=0,
+        sim_time_s=0.0,
+        wall_time_s=0.0,
+        error=why,
+        trajectory_sha256="",
+        video=None,
+    )
