@@ -1,0 +1,159 @@
+"""The sweep machinery: intervals, seeds, the results file, the executors, the CLI.
+
+- Wilson intervals match published values and stay inside [0, 1];
+- ``episodes.jsonl`` survives a cut-off last line, ``--resume`` keeps every written line
+  byte for byte and runs only what is missing, and the finished file is in plan order;
+- serial, a 2-process pool and Ray (2 CPUs) give identical files except wall times;
+- an episode that raises is a line with its error, and the sweep goes on;
+- a sweep killed half-way and resumed ends with every episode exactly once.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from openral_cli.optional_values import with_optional_values
+from openral_eval import policies
+from openral_eval.episode import EpisodeSpec, run_episode
+from openral_eval.results import EpisodeLog
+from openral_eval.summary import wilson
+
+from tests.conftest import ROBOTS
+
+SCENE = str(ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml")
+OPENRAL = Path(sys.executable).parent / "openral"
+SWEEP = [
+    "sim",
+    "sweep",
+    "--config",
+    SCENE,
+    "--policy",
+    "wave",
+    "-p",
+    "required_slots=",
+    "--steps",
+    "8",
+]
+
+
+@pytest.mark.parametrize(
+    ("k", "n", "low", "high"),
+    [
+        (0, 10, 0.0, 0.2775),
+        (10, 10, 0.7225, 1.0),
+        (5, 10, 0.2366, 0.7634),
+        (18, 20, 0.6990, 0.9721),
+    ],
+)
+def test_wilson_interval_matches_published_values(k: int, n: int, low: float, high: float) -> None:
+    assert wilson(k, n) == pytest.approx((low, high), abs=5e-4)
+
+
+def test_ray_alone_means_a_local_instance() -> None:
+    assert with_optional_values(["sim", "sweep", "--ray"]) == ["sim", "sweep", "--ray", "local"]
+    assert with_optional_values(["--ray", "--out", "o"]) == ["--ray", "local", "--out", "o"]
+    assert with_optional_values(["--ray", "10.0.0.2:6379"]) == ["--ray", "10.0.0.2:6379"]
+
+
+def _lines(path: Path) -> list[dict[str, object]]:
+    return [json.loads(line) for line in path.read_text().splitlines()]
+
+
+def _without_wall_time(path: Path) -> list[dict[str, object]]:
+    return [{k: v for k, v in line.items() if k != "wall_time_s"} for line in _lines(path)]
+
+
+def _sweep(out: Path, *extra: str, seeds: str = "0:4") -> subprocess.CompletedProcess[str]:
+    command = [str(OPENRAL), *SWEEP, "--seeds", seeds, "--video", "none", "--out", str(out), *extra]
+    return subprocess.run(command, capture_output=True, text=True, timeout=600)
+
+
+def test_serial_pool_and_ray_write_the_same_file(tmp_path: Path) -> None:
+    runs = {
+        "serial": ("--workers", "1"),
+        "pool": ("--workers", "2"),
+        "ray": ("--workers", "2", "--ray"),
+    }
+    for name, extra in runs.items():
+        result = _sweep(tmp_path / name, *extra)
+        assert result.returncode == 0, result.stderr
+    serial = _without_wall_time(tmp_path / "serial" / "episodes.jsonl")
+    assert [line["seed"] for line in serial] == [0, 1, 2, 3]
+    assert all(line["trajectory_sha256"] and line["error"] is None for line in serial)
+    for name in ("pool", "ray"):
+        assert _without_wall_time(tmp_path / name / "episodes.jsonl") == serial, name
+
+
+def test_a_cut_off_line_is_dropped_and_resume_keeps_every_written_line(tmp_path: Path) -> None:
+    log = EpisodeLog(tmp_path / "episodes.jsonl")
+    log.start(resume=False)
+    specs = [EpisodeSpec(SCENE, seed, "wave", (("required_slots", ""),), 4) for seed in range(3)]
+    for spec in specs[:2]:
+        log.append(run_episode(spec))
+    written = log.path.read_bytes()
+    with log.path.open("ab") as file:
+        file.write(b'{"scene": "cut off by a ki')
+    assert set(log.done()) == {specs[0].key, specs[1].key}
+    log.start(resume=True)
+    assert log.path.read_bytes() == written
+    log.append(run_episode(specs[2]))
+    assert [line["seed"] for line in log.sort(reversed(specs))] == [2, 1, 0]
+
+
+def test_an_episode_that_raises_is_recorded_and_the_sweep_goes_on(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    class Broken:
+        required_slots: tuple[str, ...] = ()
+
+        def act(self, obs: policies.Observation) -> object:
+            raise RuntimeError("the policy fell over")
+
+    entry = policies.PolicyEntry(policies.WaveConfig, lambda config: Broken())
+    monkeypatch.setitem(policies.POLICIES, "broken", entry)
+    result = run_episode(EpisodeSpec(SCENE, 0, "broken", (), 5))
+    assert not result.success and result.steps == 0
+    assert result.error is not None and result.error.startswith(
+        "RuntimeError: the policy fell over"
+    )
+
+
+def test_a_killed_sweep_resumed_runs_every_episode_once(tmp_path: Path) -> None:
+    out = tmp_path / "killed"
+    command = [str(OPENRAL), *SWEEP, "--seeds", "0:12", "--workers", "2", "--video", "none"]
+    process = subprocess.Popen(
+        [*command, "--out", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
+    log = out / "episodes.jsonl"
+    deadline = time.monotonic() + 300
+    while (
+        not log.exists() or len(log.read_text().splitlines()) < 4
+    ) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    before = log.read_text().splitlines()
+    assert 4 <= len(before) < 12, "kill the sweep half-way"
+    again = _sweep(out, "--workers", "2", "--resume", seeds="0:12")
+    assert again.returncode == 0, again.stderr
+    after = log.read_text().splitlines()
+    seeds = [json.loads(line)["seed"] for line in after]
+    assert seeds == list(range(12))
+    assert set(before) <= set(after)  # every line written before the kill, byte for byte
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["scenes"][0]["episodes"] == 12
+
+
+def test_results_already_there_need_resume(tmp_path: Path) -> None:
+    assert _sweep(tmp_path, seeds="0:1").returncode == 0
+    again = _sweep(tmp_path, seeds="0:1")
+    assert again.returncode == 1
+    assert "already holds results: add --resume" in again.stderr
+    bad = _sweep(tmp_path / "bad", seeds="5:2")
+    assert bad.returncode == 2 and "gives no non-negative seed" in bad.stderr
