@@ -81,6 +81,10 @@ bench-camera *ARGS:
 bench-realtime *ARGS:
     python -m benchmarks.real_time {{ARGS}}
 
+# Sweep scaling: the franka tabletop sweep with --workers 1, --workers 2 and --ray (2 CPUs), wall times, speed-ups, identical results; writes benchmarks/results/sweep_scaling.json.
+bench-sweep *ARGS:
+    python -m benchmarks.sweep_scaling {{ARGS}}
+
 # Joint-trajectory tracking on the franka tabletop: error against the path with and without the glide, and a following tick's cost over a holding one; writes benchmarks/results/trajectory_tracking.json.
 bench-trajectory *ARGS:
     python -m benchmarks.trajectory_tracking {{ARGS}}
