@@ -26,6 +26,7 @@ import numpy.typing as npt
 from openral_bridge import topics
 from openral_core import VlaSlot, open_robot_by_id
 from openral_core.errors import OpenralError
+from openral_eval.policies import Observation, PolicyAdapter, make_policy, parse_params
 from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -35,7 +36,6 @@ from rclpy.qos import (
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float64MultiArray
 
-from openral_eval.policies import Observation, PolicyAdapter, make_policy, parse_params
 from openral_nodes.runtime import LATCHED
 from openral_nodes.topic_codec import image_to_rgb
 

@@ -33,6 +33,7 @@ from openral_sim.rollout import SimRollout
 from openral_sim.scene import build_scene, scene_robot
 
 from openral_eval.policies import Observation, PolicyAdapter, make_policy
+from openral_eval.privileged import Pose, Privileged
 from openral_eval.video import VideoWriter
 
 DEFAULT_STEPS = 300
@@ -182,13 +183,21 @@ class _Inputs:
             obs["privileged"] = self._privileged()
         return obs
 
-    def _privileged(self):  # type: ignore[no-untyped-def]
-        from openral_eval.policies import Privileged
-
+    def _privileged(self) -> Privileged:
         env = self.env
         if not isinstance(env, NativeScene):
             raise ValueError("a policy with privileged state needs a native scene")
         if self.scratch is None:
             self.scratch = mujoco.MjData(env.model)
         mujoco.mj_copyData(self.scratch, env.model, env.data)
-        return Privileged(model=env.model, data=self.scratch, objects=env.object_poses())
+        return Privileged(model=env.model, data=self.scratch, objects=object_poses(env))
+
+
+def object_poses(env: NativeScene) -> dict[str, Pose]:
+    """World pose of every object the scene file lists (its body ``scene_<name>``)."""
+    options = env.scene.scene.options
+    poses: dict[str, Pose] = {}
+    for obj in options.objects if options and options.objects else []:
+        body = mujoco.mj_name2id(env.model, mujoco.mjtObj.mjOBJ_BODY, f"scene_{obj.name}")
+        poses[obj.name] = (env.data.xpos[body].copy(), env.data.xquat[body].copy())
+    return poses

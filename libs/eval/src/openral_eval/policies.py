@@ -17,11 +17,13 @@ import dataclasses
 import math
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
-from typing import Any, Protocol, TypedDict
+from typing import Any, NotRequired, Protocol, TypedDict
 
 import numpy as np
 import numpy.typing as npt
 from openral_core.errors import OpenralError
+
+from openral_eval.privileged import Privileged
 
 
 class Observation(TypedDict):
@@ -35,6 +37,8 @@ class Observation(TypedDict):
     """HAL action slot names and the hold action that keeps the robot still."""
     time_s: float
     """Seconds since the runner's first tick with a complete observation."""
+    privileged: NotRequired[Privileged]
+    """The simulation itself, for a policy with ``needs_privileged`` (episodes only)."""
 
 
 class PolicyAdapter(Protocol):

@@ -1,0 +1,28 @@
+"""Privileged observations: what a scripted policy may know that a camera-only one cannot.
+
+A policy that sets ``needs_privileged = True`` gets ``obs["privileged"]`` on every step of
+an episode (never under ROS: the rskill runner refuses such a policy): the scene's model,
+a scratch copy of the simulation state it may compute on (``mj_kinematics``, Jacobians),
+and the world pose of every scene object.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+from openral_mujoco.state import FloatArray
+
+Pose = tuple[FloatArray, FloatArray]
+"""World position [m] and orientation quaternion (w, x, y, z)."""
+
+
+@dataclass(frozen=True)
+class Privileged:
+    """The simulation behind one observation (see the module doc)."""
+
+    model: mujoco.MjModel
+    data: mujoco.MjData
+    """A copy of the state at this step, the policy's to change."""
+    objects: dict[str, Pose]
+    """Scene object name (as in the scene file) → its world pose."""
