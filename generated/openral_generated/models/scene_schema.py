@@ -181,6 +181,194 @@ A robosuite environment name, exactly as robosuite spells it (`Lift`, `PickPlace
 """
 
 
+PositionMinMItem = TypeAliasType(
+    "PositionMinMItem", Annotated[StrictFloat, Field(ge=-1.0, le=1.0)]
+)
+
+
+PositionMaxMItem = TypeAliasType(
+    "PositionMaxMItem", Annotated[StrictFloat, Field(ge=-1.0, le=1.0)]
+)
+
+
+YawDegItem = TypeAliasType(
+    "YawDegItem", Annotated[StrictFloat, Field(ge=-360.0, le=360.0)]
+)
+
+
+RgbaItem1Item = TypeAliasType(
+    "RgbaItem1Item", Annotated[StrictFloat, Field(ge=0.0, le=1.0)]
+)
+
+
+RgbaItem1 = TypeAliasType(
+    "RgbaItem1", Annotated[list[RgbaItem1Item], Field(max_length=4, min_length=4)]
+)
+
+
+class ObjectRandomization(OpenralModel):
+    """
+    Seeded ranges for one object's start: where it lies, how it is turned, its colour.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    object: Annotated[StrictStr, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
+    """
+    An object of `scene.options.objects`, by its `name`.
+    """
+    position_min_m: Annotated[
+        list[PositionMinMItem] | None, Field(max_length=3, min_length=3)
+    ] = None
+    """
+    Lowest offset x, y, z [m] added to the object's `position_m` (uniform per axis).
+    """
+    position_max_m: Annotated[
+        list[PositionMaxMItem] | None, Field(max_length=3, min_length=3)
+    ] = None
+    """
+    Highest offset x, y, z [m] added to the object's `position_m`; each at least `position_min_m`'s.
+    """
+    yaw_deg: Annotated[
+        list[YawDegItem] | None,
+        Field(examples=[[-180.0, 180.0]], max_length=2, min_length=2),
+    ] = None
+    """
+    Range of the object's turn about the world z axis [deg] (uniform).
+    """
+    rgba: Annotated[list[RgbaItem1] | None, Field(max_length=64, min_length=1)] = None
+    """
+    Colours to choose from, one per episode (uniform); each channel in [0, 1].
+    """
+
+
+LightIntensityScaleItem = TypeAliasType(
+    "LightIntensityScaleItem", Annotated[StrictFloat, Field(ge=0.0, le=10.0)]
+)
+
+
+class Randomization(OpenralModel):
+    """
+    Seeded ranges an episode's start is drawn from (a native scene). The episode's seed alone decides every draw: the same seed gives the same episode in `openral sim run`, `deploy sim` and `openral sim sweep`.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    objects: Annotated[list[ObjectRandomization] | None, Field(max_length=256)] = None
+    """
+    Per object: position offset, yaw and colour ranges.
+    """
+    light_intensity_scale: Annotated[
+        list[LightIntensityScaleItem] | None,
+        Field(examples=[[0.8, 1.2]], max_length=2, min_length=2),
+    ] = None
+    """
+    Range of one factor scaling every scene light's diffuse intensity (uniform).
+    """
+    light_direction_deg: Annotated[StrictFloat | None, Field(ge=0.0, le=90.0)] = None
+    """
+    Largest tilt of each directional light's direction [deg] (uniform in a cone).
+    """
+    camera_position_m: Annotated[StrictFloat | None, Field(ge=0.0, le=1.0)] = None
+    """
+    Largest offset of each fixed scene camera's position along each axis [m] (uniform).
+    """
+    camera_angle_deg: Annotated[StrictFloat | None, Field(ge=0.0, le=45.0)] = None
+    """
+    Largest turn of each fixed scene camera about a random axis [deg] (uniform).
+    """
+    joint_noise: Annotated[StrictFloat | None, Field(ge=0.0, le=0.5)] = None
+    """
+    Largest offset added to each arm joint's start position [rad or m] (uniform ±).
+    """
+
+
+class ObjectAbove(OpenralModel):
+    """
+    The object's centre is above a height (lifted).
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    kind: Literal["object_above"]
+    """
+    `object_above`.
+    """
+    object: Annotated[StrictStr, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
+    """
+    An object of `scene.options.objects`, by its `name`.
+    """
+    for_s: Annotated[StrictFloat, Field(ge=0.0, le=3600.0)] = 0.0
+    """
+    How long the predicate must hold without a break [s] (0: at one control step).
+    """
+    z_m: Annotated[StrictFloat, Field(ge=-100.0, le=100.0)]
+    """
+    Height in the world frame [m] the object's centre must be above.
+    """
+
+
+MinMItem = TypeAliasType("MinMItem", Annotated[StrictFloat, Field(ge=-100.0, le=100.0)])
+
+
+MaxMItem = TypeAliasType("MaxMItem", Annotated[StrictFloat, Field(ge=-100.0, le=100.0)])
+
+
+class ObjectInRegion(OpenralModel):
+    """
+    The object's centre is inside an axis-aligned box of the world (placed).
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    kind: Literal["object_in_region"]
+    """
+    `object_in_region`.
+    """
+    object: Annotated[StrictStr, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
+    """
+    An object of `scene.options.objects`, by its `name`.
+    """
+    for_s: Annotated[StrictFloat, Field(ge=0.0, le=3600.0)] = 0.0
+    """
+    How long the predicate must hold without a break [s] (0: at one control step).
+    """
+    min_m: Annotated[list[MinMItem], Field(max_length=3, min_length=3)]
+    """
+    The box's lowest corner x, y, z [m], world frame.
+    """
+    max_m: Annotated[list[MaxMItem], Field(max_length=3, min_length=3)]
+    """
+    The box's highest corner x, y, z [m], world frame.
+    """
+
+
+class GripperHolds(OpenralModel):
+    """
+    Every finger of the robot's gripper touches the object (held between the fingers).
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    kind: Literal["gripper_holds"]
+    """
+    `gripper_holds`.
+    """
+    object: Annotated[StrictStr, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
+    """
+    An object of `scene.options.objects`, by its `name`.
+    """
+    for_s: Annotated[StrictFloat, Field(ge=0.0, le=3600.0)] = 0.0
+    """
+    How long the predicate must hold without a break [s] (0: at one control step).
+    """
+
+
 class SceneSpec(OpenralModel):
     """
     Scene identity, backend, assets, image size and cameras.
@@ -247,4 +435,12 @@ class DeployScene(OpenralModel):
     scene: SceneSpec
     """
     The scene itself.
+    """
+    randomization: Randomization | None = None
+    success: Annotated[
+        list[ObjectAbove | ObjectInRegion | GripperHolds] | None,
+        Field(max_length=32, min_length=1),
+    ] = None
+    """
+    What success means in this scene: every predicate holds (AND). An episode ends on success or at its step limit.
     """

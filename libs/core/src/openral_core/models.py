@@ -25,8 +25,13 @@ from openral_generated.models.scene_schema import (
     Backend,
     BasePose,
     DeployScene,
+    GripperHolds,
     NativeAssets,
+    ObjectAbove,
+    ObjectInRegion,
+    ObjectRandomization,
     Observation,
+    Randomization,
     SceneObject,
     SceneOptions,
     SceneSpec,
@@ -49,6 +54,8 @@ StateSensor = ImuSensor | ForceTorqueSensor | PoseSensor
 """A sensor read from MuJoCo's sensor data at a site (no rendering, no ray casting)."""
 SiteSensor = LidarSensor | ImuSensor | ForceTorqueSensor | PoseSensor
 """A sensor that sits at an MJCF site (one of the model's, or one the scene creates)."""
+SuccessPredicate = ObjectAbove | ObjectInRegion | GripperHolds
+"""Any success predicate of a scene, discriminated by ``kind``."""
 SimControl = PositionControl | TorquePdControl
 """Any control law, discriminated by ``mode``."""
 
@@ -62,6 +69,7 @@ __all__ = [
     "DriveAxes",
     "DriveKind",
     "ForceTorqueSensor",
+    "GripperHolds",
     "GripperReadMode",
     "GripperWriteMode",
     "ImuSensor",
@@ -70,9 +78,13 @@ __all__ = [
     "LimitedJoint",
     "MobileBase",
     "NativeAssets",
+    "ObjectAbove",
+    "ObjectInRegion",
+    "ObjectRandomization",
     "Observation",
     "PoseSensor",
     "PositionControl",
+    "Randomization",
     "RgbSensor",
     "RobotDescription",
     "SceneObject",
@@ -85,5 +97,6 @@ __all__ = [
     "SimGripperDescription",
     "SiteSensor",
     "StateSensor",
+    "SuccessPredicate",
     "TorquePdControl",
 ]

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
 
+from openral_core.episode_rules import episode_findings
 from openral_core.models import (
     Base,
     DeployScene,
@@ -71,6 +72,7 @@ def scene_findings(scene: DeployScene, folder_robot: str | None = None) -> list[
         *_robot_matches_folder(scene, folder_robot),
         *_unique(located, "object name"),
         *_object_sizes(objects),
+        *episode_findings(scene),
     ]
 
 

@@ -190,7 +190,14 @@ class _Inputs:
         if self.scratch is None:
             self.scratch = mujoco.MjData(env.model)
         mujoco.mj_copyData(self.scratch, env.model, env.data)
-        return Privileged(model=env.model, data=self.scratch, objects=object_poses(env))
+        slots = env.addresses.arm_slots
+        return Privileged(
+            model=env.model,
+            data=self.scratch,
+            objects=object_poses(env),
+            arm_slots=tuple(int(s) for s in slots),
+            arm_dofs=tuple(int(d) for d in env.addresses.qvel[slots]),
+        )
 
 
 def object_poses(env: NativeScene) -> dict[str, Pose]:

@@ -123,6 +123,7 @@ class PolicyEntry:
 POLICIES: dict[str, PolicyEntry] = {
     "wave": PolicyEntry(WaveConfig, WavePolicy),
 }
+"""Built-in policies by name (``scripted_lift`` is added by its module, below)."""
 """Built-in policies by name."""
 
 
@@ -180,3 +181,13 @@ def _convert(text: str, like: object) -> object:
     if isinstance(like, int):
         return int(text)
     return text
+
+
+def _register_builtins() -> None:
+    """Policies defined in modules of their own (imported here, after the registry)."""
+    from openral_eval.scripted_lift import LiftConfig, ScriptedLift
+
+    POLICIES["scripted_lift"] = PolicyEntry(LiftConfig, ScriptedLift)
+
+
+_register_builtins()

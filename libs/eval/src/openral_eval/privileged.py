@@ -26,3 +26,7 @@ class Privileged:
     """A copy of the state at this step, the policy's to change."""
     objects: dict[str, Pose]
     """Scene object name (as in the scene file) → its world pose."""
+    arm_slots: tuple[int, ...]
+    """Action slots that are arm joints (position targets), in manifest order."""
+    arm_dofs: tuple[int, ...]
+    """Each of those joints' degree of freedom in :attr:`model` (Jacobian columns)."""

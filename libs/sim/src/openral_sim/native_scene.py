@@ -44,6 +44,7 @@ from openral_mujoco.state import FloatArray, JointStateSample
 
 from openral_sim.base_drive import BASE_UPDATE_STEPS, BaseDrive
 from openral_sim.depth_cloud import DepthCamera, DepthFrame
+from openral_sim.randomization import Randomizer
 from openral_sim.range_sensors import RangeSensors
 from openral_sim.rollout import Observation, StepResult
 from openral_sim.scene_cameras import camera_sensors
@@ -51,6 +52,7 @@ from openral_sim.scene_checks import physics_steps_per_control
 from openral_sim.scene_compose import BASE_WELD, compose
 from openral_sim.scene_geometry import place_floating_base, robot_bodies, root_body
 from openral_sim.state_sensors import StateSensors
+from openral_sim.success import SuccessCheck
 
 
 class NativeScene:
@@ -116,6 +118,19 @@ class NativeScene:
         changed at any time (the next observation follows it)."""
         self._renderer: mujoco.Renderer | None = None
         self._steps = 0
+        fixed = [
+            cameras[s.name]
+            for s in description.sensors
+            if s.name in cameras and s.mount_body is None and getattr(s, "camera", None) is None
+        ]
+        self.randomizer = Randomizer(scene, self.model, fixed)
+        """The scene's seeded randomisation (:mod:`openral_sim.randomization`)."""
+        self.addresses = addresses
+        """Where the robot's joints are in :attr:`model` (per manifest joint)."""
+        self._arm_qpos = addresses.qpos[addresses.arm_slots]
+        fingers = [int(a) for g in addresses.grippers for a in g.finger_qpos]
+        self.success = SuccessCheck(scene.success or [], self.model, fingers)
+        """The scene's success predicates (:mod:`openral_sim.success`)."""
 
     # -- SimRollout ------------------------------------------------------------------------
 
@@ -176,12 +191,15 @@ class NativeScene:
         """Keyframe (if any) at the scene's base pose, the start pose held, then the
         manifest's settle steps, as ``MujocoArmHAL.connect`` does.
 
-        The native scene has nothing random in it; ``seed`` is accepted for the protocol.
+        The scene's ``randomization`` is drawn from ``seed`` (:mod:`openral_sim.randomization`);
+        without one, every seed gives the same episode.
         """
         mujoco.mj_resetData(self.model, self.data)
         self.driver.reset_to_keyframe(self.model, self.data)
         if self.wiring.keyframe_index is not None and self.wiring.floating_base:
             self._place_floating_base()
+        self.randomizer.apply(self.data, seed, self._arm_qpos)
+        self.success.reset()
         self._hold_base_where_it_is()
         self.driver.start(self.model, self.data)
         if self.base is not None:
@@ -204,8 +222,10 @@ class NativeScene:
         self.driver.command(action, self.data, glide_s=glide_s)
         self._advance(self.substeps)
         self._steps += 1
+        success = self.success.update(self.data, self.control_period_s)
         truncated = self.horizon is not None and self._steps >= self.horizon
-        return StepResult(self._observe(), truncated=truncated, info={"steps": self._steps})
+        info = {"steps": self._steps, "success": success}
+        return StepResult(self._observe(), terminated=success, truncated=truncated, info=info)
 
     def joint_state(self) -> JointStateSample:
         """Every manifest joint, in manifest order and units (as ``MujocoArmHAL`` reports)."""

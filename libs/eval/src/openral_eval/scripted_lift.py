@@ -1,0 +1,180 @@
+"""``scripted_lift``: a privileged scripted policy that lifts a cube from above.
+
+It reads the simulation (:class:`~openral_eval.privileged.Privileged`): the cube's pose and
+the hand's. It then moves the gripper's centre (``tcp_offset_m`` along the hand's z axis)
+through four phases:
+
+1. ``approach``: ``approach_m`` above the cube, fingers pointing down and turned to the
+   cube's nearest face;
+2. ``descend``: to the cube's centre;
+3. ``close``: the gripper closes for ``close_s``;
+4. ``lift``: ``lift_m`` above where the cube started.
+
+Each step it turns the Cartesian error into joint targets by damped least squares on the
+point's Jacobian: speed at most ``speed_m_s``, turn rate at most 1.5 rad/s. The targets
+are integrated onto the previous command, so gravity's sag does not become a lasting
+error. It uses no randomness and no wall clock: the same episode gives the same actions.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+from openral_mujoco.state import FloatArray
+
+from openral_eval.policies import Observation, PolicyConfigError
+from openral_eval.privileged import Privileged
+
+PHASES = ("approach", "descend", "close", "lift")
+DAMPING = 0.05
+"""Damped-least-squares damping [m] (keeps steps small near singularities)."""
+TURN_RATE = 1.5
+"""Largest commanded turn rate [rad/s]."""
+REACHED_M = 0.008
+"""A phase's target counts as reached within this distance [m]."""
+
+
+@dataclass(frozen=True)
+class LiftConfig:
+    """Parameters of :class:`ScriptedLift` (``-p key=value``)."""
+
+    object: str = "red_cube"
+    """The scene object to lift."""
+    hand_body: str = "hand"
+    """The body the gripper is mounted on (MJCF name)."""
+    gripper_slot: str = "panda_finger_joint1"
+    """The gripper's action slot (write mode ``normalised``: 1 open, 0 closed)."""
+    tcp_offset_m: float = 0.1034
+    """Distance of the point between the fingertips from the hand's origin, along its z [m]."""
+    approach_m: float = 0.10
+    lift_m: float = 0.12
+    speed_m_s: float = 0.35
+    close_s: float = 0.6
+    gain: float = 6.0
+    """Proportional gain of the Cartesian error [1/s]."""
+
+    def __post_init__(self) -> None:
+        if self.speed_m_s <= 0 or self.gain <= 0 or self.close_s < 0:
+            raise PolicyConfigError("scripted_lift speed_m_s and gain must be > 0, close_s >= 0")
+
+
+class ScriptedLift:
+    """The four-phase lift of the module doc; one instance per episode."""
+
+    needs_privileged = True
+    required_slots: tuple[str, ...] = ()
+
+    def __init__(self, config: LiftConfig) -> None:
+        self.config = config
+        self.phase = PHASES[0]
+        self._command: FloatArray | None = None
+        self._closing_s = 0.0
+        self._start: FloatArray | None = None
+        self._period_s = 0.05
+        self._last_time_s: float | None = None
+
+    def act(self, obs: Observation) -> FloatArray:
+        """The next action: arm joint targets from the IK step, and the gripper command."""
+        world = obs.get("privileged")
+        if world is None:
+            raise PolicyConfigError("scripted_lift needs privileged state (episodes only)")
+        names, hold = obs["action_spec"]
+        if self._command is None:
+            self._command = np.asarray(hold, dtype=np.float64).copy()
+        now = float(obs["time_s"])
+        if self._last_time_s is not None and now > self._last_time_s:
+            self._period_s = now - self._last_time_s  # the control period
+        self._last_time_s = now
+        if self.config.gripper_slot not in names:
+            raise PolicyConfigError(f"no action slot {self.config.gripper_slot!r}; slots: {names}")
+        position, quat = world.objects[self.config.object]
+        if self._start is None:
+            self._start = np.array(position, dtype=np.float64)
+        target, gripper = self._phase_target(np.asarray(position), world)
+        self._command[list(world.arm_slots)] += self._ik_step(world, target, np.asarray(quat))
+        self._command[names.index(self.config.gripper_slot)] = gripper
+        return self._command.copy()
+
+    # -- phases ----------------------------------------------------------------------------
+
+    def _phase_target(self, cube: FloatArray, world: Privileged) -> tuple[FloatArray, float]:
+        """Where the gripper's centre should go now, and the gripper command."""
+        config = self.config
+        tcp = self._tcp(world)[0]
+        above = cube + np.array([0.0, 0.0, config.approach_m])
+        if self.phase == "approach":
+            if np.linalg.norm(tcp - above) < REACHED_M:
+                self.phase = "descend"
+            return above, 1.0
+        if self.phase == "descend":
+            if np.linalg.norm(tcp - cube) < REACHED_M:
+                self.phase = "close"
+            return cube, 1.0
+        if self.phase == "close":
+            self._closing_s += self._period_s
+            if self._closing_s >= config.close_s:
+                self.phase = "lift"
+            return cube, 0.0
+        assert self._start is not None
+        return self._start + np.array([0.0, 0.0, config.lift_m]), 0.0
+
+    # -- kinematics ------------------------------------------------------------------------
+
+    def _tcp(self, world: Privileged) -> tuple[FloatArray, FloatArray, int]:
+        """(gripper centre in the world [m], hand rotation matrix, hand body id)."""
+        model, data = world.model, world.data
+        mujoco.mj_kinematics(model, data)
+        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, self.config.hand_body)
+        if body < 0:
+            raise PolicyConfigError(f"no body {self.config.hand_body!r} in the scene")
+        rotation = data.xmat[body].reshape(3, 3).copy()
+        return data.xpos[body] + rotation[:, 2] * self.config.tcp_offset_m, rotation, body
+
+    def _ik_step(self, world: Privileged, target: FloatArray, cube_quat: FloatArray) -> FloatArray:
+        """Joint target increments for one control period towards ``target``."""
+        model, data = world.model, world.data
+        tcp, rotation, body = self._tcp(world)
+        mujoco.mj_comPos(model, data)
+        jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+        mujoco.mj_jac(model, data, jacp, jacr, tcp, body)
+        dofs = list(world.arm_dofs)
+        jacobian = np.vstack([jacp[:, dofs], jacr[:, dofs]])
+        velocity = self.config.gain * (target - tcp)
+        speed = np.linalg.norm(velocity)
+        if speed > self.config.speed_m_s:
+            velocity *= self.config.speed_m_s / speed
+        turn = np.clip(
+            self.config.gain * _orientation_error(rotation, cube_quat), -TURN_RATE, TURN_RATE
+        )
+        twist = np.concatenate([velocity, turn])
+        damped = jacobian @ jacobian.T + DAMPING**2 * np.eye(6)
+        rates = jacobian.T @ np.linalg.solve(damped, twist)
+        step: FloatArray = rates * self._period_s
+        return step
+
+
+def _orientation_error(rotation: FloatArray, cube_quat: FloatArray) -> FloatArray:
+    """Rotation vector [rad, world] from the hand's orientation to fingers-down, turned to
+    the cube face nearest the hand's present yaw (a cube looks the same every 90°)."""
+    cube = np.empty(9)
+    mujoco.mju_quat2Mat(cube, cube_quat)
+    cube_x = cube.reshape(3, 3)[:, 0]
+    cube_yaw = math.atan2(cube_x[1], cube_x[0])
+    hand_yaw = math.atan2(rotation[1, 0], rotation[0, 0])
+    quarter = math.pi / 2
+    yaw = cube_yaw + quarter * round((hand_yaw - cube_yaw) / quarter)
+    wanted = np.array(
+        [
+            [math.cos(yaw), math.sin(yaw), 0.0],
+            [math.sin(yaw), -math.cos(yaw), 0.0],
+            [0.0, 0.0, -1.0],
+        ]
+    )
+    error = wanted @ rotation.T
+    quat, vector = np.empty(4), np.empty(3)
+    mujoco.mju_mat2Quat(quat, error.reshape(9))
+    mujoco.mju_quat2Vel(vector, quat, 1.0)
+    return vector
