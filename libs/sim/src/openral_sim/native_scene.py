@@ -212,7 +212,9 @@ class NativeScene:
         """Apply ``action`` (one value per manifest joint) for one control period; with
         ``glide`` the arm's set point moves to it at constant speed over the period, that
         speed fed forward (the next sample of a smooth path, see
-        :class:`~openral_mujoco.joint_driver.JointDriver`).
+        :class:`~openral_mujoco.joint_driver.JointDriver`). ``info["success"]`` says whether
+        the scene's ``success`` predicates all hold now (a sweep ends the episode on it;
+        ``deploy sim`` does not: the world never resets under a ROS client by itself).
 
         Raises:
             ActionRejected: Wrong type, width, or a non-finite value; nothing is changed.
@@ -224,8 +226,8 @@ class NativeScene:
         self._steps += 1
         success = self.success.update(self.data, self.control_period_s)
         truncated = self.horizon is not None and self._steps >= self.horizon
-        info = {"steps": self._steps, "success": success}
-        return StepResult(self._observe(), terminated=success, truncated=truncated, info=info)
+        info = {"steps": self._steps, "success": success}  # an evaluator ends on it, not the scene
+        return StepResult(self._observe(), truncated=truncated, info=info)
 
     def joint_state(self) -> JointStateSample:
         """Every manifest joint, in manifest order and units (as ``MujocoArmHAL`` reports)."""
