@@ -41,3 +41,26 @@ def test_it_needs_privileged_state() -> None:
     }
     with pytest.raises(PolicyConfigError, match="needs privileged state"):
         policy.act(obs)  # type: ignore[arg-type]
+
+
+def test_the_ros_runner_refuses_it_with_one_line() -> None:
+    from openral_cli.main import app
+    from typer.testing import CliRunner
+
+    result = CliRunner().invoke(
+        app,
+        [
+            "rskill",
+            "run",
+            "--robot",
+            "franka_panda",
+            "--policy",
+            "scripted_lift",
+            "--duration",
+            "1",
+        ],
+    )
+    assert result.exit_code != 0
+    assert "reads the simulation itself (privileged state)" in str(
+        result.exception or result.output
+    )
