@@ -76,7 +76,7 @@ def test_an_error_with_brackets_is_printed_verbatim(
     from openral_cli import main
     from openral_core.errors import OpenralError
 
-    def fail() -> None:
+    def fail(**kwargs: object) -> None:
         raise OpenralError("expected slots [camera1, camera2], saw [camera1]")
 
     monkeypatch.setattr(main, "app", fail)

@@ -127,6 +127,7 @@ def test_an_episode_that_raises_is_recorded_and_the_sweep_goes_on(
 def test_a_killed_sweep_resumed_runs_every_episode_once(tmp_path: Path) -> None:
     out = tmp_path / "killed"
     command = [str(OPENRAL), *SWEEP, "--seeds", "0:12", "--workers", "2", "--video", "none"]
+    command[command.index("--steps") + 1] = "1500"  # long enough episodes to kill half-way
     process = subprocess.Popen(
         [*command, "--out", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
     )
@@ -135,12 +136,14 @@ def test_a_killed_sweep_resumed_runs_every_episode_once(tmp_path: Path) -> None:
     while (
         not log.exists() or len(log.read_text().splitlines()) < 4
     ) and time.monotonic() < deadline:
-        time.sleep(0.05)
+        time.sleep(0.02)
     process.send_signal(signal.SIGKILL)
     process.wait()
     before = log.read_text().splitlines()
     assert 4 <= len(before) < 12, "kill the sweep half-way"
-    again = _sweep(out, "--workers", "2", "--resume", seeds="0:12")
+    again = subprocess.run(
+        [*command, "--out", str(out), "--resume"], capture_output=True, text=True, timeout=600
+    )
     assert again.returncode == 0, again.stderr
     after = log.read_text().splitlines()
     seeds = [json.loads(line)["seed"] for line in after]
