@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 import os
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -106,8 +107,10 @@ def sweep(
     done = log.done()
     todo = [spec for spec in plan if spec.key not in done]
     count = workers or os.cpu_count() or 1
+    started = time.perf_counter()
     _run(todo, len(plan) - len(todo), len(plan), count, ray, log, video, out_dir)
-    _report(log.sort(plan), policy, out_dir)
+    run_s = time.perf_counter() - started
+    _report(log.sort(plan), policy, out_dir, run_s)
 
 
 def _check_scene(path: Path) -> None:
@@ -181,13 +184,15 @@ def _run(
             run_pool(todo, min(workers, len(todo)), record)
 
 
-def _report(lines: list[dict[str, object]], policy: str, out_dir: Path) -> None:
-    """The per-scene table, ``summary.json`` and where everything is."""
+def _report(lines: list[dict[str, object]], policy: str, out_dir: Path, run_s: float) -> None:
+    """The per-scene table, ``summary.json`` (with ``run_wall_s``: the episodes' wall time,
+    workers' start included) and where everything is."""
     from openral_eval.summary import summarise, summary_json
     from rich.table import Table
 
     rows = summarise(lines)
-    (out_dir / "summary.json").write_text(json.dumps(summary_json(rows, policy), indent=2) + "\n")
+    summary = {**summary_json(rows, policy), "run_wall_s": round(run_s, 3)}
+    (out_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     table = Table(title=f"{policy}: success rate per scene (95 % Wilson interval)")
     for column in ("scene", "episodes", "success", "rate", "95 % interval", "mean steps", "errors"):
         table.add_column(column, justify="left" if column == "scene" else "right")
