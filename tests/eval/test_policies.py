@@ -76,7 +76,7 @@ def test_make_policy_converts_string_parameters_by_field_type() -> None:
 @pytest.mark.parametrize(
     ("name", "params", "message"),
     [
-        ("dance", {}, "unknown policy 'dance'; built-in policies: wave"),
+        ("dance", {}, "unknown policy 'dance'; available: wave, scripted_lift"),
         ("wave", {"speed": "1"}, "unknown parameter 'speed'.*valid: amplitude, period_s"),
         ("wave", {"amplitude": "big"}, "amplitude='big': expected float"),
         ("wave", {"period_s": "0"}, "period_s must be > 0"),

@@ -127,14 +127,44 @@ POLICIES: dict[str, PolicyEntry] = {
 """Built-in policies by name."""
 
 
+ENTRY_POINT_GROUP = "openral.policies"
+"""Installed packages register policies here: an entry point named after the policy that
+loads a :class:`PolicyEntry`."""
+
+
 def make_policy(name: str, params: Mapping[str, str] | None = None) -> PolicyAdapter:
-    """Build the registered policy ``name`` from string parameters (its config's fields)."""
-    entry = POLICIES.get(name)
-    if entry is None:
-        raise PolicyConfigError(
-            f"unknown policy {name!r}; built-in policies: {', '.join(POLICIES)}"
-        )
+    """Build policy ``name`` from string parameters (its config's fields): a built-in one,
+    else one an installed package registers under :data:`ENTRY_POINT_GROUP`.
+
+    Raises:
+        PolicyConfigError: An unknown name (the message lists what there is), a registered
+            entry point that does not load a PolicyEntry, or a bad parameter.
+    """
+    entry = POLICIES.get(name) or _registered(name)
     return entry.build(parse_config(entry.config_type, params or {}, name))
+
+
+def _registered(name: str) -> PolicyEntry:
+    """The PolicyEntry an installed package registers as ``name``."""
+    from importlib.metadata import entry_points
+
+    found = {point.name: point for point in entry_points(group=ENTRY_POINT_GROUP)}
+    point = found.get(name)
+    if point is None:
+        names = ", ".join([*POLICIES, *sorted(found)])
+        raise PolicyConfigError(f"unknown policy {name!r}; available: {names}")
+    where = f"entry point {point.value!r} of {point.dist.name if point.dist else '?'}"
+    try:
+        entry = point.load()
+    except Exception as error:  # a broken plug-in is its package's fault, said in one line
+        raise PolicyConfigError(
+            f"policy {name!r}: {where} does not load ({type(error).__name__}: {error})"
+        ) from None
+    if not isinstance(entry, PolicyEntry):
+        raise PolicyConfigError(
+            f"policy {name!r}: {where} is a {type(entry).__name__}, not a PolicyEntry"
+        )
+    return entry
 
 
 def parse_params(items: Iterable[str]) -> dict[str, str]:
