@@ -21,6 +21,7 @@ ends, in whatever order episodes end.
 
 from __future__ import annotations
 
+import logging
 import multiprocessing
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
@@ -94,10 +95,16 @@ def run_ray(specs: Sequence[EpisodeSpec], address: str, workers: int, on_result:
             "--ray needs Ray: install openral with the 'ray' extra (pip install 'openral[ray]')"
         ) from None
     try:
+        # quiet: Ray's start-up lines would interleave with the sweep's own report
         if address == "local":
-            ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
+            ray.init(
+                num_cpus=workers,
+                include_dashboard=False,
+                log_to_driver=False,
+                logging_level=logging.ERROR,
+            )
         else:
-            ray.init(address=address, log_to_driver=False)
+            ray.init(address=address, log_to_driver=False, logging_level=logging.ERROR)
     except (ConnectionError, RuntimeError, ValueError) as error:
         raise SweepError(f"cannot start or join Ray at {address!r}: {error}") from None
     try:
