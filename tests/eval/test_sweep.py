@@ -160,3 +160,31 @@ def test_results_already_there_need_resume(tmp_path: Path) -> None:
     assert "already holds results: add --resume" in again.stderr
     bad = _sweep(tmp_path / "bad", seeds="5:2")
     assert bad.returncode == 2 and "gives no non-negative seed" in bad.stderr
+
+
+def test_an_episode_whose_worker_dies_is_retried_then_recorded(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import os
+
+    from openral_eval.sweep import run_pool
+
+    class Fatal:
+        required_slots: tuple[str, ...] = ()
+
+        def act(self, obs: policies.Observation) -> object:
+            os._exit(3)  # the worker process dies, as on a segfault
+
+    monkeypatch.setitem(
+        policies.POLICIES, "fatal", policies.PolicyEntry(policies.WaveConfig, lambda c: Fatal())
+    )
+    specs = [
+        EpisodeSpec(SCENE, 0, "fatal", (), 5),
+        EpisodeSpec(SCENE, 1, "wave", (("required_slots", ""),), 5),
+    ]
+    results: list[object] = []
+    run_pool(specs, 2, results.append)
+    by_seed = {r.seed: r for r in results}  # type: ignore[attr-defined]
+    assert set(by_seed) == {0, 1}
+    assert by_seed[0].error == "its worker process died, every time it ran"
+    assert by_seed[1].error is None and by_seed[1].steps == 5  # the other episode still ran

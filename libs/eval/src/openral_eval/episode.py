@@ -77,6 +77,13 @@ class EpisodeResult:
     trajectory_sha256: str
     video: str | None = None
 
+    @classmethod
+    def unfinished(cls, spec: EpisodeSpec, why: str) -> EpisodeResult:
+        """The result of an episode that never finished (its worker died)."""
+        return cls(
+            spec.scene, spec.seed, spec.policy, dict(spec.params), False, 0, 0.0, 0.0, why, ""
+        )
+
 
 _SCENES: dict[str, tuple[SimRollout, LoadedRobot]] = {}
 """This process's scenes by file, built on first use."""

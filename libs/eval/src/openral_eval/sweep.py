@@ -53,7 +53,7 @@ def run_pool(specs: Sequence[EpisodeSpec], workers: int, on_result: OnResult) ->
         pending = _pool_pass(pending, workers, on_result)
         attempts += 1
     for spec in pending:
-        on_result(_died(spec, "its worker process died, every time it ran"))
+        on_result(EpisodeResult.unfinished(spec, "its worker process died, every time it ran"))
 
 
 def _pool_pass(specs: list[EpisodeSpec], workers: int, on_result: OnResult) -> list[EpisodeSpec]:
@@ -117,23 +117,8 @@ def run_ray(specs: Sequence[EpisodeSpec], address: str, workers: int, on_result:
                 try:
                     on_result(ray.get(ref))
                 except RayError as error:
-                    on_result(_died(spec, f"Ray gave up on it: {type(error).__name__}"))
+                    on_result(
+                        EpisodeResult.unfinished(spec, f"Ray gave up on it: {type(error).__name__}")
+                    )
     finally:
         ray.shutdown()
-
-
-def _died(spec: EpisodeSpec, why: str) -> EpisodeResult:
-    """The result of an episode that never finished."""
-    return EpisodeResult(
-        scene=spec.scene,
-        seed=spec.seed,
-        policy=spec.policy,
-        params=dict(spec.params),
-        success=False,
-        steps=0,
-        sim_time_s=0.0,
-        wall_time_s=0.0,
-        error=why,
-        trajectory_sha256="",
-        video=None,
-    )
