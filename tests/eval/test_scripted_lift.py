@@ -64,3 +64,20 @@ def test_the_ros_runner_refuses_it_with_one_line() -> None:
     assert "reads the simulation itself (privileged state)" in str(
         result.exception or result.output
     )
+
+
+def test_the_gripper_holds_the_lifted_cube() -> None:
+    from openral_core.models import GripperHolds
+    from openral_eval.episode import scene_for
+    from openral_sim.native_scene import NativeScene
+    from openral_sim.success import SuccessCheck
+
+    result = run_episode(EpisodeSpec(SCENE, 3, "scripted_lift", (), 300))
+    assert result.success
+    env, _ = scene_for(SCENE)
+    assert isinstance(env, NativeScene)
+    fingers = [int(a) for g in env.addresses.grippers for a in g.finger_qpos]
+    holds = SuccessCheck(
+        [GripperHolds(kind="gripper_holds", object="red_cube")], env.model, fingers
+    )
+    assert holds.update(env.data, 0.05)  # both fingers touch the cube it lifted

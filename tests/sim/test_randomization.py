@@ -129,3 +129,38 @@ def test_an_unknown_object_is_located_with_the_closest_name(tmp_path: Path) -> N
     assert "no object 'red_cub' in scene.options.objects" in message
     assert "(did you mean red_cube?)" in message
     assert math.isfinite(len(message))
+
+
+def test_lights_cameras_and_joint_noise_follow_the_seed(tmp_path: Path) -> None:
+    extra = (
+        "  light_intensity_scale: [0.5, 0.6]\n"
+        "  light_direction_deg: 20.0\n"
+        "  camera_position_m: 0.03\n"
+        "  camera_angle_deg: 5.0\n"
+        "  joint_noise: 0.05\n"
+    )
+    text = FRANKA.read_text().replace("randomization:\n", "randomization:\n" + extra)
+    folder = tmp_path / "robots" / "franka_panda" / "scenes"
+    folder.mkdir(parents=True)
+    (folder / "tabletop.yaml").write_text(text)
+    plain, jittered = scene(), scene(folder / "tabletop.yaml")
+    plain.reset(seed=4)
+    jittered.reset(seed=4)
+    model, base = jittered.model, plain.model
+    scale = model.light_diffuse / np.where(base.light_diffuse > 0, base.light_diffuse, 1.0)
+    lit = base.light_diffuse > 0
+    assert np.all((scale[lit] >= 0.5 - 1e-6) & (scale[lit] <= 0.6 + 1e-6))
+    tilt = np.degrees(np.arccos(np.clip(np.sum(model.light_dir * base.light_dir, axis=1), -1, 1)))
+    assert np.all(tilt <= 20.0 + 1e-4) and tilt.max() > 0.0
+    agentview = mujoco.mj_name2id(
+        model, mujoco.mjtObj.mjOBJ_CAMERA, jittered.camera_models["agentview"]
+    )
+    shift = np.abs(model.cam_pos[agentview] - base.cam_pos[agentview])
+    assert 0.0 < shift.max() <= 0.03 + 1e-9
+    arm = jittered.addresses.qpos[jittered.addresses.arm_slots]
+    noise = np.abs(jittered.data.qpos[arm] - plain.data.qpos[arm])
+    assert 0.0 < noise.max() <= 0.05 + 0.01  # the noise, plus what settling moved
+    again = scene(folder / "tabletop.yaml")
+    again.reset(seed=4)
+    assert np.array_equal(again.data.qpos, jittered.data.qpos)
+    assert np.array_equal(again.model.cam_quat, model.cam_quat)
