@@ -35,11 +35,11 @@ import numpy as np
 import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
 from openral_core.located import error_at
-from openral_core.models import DeployScene, NativeAssets
+from openral_core.models import DeployScene, NativeAssets, RobotDescription
 from openral_core.tables import HalWiring
 from openral_mujoco.errors import HalError
 from openral_mujoco.joint_driver import JointDriver
-from openral_mujoco.robot_addresses import locate_robot
+from openral_mujoco.robot_addresses import RobotAddresses, locate_robot
 from openral_mujoco.state import FloatArray, JointStateSample
 
 from openral_sim.base_drive import BASE_UPDATE_STEPS, BaseDrive
@@ -118,15 +118,25 @@ class NativeScene:
         changed at any time (the next observation follows it)."""
         self._renderer: mujoco.Renderer | None = None
         self._steps = 0
-        fixed = [
+        self._setup_episodes(scene, description, cameras, addresses)
+
+    def _setup_episodes(
+        self,
+        scene: DeployScene,
+        description: RobotDescription,
+        cameras: dict[str, str],
+        addresses: RobotAddresses,
+    ) -> None:
+        """The scene file's seeded randomisation and success predicates."""
+        self.addresses = addresses
+        """Where the robot's joints are in :attr:`model` (per manifest joint)."""
+        fixed = [  # the cameras the scene places (not on the robot, not the model's own)
             cameras[s.name]
             for s in description.sensors
             if s.name in cameras and s.mount_body is None and getattr(s, "camera", None) is None
         ]
         self.randomizer = Randomizer(scene, self.model, fixed)
         """The scene's seeded randomisation (:mod:`openral_sim.randomization`)."""
-        self.addresses = addresses
-        """Where the robot's joints are in :attr:`model` (per manifest joint)."""
         self._arm_qpos = addresses.qpos[addresses.arm_slots]
         fingers = [int(a) for g in addresses.grippers for a in g.finger_qpos]
         self.success = SuccessCheck(scene.success or [], self.model, fingers)
