@@ -62,8 +62,22 @@ def _bad(client: Client) -> dict[str, tuple[object, str]]:
     }
 
 
+def _still(client: Client) -> np.ndarray:
+    """Positions of the two joints once the arm has stopped settling (a fresh graph's arm
+    sags into its servos' grip for a second or two)."""
+
+    def resting() -> bool:
+        velocities = client.probe.latest(JOINT_STATES).velocity
+        return bool(np.abs(np.asarray(velocities)).max() < 1e-4)
+
+    deadline = time.monotonic() + 20.0
+    while not resting() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    return client.positions(client.probe.latest(JOINT_STATES))
+
+
 def test_each_bad_trajectory_is_refused_with_its_reason_and_moves_nothing(client: Client) -> None:
-    before = client.positions(client.probe.latest(JOINT_STATES))
+    before = _still(client)
     started = time.monotonic()
     for name, (msg, reason) in _bad(client).items():
         client.trajectory.publish(msg)
