@@ -10,8 +10,7 @@ the scene's ``control_freq_hz``) and each tick advances the scene by exactly one
   or because the E-stop latched before the tick), is counted in :attr:`superseded`, never
   applied and never silently lost;
 - with no new action, holding what is commanded (:meth:`Tickable.tick` with None: the targets
-  in force on a position-controlled scene, the backend's hold on a delta controller).
-
+  in force on a position-controlled scene, the backend's hold on a delta controller);
 - with no new action while a joint trajectory runs (:attr:`ControlLoop.follower`), gliding
   to the trajectory's point at the end of the period; an offered action pre-empts the
   trajectory, and a tick the E-stop keeps from stepping aborts it.
@@ -151,9 +150,7 @@ class ControlLoop:
             self._job = None
             pacer.cancel(job)
         with self._pending_lock:
-            if self._pending is not None:
-                self.superseded += 1
-                self._pending = None
+            self._drop_pending()
             reset, self._reset = self._reset, None
         if reset is not None:
             reset.error = "the control loop stopped before the reset"
@@ -183,9 +180,7 @@ class ControlLoop:
             raise ResetFailed("the control loop is not running")
         request = _ResetRequest()
         with self._pending_lock:
-            if self._pending is not None:
-                self.superseded += 1
-                self._pending = None
+            self._drop_pending()
             self._reset = request
         if not request.done.wait(timeout_s):
             with self._pending_lock:
@@ -276,6 +271,12 @@ class ControlLoop:
                 self.on_reset()
         finally:
             request.done.set()
+
+    def _drop_pending(self) -> None:
+        """Drop a waiting action, counted as superseded (holding ``_pending_lock``)."""
+        if self._pending is not None:
+            self.superseded += 1
+            self._pending = None
 
     def _abort_trajectory(self) -> None:
         if self.follower is not None and self.follower.cancel():

@@ -93,17 +93,17 @@ class ScriptedLift:
         position, quat = world.objects[self.config.object]
         if self._start is None:
             self._start = np.array(position, dtype=np.float64)
-        target, gripper = self._phase_target(np.asarray(position), world)
-        self._command[list(world.arm_slots)] += self._ik_step(world, target, np.asarray(quat))
+        hand = self._tcp(world)  # the kinematics of this step, computed once
+        target, gripper = self._phase_target(np.asarray(position), hand[0])
+        self._command[list(world.arm_slots)] += self._ik_step(world, hand, target, np.asarray(quat))
         self._command[names.index(self.config.gripper_slot)] = gripper
         return self._command.copy()
 
     # -- phases ----------------------------------------------------------------------------
 
-    def _phase_target(self, cube: FloatArray, world: Privileged) -> tuple[FloatArray, float]:
-        """Where the gripper's centre should go now, and the gripper command."""
+    def _phase_target(self, cube: FloatArray, tcp: FloatArray) -> tuple[FloatArray, float]:
+        """Where the gripper's centre (now at ``tcp``) should go, and the gripper command."""
         config = self.config
-        tcp = self._tcp(world)[0]
         above = cube + np.array([0.0, 0.0, config.approach_m])
         if self.phase == "approach":
             if np.linalg.norm(tcp - above) < REACHED_M:
@@ -133,10 +133,17 @@ class ScriptedLift:
         rotation = data.xmat[body].reshape(3, 3).copy()
         return data.xpos[body] + rotation[:, 2] * self.config.tcp_offset_m, rotation, body
 
-    def _ik_step(self, world: Privileged, target: FloatArray, cube_quat: FloatArray) -> FloatArray:
-        """Joint target increments for one control period towards ``target``."""
+    def _ik_step(
+        self,
+        world: Privileged,
+        hand: tuple[FloatArray, FloatArray, int],
+        target: FloatArray,
+        cube_quat: FloatArray,
+    ) -> FloatArray:
+        """Joint target increments for one control period towards ``target``, from the
+        ``hand`` that :meth:`_tcp` computed for this step."""
         model, data = world.model, world.data
-        tcp, rotation, body = self._tcp(world)
+        tcp, rotation, body = hand
         mujoco.mj_comPos(model, data)
         jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
         mujoco.mj_jac(model, data, jacp, jacr, tcp, body)

@@ -26,6 +26,7 @@ from openral_cli.console import out, progress
 
 if TYPE_CHECKING:
     from openral_eval.episode import EpisodeResult, EpisodeSpec
+    from openral_eval.results import EpisodeLog
 
 VIDEO_CHOICES = ("first", "failures", "all", "none")
 MAX_EPISODES = 100_000
@@ -151,17 +152,15 @@ def _run(
     total: int,
     workers: int,
     ray: str | None,
-    log: object,
+    log: EpisodeLog,
     video: str,
     out_dir: Path,
 ) -> None:
     """Run ``todo`` with a progress bar; every result is written as it arrives."""
     from dataclasses import replace
 
-    from openral_eval.results import EpisodeLog
     from openral_eval.sweep import run_pool, run_ray, run_serial
 
-    assert isinstance(log, EpisodeLog)
     with progress() as bar:
         task = bar.add_task("episodes", total=total, completed=already)
         wins = [0]
