@@ -188,3 +188,38 @@ def test_an_episode_whose_worker_dies_is_retried_then_recorded(
     assert set(by_seed) == {0, 1}
     assert by_seed[0].error == "its worker process died, every time it ran"
     assert by_seed[1].error is None and by_seed[1].steps == 5  # the other episode still ran
+
+
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+@pytest.mark.parametrize(
+    ("address", "expected"),
+    [
+        (f"127.0.0.1:{_free_port()}", "nothing answers (Connection refused)"),
+        ("no-port-here", "expected 'local', 'auto' or a cluster's HOST:PORT"),
+    ],
+)
+def test_a_ray_address_where_nothing_answers_is_one_line_at_once(
+    tmp_path: Path, address: str, expected: str
+) -> None:
+    started = time.monotonic()
+    result = _sweep(tmp_path / "out", "--ray", address, seeds="0:1")
+    assert result.returncode == 1
+    assert expected in result.stderr and "Traceback" not in result.stderr
+    assert time.monotonic() - started < 60  # Ray's own join retries for over ten minutes
+    assert not (tmp_path / "out" / "episodes.jsonl").exists()
+
+
+def test_run_wall_time_counts_the_episodes_not_the_start_up(tmp_path: Path) -> None:
+    started = time.monotonic()
+    assert _sweep(tmp_path, seeds="0:2").returncode == 0
+    command_s = time.monotonic() - started
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    episodes_s = sum(line["wall_time_s"] for line in _lines(tmp_path / "episodes.jsonl"))
+    assert episodes_s <= summary["run_wall_s"] < command_s

@@ -12,8 +12,9 @@ same (scene, seed, policy) gives the same result anywhere; only the wall times d
   in a new pool, at most :data:`RETRIES` times, then recorded with an error.
 - Ray (the optional ``ray`` extra): ``address`` ``local`` starts a Ray instance on this
   machine with ``workers`` CPUs; any other address joins that cluster (whose nodes must
-  have openral installed). Each episode is one task of one CPU, retried
-  :data:`RETRIES` times when its worker dies.
+  have openral installed; the head must accept a connection within
+  :data:`JOIN_TIMEOUT_S`). Each episode is one task of one CPU, retried :data:`RETRIES`
+  times when its worker dies. Ray's usage report is off (nothing leaves the machine).
 
 Every finished episode goes to ``on_result`` on this process's main thread, as soon as it
 ends, in whatever order episodes end.
@@ -23,9 +24,13 @@ from __future__ import annotations
 
 import logging
 import multiprocessing
-from collections.abc import Callable, Sequence
+import os
+import socket
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
+from types import ModuleType
 
 from openral_core.errors import OpenralError
 
@@ -87,27 +92,9 @@ def run_ray(specs: Sequence[EpisodeSpec], address: str, workers: int, on_result:
     Raises:
         SweepError: Ray is not installed, or the cluster at ``address`` cannot be joined.
     """
-    try:
-        import ray
+    with ray_session(address, workers) as ray:
         from ray.exceptions import RayError
-    except ImportError:
-        raise SweepError(
-            "--ray needs Ray: install openral with the 'ray' extra (pip install 'openral[ray]')"
-        ) from None
-    try:
-        # quiet: Ray's start-up lines would interleave with the sweep's own report
-        if address == "local":
-            ray.init(
-                num_cpus=workers,
-                include_dashboard=False,
-                log_to_driver=False,
-                logging_level=logging.ERROR,
-            )
-        else:
-            ray.init(address=address, log_to_driver=False, logging_level=logging.ERROR)
-    except (ConnectionError, RuntimeError, ValueError) as error:
-        raise SweepError(f"cannot start or join Ray at {address!r}: {error}") from None
-    try:
+
         task = ray.remote(num_cpus=1, max_retries=RETRIES)(run_episode)
         waiting = {task.remote(spec): spec for spec in specs}
         while waiting:
@@ -120,5 +107,70 @@ def run_ray(specs: Sequence[EpisodeSpec], address: str, workers: int, on_result:
                     on_result(
                         EpisodeResult.unfinished(spec, f"Ray gave up on it: {type(error).__name__}")
                     )
+
+
+@contextmanager
+def ray_session(address: str, workers: int) -> Iterator[ModuleType]:
+    """Ray for the block: a new local instance with ``workers`` CPUs (``address``
+    ``local``) or the cluster at ``address``; shut down (or left) after the block.
+
+    Raises:
+        SweepError: Ray is not installed, or the cluster at ``address`` cannot be joined.
+    """
+    try:
+        import ray
+    except ImportError:
+        raise SweepError(
+            "--ray needs Ray: install openral with the 'ray' extra (pip install 'openral[ray]')"
+        ) from None
+    os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")  # offline: no usage report
+    # quiet: Ray's start-up lines would interleave with the sweep's own report
+    try:
+        if address == "local":
+            ray.init(
+                num_cpus=workers,
+                include_dashboard=False,
+                log_to_driver=False,
+                logging_level=logging.ERROR,
+            )
+        else:
+            check_ray_address(address)
+            ray.init(address=address, log_to_driver=False, logging_level=logging.ERROR)
+    except (ConnectionError, RuntimeError, ValueError) as error:
+        raise SweepError(f"cannot start or join Ray at {address!r}: {error}") from None
+    try:
+        yield ray
     finally:
         ray.shutdown()
+
+
+JOIN_TIMEOUT_S = 5.0
+"""How long a cluster's head has to accept a TCP connection before ``--ray ADDRESS`` fails.
+
+Ray's own join keeps retrying for many minutes when nothing listens at the address."""
+
+
+def check_ray_address(address: str) -> None:
+    """Fail fast unless something accepts a connection at ``address`` (``[ray://]HOST:PORT``;
+    ``auto`` is left to Ray, which finds a local cluster or fails at once).
+
+    Raises:
+        SweepError: the address is malformed, or nothing answers within :data:`JOIN_TIMEOUT_S`.
+    """
+    if address == "auto":
+        return
+    host, _, port = address.removeprefix("ray://").rpartition(":")
+    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise SweepError(
+            f"--ray {address!r}: expected 'local', 'auto' or a cluster's HOST:PORT "
+            "(e.g. 10.0.0.5:6379)"
+        )
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=JOIN_TIMEOUT_S).close()
+    except TimeoutError:
+        raise SweepError(
+            f"cannot join Ray at {address!r}: nothing answers within {JOIN_TIMEOUT_S:g} s"
+        ) from None
+    except OSError as error:
+        reason = error.strerror or type(error).__name__
+        raise SweepError(f"cannot join Ray at {address!r}: nothing answers ({reason})") from None

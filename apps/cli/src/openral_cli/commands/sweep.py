@@ -88,6 +88,7 @@ def sweep(
     success rate with its 95 % Wilson interval."""
     from openral_eval.policies import make_policy, parse_params
     from openral_eval.results import EpisodeLog
+    from openral_eval.sweep import check_ray_address
 
     if video not in VIDEO_CHOICES:
         raise typer.BadParameter(
@@ -96,7 +97,9 @@ def sweep(
     pairs = tuple(sorted(parse_params(params or []).items()))
     make_policy(policy, dict(pairs))  # a bad name or parameter stops here, before any episode
     for path in config:
-        _check_scene(path)
+        _build_scene(path)
+    if ray not in (None, "local"):
+        check_ray_address(ray)  # before the results file is touched
     plan = _plan(config, parse_seeds(seeds), policy, pairs, steps, video, out_dir)
     log = EpisodeLog(out_dir / "episodes.jsonl")
     if log.path.exists() and log.path.stat().st_size and not resume:
@@ -109,17 +112,18 @@ def sweep(
     todo = [spec for spec in plan if spec.key not in done]
     count = workers or os.cpu_count() or 1
     started = time.perf_counter()
-    _run(todo, len(plan) - len(todo), len(plan), count, ray, log, video, out_dir)
-    run_s = time.perf_counter() - started
+    last_written = _run(todo, len(plan) - len(todo), len(plan), count, ray, log, video, out_dir)
+    run_s = (last_written or time.perf_counter()) - started
     _report(log.sort(plan), policy, out_dir, run_s)
 
 
-def _check_scene(path: Path) -> None:
-    """Load the scene file now, so a bad one is one located error before any episode."""
-    from openral_core.loader import load_scene
-    from openral_sim.scene import scene_robot
+def _build_scene(path: Path) -> None:
+    """Load and build the scene now, before the sweep's clock starts: a bad file is one
+    located error before any episode, and episodes run in this process or in workers
+    forked from it find the scene built (Ray's workers build their own)."""
+    from openral_eval.episode import scene_for
 
-    scene_robot(load_scene(path))
+    scene_for(str(path))
 
 
 def _plan(
@@ -155,8 +159,9 @@ def _run(
     log: EpisodeLog,
     video: str,
     out_dir: Path,
-) -> None:
-    """Run ``todo`` with a progress bar; every result is written as it arrives."""
+) -> float | None:
+    """Run ``todo`` with a progress bar; every result is written as it arrives. Returns
+    when (``time.perf_counter``) the last one was written, None if none was."""
     from dataclasses import replace
 
     from openral_eval.sweep import run_pool, run_ray, run_serial
@@ -164,6 +169,7 @@ def _run(
     with progress() as bar:
         task = bar.add_task("episodes", total=total, completed=already)
         wins = [0]
+        last_written: list[float | None] = [None]
 
         def record(result: EpisodeResult) -> None:
             if video == "failures" and result.success and result.video:
@@ -172,6 +178,7 @@ def _run(
             if result.video:  # as the directory's own path, whichever --out named it
                 result = replace(result, video=str(Path(result.video).relative_to(out_dir)))
             log.append(result)
+            last_written[0] = time.perf_counter()
             wins[0] += int(result.success)
             bar.update(task, advance=1, description=f"episodes · {wins[0]} succeeded")
 
@@ -181,11 +188,13 @@ def _run(
             run_serial(todo, record)
         else:
             run_pool(todo, min(workers, len(todo)), record)
+    return last_written[0]
 
 
 def _report(lines: list[dict[str, object]], policy: str, out_dir: Path, run_s: float) -> None:
-    """The per-scene table, ``summary.json`` (with ``run_wall_s``: the episodes' wall time,
-    workers' start included) and where everything is."""
+    """The per-scene table, ``summary.json`` (with ``run_wall_s``: from the first episode
+    handed out to the last result written: the workers' start counts, their shutdown not)
+    and where everything is."""
     from openral_eval.summary import summarise, summary_json
     from rich.table import Table
 
