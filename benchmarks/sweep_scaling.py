@@ -9,7 +9,7 @@ last result written, so the pool's forks and Ray's start-up count, the command's
 - ``cameras``: ``wave`` observing its two camera slots, 200 steps, seeds 0:40 (two frames
   rendered per step, as a VLA observes: ~6 s per episode, ~2 minutes on two cores);
 - ``lift``: ``scripted_lift`` over seeds 0:20 (the issue's sweep; ~60 steps,
-  about a second on two cores; ~60–90 ms an episode).
+  about a second on two cores; ~60-90 ms an episode).
 
 The same run also times Ray's fixed cost alone: a Ray session that starts, runs one empty
 task per CPU and ends, as ``openral sim sweep --ray`` starts it. A sweep shorter than a
