@@ -15,12 +15,13 @@ import signal
 import subprocess
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 from openral_cli.optional_values import with_optional_values
 from openral_eval import policies
-from openral_eval.episode import EpisodeSpec, run_episode
+from openral_eval.episode import EpisodeResult, EpisodeSpec, run_episode
 from openral_eval.results import EpisodeLog
 from openral_eval.summary import wilson
 
@@ -74,20 +75,45 @@ def _sweep(out: Path, *extra: str, seeds: str = "0:4") -> subprocess.CompletedPr
     return subprocess.run(command, capture_output=True, text=True, timeout=600)
 
 
-def test_serial_pool_and_ray_write_the_same_file(tmp_path: Path) -> None:
-    runs = {
-        "serial": ("--workers", "1"),
-        "pool": ("--workers", "2"),
-        "ray": ("--workers", "2", "--ray"),
-    }
-    for name, extra in runs.items():
-        result = _sweep(tmp_path / name, *extra)
-        assert result.returncode == 0, result.stderr
+HEAD = """
+import sys, ray
+ray.init(num_cpus=2, include_dashboard=False)
+print(ray.get_runtime_context().gcs_address, flush=True)
+sys.stdin.read()
+ray.shutdown()
+"""
+"""A Ray cluster of one node, as another program on this machine would run it: the sweep
+joins it by address; it stops when its stdin closes."""
+
+
+def test_serial_pool_ray_and_a_joined_ray_cluster_write_the_same_file(tmp_path: Path) -> None:
+    head = subprocess.Popen(
+        [sys.executable, "-c", HEAD], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+    )
+    try:
+        assert head.stdout is not None
+        address = head.stdout.readline().strip()
+        runs = {
+            "serial": ("--workers", "1"),
+            "pool": ("--workers", "2"),
+            "ray": ("--workers", "2", "--ray"),
+            "joined": ("--ray", address),
+        }
+        for name, extra in runs.items():
+            result = _sweep(tmp_path / name, *extra)
+            assert result.returncode == 0, result.stderr
+    finally:
+        head.communicate("", timeout=60)
     serial = _without_wall_time(tmp_path / "serial" / "episodes.jsonl")
     assert [line["seed"] for line in serial] == [0, 1, 2, 3]
     assert all(line["trajectory_sha256"] and line["error"] is None for line in serial)
-    for name in ("pool", "ray"):
+    for name in ("pool", "ray", "joined"):
         assert _without_wall_time(tmp_path / name / "episodes.jsonl") == serial, name
+        times = json.loads((tmp_path / name / "summary.json").read_text())
+        assert times["startup_s"] + times["episodes_wall_s"] == pytest.approx(
+            times["run_wall_s"], abs=2e-3
+        )
+        assert times["startup_s"] > 0.0 and times["episodes_wall_s"] > 0.0
 
 
 def test_a_cut_off_line_is_dropped_and_resume_keeps_every_written_line(tmp_path: Path) -> None:
@@ -137,8 +163,14 @@ def test_a_killed_sweep_resumed_runs_every_episode_once(tmp_path: Path) -> None:
         not log.exists() or len(log.read_text().splitlines()) < 4
     ) and time.monotonic() < deadline:
         time.sleep(0.02)
+    workers = _children(process.pid)
+    assert len(workers) == 2
     process.send_signal(signal.SIGKILL)
     process.wait()
+    gone = time.monotonic() + 1.0  # the workers die with the sweep, not after their episode
+    while any(_alive(pid) for pid in workers) and time.monotonic() < gone:
+        time.sleep(0.02)
+    assert not any(_alive(pid) for pid in workers)
     before = log.read_text().splitlines()
     assert 4 <= len(before) < 12, "kill the sweep half-way"
     again = subprocess.run(
@@ -153,6 +185,21 @@ def test_a_killed_sweep_resumed_runs_every_episode_once(tmp_path: Path) -> None:
     assert summary["scenes"][0]["episodes"] == 12
 
 
+def _children(pid: int) -> list[int]:
+    """The process ids of ``pid``'s children (Linux)."""
+    text = Path(f"/proc/{pid}/task/{pid}/children").read_text()
+    return [int(child) for child in text.split()]
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` still runs (a zombie that nobody has reaped yet does not)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[0]
+    except (FileNotFoundError, IndexError):
+        return False
+    return state not in ("Z", "X")
+
+
 def test_results_already_there_need_resume(tmp_path: Path) -> None:
     assert _sweep(tmp_path, seeds="0:1").returncode == 0
     again = _sweep(tmp_path, seeds="0:1")
@@ -160,34 +207,6 @@ def test_results_already_there_need_resume(tmp_path: Path) -> None:
     assert "already holds results: add --resume" in again.stderr
     bad = _sweep(tmp_path / "bad", seeds="5:2")
     assert bad.returncode == 2 and "gives no non-negative seed" in bad.stderr
-
-
-def test_an_episode_whose_worker_dies_is_retried_then_recorded(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    import os
-
-    from openral_eval.sweep import run_pool
-
-    class Fatal:
-        required_slots: tuple[str, ...] = ()
-
-        def act(self, obs: policies.Observation) -> object:
-            os._exit(3)  # the worker process dies, as on a segfault
-
-    monkeypatch.setitem(
-        policies.POLICIES, "fatal", policies.PolicyEntry(policies.WaveConfig, lambda c: Fatal())
-    )
-    specs = [
-        EpisodeSpec(SCENE, 0, "fatal", (), 5),
-        EpisodeSpec(SCENE, 1, "wave", (("required_slots", ""),), 5),
-    ]
-    results: list[object] = []
-    run_pool(specs, 2, results.append)
-    by_seed = {r.seed: r for r in results}  # type: ignore[attr-defined]
-    assert set(by_seed) == {0, 1}
-    assert by_seed[0].error == "its worker process died, every time it ran"
-    assert by_seed[1].error is None and by_seed[1].steps == 5  # the other episode still ran
 
 
 def _free_port() -> int:
@@ -218,8 +237,45 @@ def test_a_ray_address_where_nothing_answers_is_one_line_at_once(
 
 def test_run_wall_time_counts_the_episodes_not_the_start_up(tmp_path: Path) -> None:
     started = time.monotonic()
-    assert _sweep(tmp_path, seeds="0:2").returncode == 0
+    assert _sweep(tmp_path, "--workers", "1", seeds="0:2").returncode == 0
     command_s = time.monotonic() - started
     summary = json.loads((tmp_path / "summary.json").read_text())
     episodes_s = sum(line["wall_time_s"] for line in _lines(tmp_path / "episodes.jsonl"))
-    assert episodes_s <= summary["run_wall_s"] < command_s
+    assert episodes_s <= summary["episodes_wall_s"] <= summary["run_wall_s"] < command_s
+
+
+@pytest.mark.parametrize(
+    ("where", "gave_up"),
+    [
+        ("pool", "its worker process died, every time it ran"),
+        ("ray", "Ray gave up on it: WorkerCrashedError"),
+    ],
+)
+def test_a_dead_worker_costs_only_its_episode_which_is_retried_then_recorded(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, where: str, gave_up: str
+) -> None:
+    import os
+
+    from openral_eval import sweep
+
+    marker = tmp_path / "seed0-died-once"
+
+    def dying(spec: EpisodeSpec) -> EpisodeResult:  # forked, or pickled by value into Ray
+        if spec.seed == 1 or (spec.seed == 0 and not marker.exists()):
+            marker.touch()
+            os._exit(3)  # the worker process dies, as on a segfault
+        return run_episode(spec)
+
+    monkeypatch.setattr(sweep, "run_episode", dying)
+    specs = [EpisodeSpec(SCENE, seed, "wave", (("required_slots", ""),), 5) for seed in range(4)]
+    results: list[EpisodeResult] = []
+    if where == "pool":
+        sweep.run_pool(specs, 2, results.append)
+    else:
+        sweep.run_ray(specs, "local", 2, results.append)
+    by_seed = {result.seed: replace(result, wall_time_s=0.0) for result in results}
+    assert sorted(by_seed) == [0, 1, 2, 3]  # each exactly once
+    assert by_seed[0] == replace(run_episode(specs[0]), wall_time_s=0.0)  # the retry ran it
+    assert by_seed[1].error == gave_up
+    for seed in (2, 3):  # running beside the dying ones, never lost with them
+        assert by_seed[seed] == replace(run_episode(specs[seed]), wall_time_s=0.0)

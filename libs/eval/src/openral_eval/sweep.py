@@ -8,93 +8,86 @@ same (scene, seed, policy) gives the same result anywhere; only the wall times d
   of the sweep is built here (so a worker starts in milliseconds with the scenes ready,
   instead of importing and composing for a second or more). Nothing in this process has
   rendered (no GL context is inherited): each worker renders offscreen on its own. A
-  worker that dies takes the pool with it: the episodes it had not finished are run again
-  in a new pool, at most :data:`RETRIES` times, then recorded with an error.
-- Ray (the optional ``ray`` extra): ``address`` ``local`` starts a Ray instance on this
-  machine with ``workers`` CPUs; any other address joins that cluster (whose nodes must
-  have openral installed; the head must accept a connection within
-  :data:`JOIN_TIMEOUT_S`). Each episode is one task of one CPU, retried :data:`RETRIES`
-  times when its worker dies. Ray's usage report is off (nothing leaves the machine).
+  worker that dies costs only the episode it was running, which runs again in a new
+  worker, at most :data:`RETRIES` times, then is recorded with an error
+  (:mod:`openral_eval.fork_pool`).
+- Ray (the optional ``ray`` extra; :mod:`openral_eval.ray_session`): ``address``
+  ``local`` starts a Ray instance on this machine with ``workers`` CPUs; any other address
+  joins that cluster. Each episode is one task of one CPU, retried :data:`RETRIES` times
+  when its worker dies.
 
 Every finished episode goes to ``on_result`` on this process's main thread, as soon as it
-ends, in whatever order episodes end.
+ends, in whatever order episodes end. ``on_ready`` is called once, when every worker is up
+with the sweep's scenes built (at once in this process; after the forks for the pool; after
+Ray has started and one warm-up task per CPU has built the scenes): what comes before it is
+start-up, a fixed cost; what comes after it is the episodes.
 """
 
 from __future__ import annotations
 
-import logging
-import multiprocessing
-import os
-import socket
-from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from concurrent.futures.process import BrokenProcessPool
-from contextlib import contextmanager
+from collections.abc import Callable, Sequence
 from types import ModuleType
 
-from openral_core.errors import OpenralError
-
 from openral_eval.episode import EpisodeResult, EpisodeSpec, run_episode, scene_for
+from openral_eval.fork_pool import ForkPool
+from openral_eval.ray_session import ray_session
 
 RETRIES = 2
 """Extra attempts of an episode whose worker process died."""
 OnResult = Callable[[EpisodeResult], None]
+OnReady = Callable[[], None]
 
 
-class SweepError(OpenralError):
-    """A sweep could not start (Ray missing or unreachable)."""
+def _nothing() -> None:
+    """The default ``on_ready``."""
 
 
-def run_serial(specs: Sequence[EpisodeSpec], on_result: OnResult) -> None:
+def run_serial(
+    specs: Sequence[EpisodeSpec], on_result: OnResult, on_ready: OnReady = _nothing
+) -> None:
     """Every episode in this process, in order."""
+    build_scenes(sorted({spec.scene for spec in specs}))
+    on_ready()
     for spec in specs:
         on_result(run_episode(spec))
 
 
-def run_pool(specs: Sequence[EpisodeSpec], workers: int, on_result: OnResult) -> None:
-    """Every episode in a pool of ``workers`` processes (see the module doc)."""
-    pending, attempts = list(specs), 0
-    while pending and attempts <= RETRIES:
-        pending = _pool_pass(pending, workers, on_result)
-        attempts += 1
-    for spec in pending:
-        on_result(EpisodeResult.unfinished(spec, "its worker process died, every time it ran"))
+def run_pool(
+    specs: Sequence[EpisodeSpec],
+    workers: int,
+    on_result: OnResult,
+    on_ready: OnReady = _nothing,
+) -> None:
+    """Every episode in a :class:`~openral_eval.fork_pool.ForkPool` of ``workers``
+    processes forked once the scenes are built here (see the module doc)."""
+    build_scenes(sorted({spec.scene for spec in specs}))  # before the forks: inherited
+    with ForkPool(run_episode, workers, RETRIES) as pool:
+        on_ready()
+        pool.run(specs, on_result, _died)
 
 
-def _pool_pass(specs: list[EpisodeSpec], workers: int, on_result: OnResult) -> list[EpisodeSpec]:
-    """Run ``specs`` in one pool; returns those whose worker died with the pool."""
-    for path in sorted({spec.scene for spec in specs}):
-        scene_for(path)  # built before the fork: every worker inherits it
-    context = multiprocessing.get_context("fork")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
-        running: dict[Future[EpisodeResult], EpisodeSpec] = {}
-        queue = list(reversed(specs))
-        broken: list[EpisodeSpec] = []
-        while queue or running:
-            while queue and len(running) < 2 * workers:  # a little ahead, never all at once
-                spec = queue.pop()
-                running[pool.submit(run_episode, spec)] = spec
-            finished, _ = wait(running, return_when=FIRST_COMPLETED)
-            for future in finished:
-                spec = running.pop(future)
-                try:
-                    on_result(future.result())
-                except BrokenProcessPool:
-                    broken.append(spec)
-            if broken:
-                return broken + [running[f] for f in running] + list(reversed(queue))
-    return []
+def _died(spec: EpisodeSpec) -> EpisodeResult:
+    return EpisodeResult.unfinished(spec, "its worker process died, every time it ran")
 
 
-def run_ray(specs: Sequence[EpisodeSpec], address: str, workers: int, on_result: OnResult) -> None:
+def run_ray(
+    specs: Sequence[EpisodeSpec],
+    address: str,
+    workers: int,
+    on_result: OnResult,
+    on_ready: OnReady = _nothing,
+) -> None:
     """Every episode as a Ray task (see the module doc).
 
     Raises:
-        SweepError: Ray is not installed, or the cluster at ``address`` cannot be joined.
+        openral_eval.ray_session.SweepError: Ray is not installed, or the cluster at
+            ``address`` cannot be joined.
     """
     with ray_session(address, workers) as ray:
         from ray.exceptions import RayError
 
+        _warm_up(ray, sorted({spec.scene for spec in specs}), len(specs))
+        on_ready()
         task = ray.remote(num_cpus=1, max_retries=RETRIES)(run_episode)
         waiting = {task.remote(spec): spec for spec in specs}
         while waiting:
@@ -109,68 +102,25 @@ def run_ray(specs: Sequence[EpisodeSpec], address: str, workers: int, on_result:
                     )
 
 
-@contextmanager
-def ray_session(address: str, workers: int) -> Iterator[ModuleType]:
-    """Ray for the block: a new local instance with ``workers`` CPUs (``address``
-    ``local``) or the cluster at ``address``; shut down (or left) after the block.
+def build_scenes(paths: Sequence[str]) -> None:
+    """Build every scene of ``paths`` in this process (:func:`scene_for`), leaving one that
+    fails to the episodes, which record its error."""
+    for path in paths:
+        try:
+            scene_for(path)
+        except Exception:  # every episode of that scene will say why
+            continue
 
-    Raises:
-        SweepError: Ray is not installed, or the cluster at ``address`` cannot be joined.
-    """
+
+def _warm_up(ray: ModuleType, paths: list[str], episodes: int) -> None:
+    """One task per CPU of the cluster (at most one per episode), each building the scenes
+    in its worker, all at once so that each lands in a worker of its own; the episodes
+    that follow reuse those workers. A worker that dies here is the episodes' concern."""
+    from ray.exceptions import RayError
+
+    cpus = int(ray.cluster_resources().get("CPU", 1))
+    warm = ray.remote(num_cpus=1)(build_scenes)
     try:
-        import ray
-    except ImportError:
-        raise SweepError(
-            "--ray needs Ray: install openral with the 'ray' extra (pip install 'openral[ray]')"
-        ) from None
-    os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")  # offline: no usage report
-    # quiet: Ray's start-up lines would interleave with the sweep's own report
-    try:
-        if address == "local":
-            ray.init(
-                num_cpus=workers,
-                include_dashboard=False,
-                log_to_driver=False,
-                logging_level=logging.ERROR,
-            )
-        else:
-            check_ray_address(address)
-            ray.init(address=address, log_to_driver=False, logging_level=logging.ERROR)
-    except (ConnectionError, RuntimeError, ValueError) as error:
-        raise SweepError(f"cannot start or join Ray at {address!r}: {error}") from None
-    try:
-        yield ray
-    finally:
-        ray.shutdown()
-
-
-JOIN_TIMEOUT_S = 5.0
-"""How long a cluster's head has to accept a TCP connection before ``--ray ADDRESS`` fails.
-
-Ray's own join keeps retrying for many minutes when nothing listens at the address."""
-
-
-def check_ray_address(address: str) -> None:
-    """Fail fast unless something accepts a connection at ``address`` (``[ray://]HOST:PORT``;
-    ``auto`` is left to Ray, which finds a local cluster or fails at once).
-
-    Raises:
-        SweepError: the address is malformed, or nothing answers within :data:`JOIN_TIMEOUT_S`.
-    """
-    if address == "auto":
+        ray.get([warm.remote(paths) for _ in range(max(1, min(cpus, episodes)))])
+    except RayError:
         return
-    host, _, port = address.removeprefix("ray://").rpartition(":")
-    if not host or not port.isdigit() or not 0 < int(port) < 65536:
-        raise SweepError(
-            f"--ray {address!r}: expected 'local', 'auto' or a cluster's HOST:PORT "
-            "(e.g. 10.0.0.5:6379)"
-        )
-    try:
-        socket.create_connection((host.strip("[]"), int(port)), timeout=JOIN_TIMEOUT_S).close()
-    except TimeoutError:
-        raise SweepError(
-            f"cannot join Ray at {address!r}: nothing answers within {JOIN_TIMEOUT_S:g} s"
-        ) from None
-    except OSError as error:
-        reason = error.strerror or type(error).__name__
-        raise SweepError(f"cannot join Ray at {address!r}: nothing answers ({reason})") from None

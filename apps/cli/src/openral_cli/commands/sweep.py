@@ -87,8 +87,8 @@ def sweep(
     sim, in parallel; write ``episodes.jsonl`` and ``summary.json`` and print each scene's
     success rate with its 95 % Wilson interval."""
     from openral_eval.policies import make_policy, parse_params
+    from openral_eval.ray_session import check_ray_address
     from openral_eval.results import EpisodeLog
-    from openral_eval.sweep import check_ray_address
 
     if video not in VIDEO_CHOICES:
         raise typer.BadParameter(
@@ -111,10 +111,39 @@ def sweep(
     done = log.done()
     todo = [spec for spec in plan if spec.key not in done]
     count = workers or os.cpu_count() or 1
-    started = time.perf_counter()
-    last_written = _run(todo, len(plan) - len(todo), len(plan), count, ray, log, video, out_dir)
-    run_s = (last_written or time.perf_counter()) - started
-    _report(log.sort(plan), policy, out_dir, run_s)
+    clock = SweepClock()
+    _run(todo, len(plan) - len(todo), len(plan), count, ray, log, video, out_dir, clock)
+    _report(log.sort(plan), policy, out_dir, clock)
+
+
+class SweepClock:
+    """When (``time.perf_counter``) a sweep started handing out episodes, when its workers
+    were ready, and when its last result was written [s]."""
+
+    def __init__(self) -> None:
+        self.started = time.perf_counter()
+        self.ready: float | None = None
+        self.last_written: float | None = None
+
+    def start(self) -> None:
+        self.started = time.perf_counter()
+
+    def mark_ready(self) -> None:
+        self.ready = time.perf_counter()
+
+    def mark_written(self) -> None:
+        self.last_written = time.perf_counter()
+
+    def times(self) -> dict[str, float]:
+        """``run_wall_s`` (start to last result), split into ``startup_s`` (start to ready)
+        and ``episodes_wall_s`` (ready to last result), in seconds."""
+        end = self.last_written or time.perf_counter()
+        ready = min(self.ready or self.started, end)
+        return {
+            "run_wall_s": round(end - self.started, 3),
+            "startup_s": round(ready - self.started, 3),
+            "episodes_wall_s": round(end - ready, 3),
+        }
 
 
 def _build_scene(path: Path) -> None:
@@ -159,9 +188,10 @@ def _run(
     log: EpisodeLog,
     video: str,
     out_dir: Path,
-) -> float | None:
-    """Run ``todo`` with a progress bar; every result is written as it arrives. Returns
-    when (``time.perf_counter``) the last one was written, None if none was."""
+    clock: SweepClock,
+) -> None:
+    """Run ``todo`` with a progress bar; every result is written as it arrives (and
+    ``clock`` marks when the workers were ready and when the last result was written)."""
     from dataclasses import replace
 
     from openral_eval.sweep import run_pool, run_ray, run_serial
@@ -169,7 +199,6 @@ def _run(
     with progress() as bar:
         task = bar.add_task("episodes", total=total, completed=already)
         wins = [0]
-        last_written: list[float | None] = [None]
 
         def record(result: EpisodeResult) -> None:
             if video == "failures" and result.success and result.video:
@@ -178,28 +207,27 @@ def _run(
             if result.video:  # as the directory's own path, whichever --out named it
                 result = replace(result, video=str(Path(result.video).relative_to(out_dir)))
             log.append(result)
-            last_written[0] = time.perf_counter()
+            clock.mark_written()
             wins[0] += int(result.success)
             bar.update(task, advance=1, description=f"episodes · {wins[0]} succeeded")
 
+        clock.start()
         if ray is not None:
-            run_ray(todo, ray, workers, record)
+            run_ray(todo, ray, workers, record, clock.mark_ready)
         elif workers == 1 or len(todo) <= 1:
-            run_serial(todo, record)
+            run_serial(todo, record, clock.mark_ready)
         else:
-            run_pool(todo, min(workers, len(todo)), record)
-    return last_written[0]
+            run_pool(todo, min(workers, len(todo)), record, clock.mark_ready)
 
 
-def _report(lines: list[dict[str, object]], policy: str, out_dir: Path, run_s: float) -> None:
-    """The per-scene table, ``summary.json`` (with ``run_wall_s``: from the first episode
-    handed out to the last result written: the workers' start counts, their shutdown not)
-    and where everything is."""
+def _report(lines: list[dict[str, object]], policy: str, out_dir: Path, clock: SweepClock) -> None:
+    """The per-scene table, ``summary.json`` (with the :meth:`SweepClock.times`: the
+    workers' start counts in ``run_wall_s``, their shutdown not) and where everything is."""
     from openral_eval.summary import summarise, summary_json
     from rich.table import Table
 
     rows = summarise(lines)
-    summary = {**summary_json(rows, policy), "run_wall_s": round(run_s, 3)}
+    summary = {**summary_json(rows, policy), **clock.times()}
     (out_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
     table = Table(title=f"{policy}: success rate per scene (95 % Wilson interval)")
     for column in ("scene", "episodes", "success", "rate", "95 % interval", "mean steps", "errors"):

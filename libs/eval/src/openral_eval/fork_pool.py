@@ -1,0 +1,140 @@
+"""A pool of forked worker processes in which a dead worker costs only its own episode.
+
+The standard library's process pools break as a whole when one worker dies (every
+episode in flight is lost with it, so an innocent episode sharing a pool with one that
+crashes its process would be recorded as dead too). Here each worker has a pipe of its
+own and runs one episode at a time:
+
+- a worker that dies (its pipe closes) is replaced by a new fork, and only the episode it
+  was running is tried again, at most ``retries`` times, then recorded with an error;
+- workers are forked from this process, so they inherit whatever it has built (the
+  sweep's scenes) and start in milliseconds; they ignore Ctrl-C (this process decides
+  when they stop) and are killed when this process dies, even by ``SIGKILL``.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import multiprocessing
+import signal
+from collections import deque
+from collections.abc import Callable, Sequence
+from contextlib import suppress
+from dataclasses import dataclass, field
+from multiprocessing.connection import Connection, wait
+from multiprocessing.process import BaseProcess
+
+from openral_eval.episode import EpisodeResult, EpisodeSpec
+
+Run = Callable[[EpisodeSpec], EpisodeResult]
+_PR_SET_PDEATHSIG = 1
+
+
+@dataclass
+class _Worker:
+    process: BaseProcess
+    pipe: Connection
+    spec: EpisodeSpec | None = field(default=None)
+
+
+def _serve(run: Run, pipe: Connection, inherited: Sequence[Connection]) -> None:
+    """A worker's loop: receive a spec, send its result; stop at ``None`` or a closed pipe."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    with suppress(AttributeError, OSError):  # Linux: die with the parent, not finish an
+        ctypes.CDLL(None).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)  # episode nobody reads
+    for other in inherited:  # the parent's ends, so that a parent's death closes our pipe
+        other.close()
+    try:
+        while (spec := pipe.recv()) is not None:
+            pipe.send(run(spec))
+    except (EOFError, BrokenPipeError):
+        return
+
+
+class ForkPool:
+    """``workers`` forked processes running ``run`` on one spec each at a time."""
+
+    def __init__(self, run: Run, workers: int, retries: int) -> None:
+        if workers < 1:
+            raise ValueError(f"a pool needs at least one worker, not {workers}")
+        self._run, self._retries = run, retries
+        self._context = multiprocessing.get_context("fork")
+        self._workers: list[_Worker] = []
+        for _ in range(workers):
+            self._workers.append(self._fork())
+
+    def _fork(self) -> _Worker:
+        mine, theirs = self._context.Pipe()
+        inherited = [mine, *(worker.pipe for worker in self._workers)]
+        process = self._context.Process(
+            target=_serve, args=(self._run, theirs, inherited), daemon=True
+        )
+        process.start()
+        theirs.close()
+        return _Worker(process, mine)
+
+    def run(
+        self,
+        specs: Sequence[EpisodeSpec],
+        on_result: Callable[[EpisodeResult], None],
+        died: Callable[[EpisodeSpec], EpisodeResult],
+    ) -> None:
+        """Every spec, each result to ``on_result`` as it arrives; a spec whose worker died
+        more than ``retries`` times gets ``died(spec)`` instead."""
+        queue, attempts = deque(specs), dict.fromkeys(specs, 0)
+        while queue or any(worker.spec for worker in self._workers):
+            for worker in self._workers:
+                if worker.spec is None and queue:
+                    worker.spec = queue.popleft()
+                    with suppress(OSError):  # it died idle: its death is found below
+                        worker.pipe.send(worker.spec)
+            busy = [worker for worker in self._workers if worker.spec is not None]
+            wait([worker.pipe for worker in busy])
+            for worker in busy:
+                if not worker.pipe.poll():
+                    continue
+                try:
+                    result = worker.pipe.recv()
+                except (EOFError, OSError):  # the worker died mid-episode
+                    self._replace(worker, queue, attempts, on_result, died)
+                    continue
+                worker.spec = None
+                on_result(result)
+
+    def _replace(
+        self,
+        worker: _Worker,
+        queue: deque[EpisodeSpec],
+        attempts: dict[EpisodeSpec, int],
+        on_result: Callable[[EpisodeResult], None],
+        died: Callable[[EpisodeSpec], EpisodeResult],
+    ) -> None:
+        """Fork a new worker in the dead one's place; try its episode again or give it up."""
+        spec = worker.spec
+        assert spec is not None
+        worker.pipe.close()
+        worker.process.join()
+        self._workers[self._workers.index(worker)] = self._fork()
+        attempts[spec] += 1
+        if attempts[spec] > self._retries:
+            on_result(died(spec))
+        else:
+            queue.appendleft(spec)
+
+    def __enter__(self) -> ForkPool:
+        return self
+
+    def __exit__(self, *_: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Stop every worker (a worker still busy is killed)."""
+        for worker in self._workers:
+            with suppress(OSError):
+                worker.pipe.send(None)
+            worker.pipe.close()
+        for worker in self._workers:
+            worker.process.join(timeout=5.0)
+            if worker.process.is_alive():
+                worker.process.kill()
+                worker.process.join()
