@@ -81,7 +81,7 @@ bench-camera *ARGS:
 bench-realtime *ARGS:
     python -m benchmarks.real_time {{ARGS}}
 
-# Sweep scaling: the franka tabletop sweep with --workers 1, --workers 2 and --ray (2 CPUs), wall times, speed-ups, identical results; writes benchmarks/results/sweep_scaling.json.
+# Sweep scaling: the franka tabletop sweeps with --workers 1, --workers 2 and --ray (2 CPUs): start-up, episodes and end-to-end times, speed-ups, identical results; writes benchmarks/results/sweep_scaling.json.
 bench-sweep *ARGS:
     python -m benchmarks.sweep_scaling {{ARGS}}
 
