@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import json
+import re
 import signal
 import subprocess
 import sys
@@ -151,12 +152,18 @@ def test_an_episode_that_raises_is_recorded_and_the_sweep_goes_on(
     )
 
 
-def test_a_killed_sweep_resumed_runs_every_episode_once(tmp_path: Path) -> None:
+@pytest.mark.parametrize("stop", [signal.SIGKILL, signal.SIGINT], ids=["SIGKILL", "SIGINT"])
+def test_a_killed_sweep_resumed_runs_every_episode_once(
+    tmp_path: Path, stop: signal.Signals
+) -> None:
     out = tmp_path / "killed"
     command = [str(OPENRAL), *SWEEP, "--seeds", "0:12", "--workers", "2", "--video", "none"]
     command[command.index("--steps") + 1] = "1500"  # long enough episodes to kill half-way
     process = subprocess.Popen(
-        [*command, "--out", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+        [*command, "--out", str(out)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
     )
     log = out / "episodes.jsonl"
     deadline = time.monotonic() + 300
@@ -166,12 +173,16 @@ def test_a_killed_sweep_resumed_runs_every_episode_once(tmp_path: Path) -> None:
         time.sleep(0.02)
     workers = _children(process.pid)
     assert len(workers) == 2
-    process.send_signal(signal.SIGKILL)
-    process.wait()
+    process.send_signal(stop)
+    _, stderr = process.communicate(timeout=60)
     gone = time.monotonic() + 1.0  # the workers die with the sweep, not after their episode
     while any(_alive(pid) for pid in workers) and time.monotonic() < gone:
         time.sleep(0.02)
     assert not any(_alive(pid) for pid in workers)
+    if stop == signal.SIGINT:  # one line, no traceback, the conventional status
+        assert process.returncode == 130
+        assert "Traceback" not in stderr
+        assert re.search(r"interrupted: \d+ of 12 episodes are in .*--resume runs the rest", stderr)
     before = log.read_text().splitlines()
     assert 4 <= len(before) < 12, "kill the sweep half-way"
     again = subprocess.run(

@@ -51,6 +51,14 @@ def _serve(run: Run, pipe: Connection, inherited: Sequence[Connection]) -> None:
         return
 
 
+def _hand_out(worker: _Worker, queue: deque[EpisodeSpec]) -> None:
+    """Give an idle worker the next episode, if there is one."""
+    if worker.spec is None and queue:
+        worker.spec = queue.popleft()
+        with suppress(OSError):  # it died idle: its death is found when its pipe is read
+            worker.pipe.send(worker.spec)
+
+
 class ForkPool:
     """``workers`` forked processes running ``run`` on one spec each at a time."""
 
@@ -84,10 +92,7 @@ class ForkPool:
         queue, attempts = deque(specs), dict.fromkeys(specs, 0)
         while queue or any(worker.spec for worker in self._workers):
             for worker in self._workers:
-                if worker.spec is None and queue:
-                    worker.spec = queue.popleft()
-                    with suppress(OSError):  # it died idle: its death is found below
-                        worker.pipe.send(worker.spec)
+                _hand_out(worker, queue)
             busy = [worker for worker in self._workers if worker.spec is not None]
             wait([worker.pipe for worker in busy])
             for worker in busy:
@@ -99,6 +104,7 @@ class ForkPool:
                     self._replace(worker, queue, attempts, on_result, died)
                     continue
                 worker.spec = None
+                _hand_out(worker, queue)  # its next episode first, then the bookkeeping
                 on_result(result)
 
     def _replace(
@@ -128,8 +134,11 @@ class ForkPool:
         self.close()
 
     def close(self) -> None:
-        """Stop every worker (a worker still busy is killed)."""
+        """Stop every worker: an idle one when it reads the end, a busy one (the sweep was
+        interrupted) at once."""
         for worker in self._workers:
+            if worker.spec is not None:
+                worker.process.kill()
             with suppress(OSError):
                 worker.pipe.send(None)
             worker.pipe.close()

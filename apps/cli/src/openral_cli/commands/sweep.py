@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 from openral_core.errors import OpenralError
 
-from openral_cli.console import out, progress
+from openral_cli.console import err, out, progress
 
 if TYPE_CHECKING:
     from openral_eval.episode import EpisodeResult, EpisodeSpec
@@ -112,7 +112,16 @@ def sweep(
     todo = [spec for spec in plan if spec.key not in done]
     count = workers or os.cpu_count() or 1
     clock = SweepClock()
-    _run(todo, len(plan) - len(todo), len(plan), count, ray, log, video, out_dir, clock)
+    try:
+        _run(todo, len(plan) - len(todo), len(plan), count, ray, log, video, out_dir, clock)
+    except KeyboardInterrupt:
+        written = len(log.done())
+        err.print(
+            f"interrupted: {written} of {len(plan)} episodes are in {log.path}; the same "
+            "command with --resume runs the rest",
+            markup=False,
+        )
+        raise typer.Exit(130) from None
     _report(log.sort(plan), policy, out_dir, clock)
 
 
