@@ -1,12 +1,13 @@
 """Sweep scaling on this machine: one process, a pool of two, and Ray with two CPUs.
 
-Each workload runs as ``openral sim sweep`` three times (``--workers 1``, ``--workers 2``,
-``--workers 2 --ray``) on the franka tabletop without videos. Two times are compared, both
-the sweep's own (``summary.json``):
+Each workload runs as ``openral sim sweep`` four ways (``--workers 1``, ``--workers 2``,
+``--workers 2 --ray``, and ``--ray ADDRESS`` joining a Ray instance of 2 CPUs started
+beforehand) on the franka tabletop without videos. Two times are compared, both the
+sweep's own (``summary.json``):
 
 - ``run_wall_s``, end to end: from the first episode handed out to the last result
   written, so the pool's forks and Ray's start-up count; the command's imports and scene
-  build (the same for all three) and the workers' shutdown do not;
+  build (the same for every run) and the workers' shutdown do not;
 - ``episodes_wall_s``, the episodes alone: from the moment every worker is up with the
   scenes built (``startup_s`` after the start) to the last result written.
 
@@ -23,7 +24,7 @@ few times that cannot be within 15 % on Ray, whatever the episodes.
 
 Targets: ``--workers 2`` ≥ 1.7 x ``--workers 1`` on 2 cores, end to end; Ray within 15 %
 of ``--workers 2`` on the episodes, and end to end on a sweep that runs minutes
-(``cameras``). The three ``episodes.jsonl`` of a workload must be identical but for wall
+(``cameras``). The four ``episodes.jsonl`` of a workload must be identical but for wall
 times. Run with ``just bench-sweep`` (``--workload lift`` for the quick one).
 """
 
@@ -37,6 +38,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+from contextlib import nullcontext
 from pathlib import Path
 
 os.environ.setdefault("MUJOCO_GL", "egl")
@@ -45,6 +47,7 @@ from openral_core.paths import repo_root
 from rich.console import Console
 from rich.table import Table
 
+from benchmarks.ray_head import ray_head
 from benchmarks.results_file import write_results
 
 SCENE = "robots/franka_panda/scenes/tabletop.yaml"
@@ -67,7 +70,10 @@ RUNS = {
     "workers 1": ("--workers", "1"),
     "workers 2": ("--workers", "2"),
     "ray": ("--workers", "2", "--ray"),
+    "ray joined": ("--ray", "ADDRESS"),
 }
+"""``ray joined``: a Ray instance of 2 CPUs already running on this machine (started before
+the sweep, its start not counted), joined by its address, as a cluster would be."""
 POOL_TARGET, RAY_TARGET = 1.7, 0.15
 
 
@@ -81,7 +87,10 @@ def timed(workload: str, run: str, seeds: str, out: Path) -> tuple[Times, list[d
     command = [str(Path(sys.executable).parent / "openral"), "sim", "sweep", "--config", SCENE]
     command += ["--seeds", seeds, "--video", "none", "--out", str(folder)]
     command += [*WORKLOADS[workload], *RUNS[run]]
-    done = subprocess.run(command, capture_output=True, text=True, cwd=repo_root(), check=False)
+    with ray_head(2) if "ADDRESS" in command else nullcontext() as head:
+        if head is not None:
+            command[command.index("ADDRESS")] = head.address
+        done = subprocess.run(command, capture_output=True, text=True, cwd=repo_root(), check=False)
     if done.returncode != 0:
         raise SystemExit(f"{workload} / {run} failed:\n{done.stderr}")
     summary = json.loads((folder / "summary.json").read_text())
@@ -121,8 +130,12 @@ def measure(workload: str, seeds: str, ray_s: float, console: Console) -> dict[s
     episodes = len(files["workers 1"])
     console.print(_table(workload, seeds, episodes, times, ray_s))
     speedup = times["workers 1"]["run_wall_s"] / times["workers 2"]["run_wall_s"]
-    over = {key: times["ray"][key] / times["workers 2"][key] - 1.0 for key in PHASES}
-    identical = files["workers 1"] == files["workers 2"] == files["ray"]
+    over = {
+        f"{ray}, {name}": times[ray][key] / times["workers 2"][key] - 1.0
+        for ray in ("ray", "ray joined")
+        for key, name in PHASES.items()
+    }
+    identical = all(lines == files["workers 1"] for lines in files.values())
     console.print(_verdict(speedup, over, ray_s / times["workers 2"]["run_wall_s"], identical))
     return {
         "seeds": seeds,
@@ -173,15 +186,15 @@ def _verdict(speedup: float, over: dict[str, float], share: float, identical: bo
         f"workers 2 / workers 1: {speedup:.2f}x ({met[speedup >= POOL_TARGET]}: >= "
         f"{POOL_TARGET}); files identical: {identical}"
     )
-    for key, name in PHASES.items():
+    for what, ratio in over.items():
         line += (
-            f"\nRay vs workers 2, {name}: {over[key]:+.0%} "
-            f"({met[over[key] <= RAY_TARGET]}: within {RAY_TARGET:.0%})"
+            f"\n{what} vs workers 2: {ratio:+.0%} "
+            f"({met[ratio <= RAY_TARGET]}: within {RAY_TARGET:.0%})"
         )
     if share > RAY_TARGET:
         line += (
             f"\nRay's start-up alone is {share:.0%} of this sweep on the pool: end to end, "
-            "Ray cannot be within the margin on it, whatever its episodes."
+            "a new Ray instance cannot be within the margin on it, whatever its episodes."
         )
     return line
 

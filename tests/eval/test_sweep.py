@@ -26,6 +26,7 @@ from openral_eval.episode import EpisodeResult, EpisodeSpec, run_episode
 from openral_eval.results import EpisodeLog
 from openral_eval.summary import wilson
 
+from benchmarks.ray_head import ray_head
 from tests.conftest import ROBOTS
 
 SCENE = str(ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml")
@@ -76,22 +77,8 @@ def _sweep(out: Path, *extra: str, seeds: str = "0:4") -> subprocess.CompletedPr
     return subprocess.run(command, capture_output=True, text=True, timeout=600)
 
 
-HEAD = """
-import sys, ray
-ray.init(num_cpus=2, include_dashboard=False)
-print(ray.get_runtime_context().gcs_address, flush=True)
-sys.stdin.read()
-ray.shutdown()
-"""
-"""A Ray cluster of one node, as another program on this machine would run it: the sweep
-joins it by address; it stops when its stdin closes."""
-
-
 def test_serial_pool_ray_and_a_joined_ray_cluster_write_the_same_file(tmp_path: Path) -> None:
-    head = subprocess.Popen(
-        [sys.executable, "-c", HEAD], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
-    )
-    try:
+    with ray_head(2) as head:  # it starts while the local sweeps run
         runs = {
             "serial": ("--workers", "1"),
             "pool": ("--workers", "2"),
@@ -99,13 +86,9 @@ def test_serial_pool_ray_and_a_joined_ray_cluster_write_the_same_file(tmp_path: 
             "joined": ("--ray", "ADDRESS"),
         }
         for name, extra in runs.items():
-            if name == "joined":  # the head started meanwhile
-                assert head.stdout is not None
-                extra = ("--ray", head.stdout.readline().strip())
-            result = _sweep(tmp_path / name, *extra)
+            args = [head.address if arg == "ADDRESS" else arg for arg in extra]
+            result = _sweep(tmp_path / name, *args)
             assert result.returncode == 0, result.stderr
-    finally:
-        head.communicate("", timeout=60)
     serial = _without_wall_time(tmp_path / "serial" / "episodes.jsonl")
     assert [line["seed"] for line in serial] == [0, 1, 2, 3]
     assert all(line["trajectory_sha256"] and line["error"] is None for line in serial)
