@@ -88,7 +88,6 @@ def sweep(
     success rate with its 95 % Wilson interval."""
     from openral_eval.policies import make_policy, parse_params
     from openral_eval.ray_session import check_ray_address
-    from openral_eval.results import EpisodeLog
 
     if video not in VIDEO_CHOICES:
         raise typer.BadParameter(
@@ -101,13 +100,7 @@ def sweep(
     if ray not in (None, "local"):
         check_ray_address(ray)  # before the results file is touched
     plan = _plan(config, parse_seeds(seeds), policy, pairs, steps, video, out_dir)
-    log = EpisodeLog(out_dir / "episodes.jsonl")
-    if log.path.exists() and log.path.stat().st_size and not resume:
-        raise OpenralError(
-            f"{log.path} already holds results: add --resume to finish that sweep, or "
-            "choose another --out"
-        )
-    log.start(resume=resume)
+    log = _open_log(out_dir / "episodes.jsonl", resume=resume)
     done = log.done()
     todo = [spec for spec in plan if spec.key not in done]
     count = workers or os.cpu_count() or 1
@@ -115,14 +108,28 @@ def sweep(
     try:
         _run(todo, len(plan) - len(todo), len(plan), count, ray, log, video, out_dir, clock)
     except KeyboardInterrupt:
-        written = len(log.done())
         err.print(
-            f"interrupted: {written} of {len(plan)} episodes are in {log.path}; the same "
-            "command with --resume runs the rest",
+            f"interrupted: {len(log.done())} of {len(plan)} episodes are in {log.path}; the "
+            "same command with --resume runs the rest",
             markup=False,
         )
         raise typer.Exit(130) from None
     _report(log.sort(plan), policy, out_dir, clock)
+
+
+def _open_log(path: Path, *, resume: bool) -> EpisodeLog:
+    """The results file, started (kept whole with ``resume``; refused if it holds results
+    and ``resume`` is not given)."""
+    from openral_eval.results import EpisodeLog
+
+    log = EpisodeLog(path)
+    if log.path.exists() and log.path.stat().st_size and not resume:
+        raise OpenralError(
+            f"{log.path} already holds results: add --resume to finish that sweep, or "
+            "choose another --out"
+        )
+    log.start(resume=resume)
+    return log
 
 
 class SweepClock:
