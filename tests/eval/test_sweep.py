@@ -16,6 +16,7 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
 
@@ -26,7 +27,7 @@ from openral_eval.episode import EpisodeResult, EpisodeSpec, run_episode
 from openral_eval.results import EpisodeLog
 from openral_eval.summary import wilson
 
-from benchmarks.ray_head import ray_head
+from benchmarks.ray_head import RayHead, ray_head
 from tests.conftest import ROBOTS
 
 SCENE = str(ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml")
@@ -77,18 +78,27 @@ def _sweep(out: Path, *extra: str, seeds: str = "0:4") -> subprocess.CompletedPr
     return subprocess.run(command, capture_output=True, text=True, timeout=600)
 
 
-def test_serial_pool_ray_and_a_joined_ray_cluster_write_the_same_file(tmp_path: Path) -> None:
-    with ray_head(2) as head:  # it starts while the local sweeps run
-        runs = {
-            "serial": ("--workers", "1"),
-            "pool": ("--workers", "2"),
-            "ray": ("--workers", "2", "--ray"),
-            "joined": ("--ray", "ADDRESS"),
-        }
-        for name, extra in runs.items():
-            args = [head.address if arg == "ADDRESS" else arg for arg in extra]
-            result = _sweep(tmp_path / name, *args)
-            assert result.returncode == 0, result.stderr
+@pytest.fixture(scope="module")
+def cluster() -> Iterator[RayHead]:
+    """A running Ray instance of 2 CPUs that tests join by address (it starts while the
+    first test using it runs its local sweeps)."""
+    with ray_head(2) as head:
+        yield head
+
+
+def test_serial_pool_ray_and_a_joined_ray_cluster_write_the_same_file(
+    tmp_path: Path, cluster: RayHead
+) -> None:
+    runs = {
+        "serial": ("--workers", "1"),
+        "pool": ("--workers", "2"),
+        "ray": ("--workers", "2", "--ray"),
+        "joined": ("--ray", "ADDRESS"),
+    }
+    for name, extra in runs.items():
+        args = [cluster.address if arg == "ADDRESS" else arg for arg in extra]
+        result = _sweep(tmp_path / name, *args)
+        assert result.returncode == 0, result.stderr
     serial = _without_wall_time(tmp_path / "serial" / "episodes.jsonl")
     assert [line["seed"] for line in serial] == [0, 1, 2, 3]
     assert all(line["trajectory_sha256"] and line["error"] is None for line in serial)
@@ -247,7 +257,11 @@ def test_run_wall_time_counts_the_episodes_not_the_start_up(tmp_path: Path) -> N
     ],
 )
 def test_a_dead_worker_costs_only_its_episode_which_is_retried_then_recorded(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, where: str, gave_up: str
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    cluster: RayHead,
+    where: str,
+    gave_up: str,
 ) -> None:
     import os
 
@@ -267,7 +281,8 @@ def test_a_dead_worker_costs_only_its_episode_which_is_retried_then_recorded(
     if where == "pool":
         sweep.run_pool(specs, 2, results.append)
     else:
-        sweep.run_ray(specs, "local", 2, results.append)
+        monkeypatch.delenv("RAY_AUTH_MODE", raising=False)  # the join may set it
+        sweep.run_ray(specs, cluster.address, 2, results.append)
     by_seed = {result.seed: replace(result, wall_time_s=0.0) for result in results}
     assert sorted(by_seed) == [0, 1, 2, 3]  # each exactly once
     assert by_seed[0] == replace(run_episode(specs[0]), wall_time_s=0.0)  # the retry ran it
