@@ -8,7 +8,7 @@ import sys
 import time
 from pathlib import Path
 
-from tests.eval.test_sweep import _alive, _children
+from tests.eval.processes import alive, children
 
 DRIVER = """
 import time
@@ -30,15 +30,15 @@ def test_workers_busy_with_an_episode_die_with_a_killed_sweep() -> None:
     )
     try:
         assert driver.stdout is not None and driver.stdout.readline().strip() == "forked"
-        workers = _children(driver.pid)
-        assert len(workers) == 2 and all(_alive(pid) for pid in workers)
+        workers = children(driver.pid)
+        assert len(workers) == 2 and all(alive(pid) for pid in workers)
         time.sleep(0.2)  # both are inside their episode
         driver.send_signal(signal.SIGKILL)
         driver.wait(timeout=30)
         gone = time.monotonic() + 2.0
-        while any(_alive(pid) for pid in workers) and time.monotonic() < gone:
+        while any(alive(pid) for pid in workers) and time.monotonic() < gone:
             time.sleep(0.02)
-        assert not any(_alive(pid) for pid in workers)
+        assert not any(alive(pid) for pid in workers)
     finally:
         driver.kill()
         driver.wait()

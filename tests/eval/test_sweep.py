@@ -29,6 +29,7 @@ from openral_eval.summary import wilson
 
 from benchmarks.ray_head import RayHead, ray_head
 from tests.conftest import ROBOTS
+from tests.eval.processes import alive, children
 
 SCENE = str(ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml")
 OPENRAL = Path(sys.executable).parent / "openral"
@@ -164,14 +165,14 @@ def test_a_killed_sweep_resumed_runs_every_episode_once(
         not log.exists() or len(log.read_text().splitlines()) < 3
     ) and time.monotonic() < deadline:
         time.sleep(0.02)
-    workers = _children(process.pid)
+    workers = children(process.pid)
     assert len(workers) == 2
     process.send_signal(stop)
     _, stderr = process.communicate(timeout=60)
     gone = time.monotonic() + 1.0  # the workers die with the sweep, not after their episode
-    while any(_alive(pid) for pid in workers) and time.monotonic() < gone:
+    while any(alive(pid) for pid in workers) and time.monotonic() < gone:
         time.sleep(0.02)
-    assert not any(_alive(pid) for pid in workers)
+    assert not any(alive(pid) for pid in workers)
     if stop == signal.SIGINT:  # one line, no traceback, the conventional status
         assert process.returncode == 130
         assert "Traceback" not in stderr
@@ -188,21 +189,6 @@ def test_a_killed_sweep_resumed_runs_every_episode_once(
     assert set(before) <= set(after)  # every line written before the kill, byte for byte
     summary = json.loads((out / "summary.json").read_text())
     assert summary["scenes"][0]["episodes"] == 8
-
-
-def _children(pid: int) -> list[int]:
-    """The process ids of ``pid``'s children (Linux)."""
-    text = Path(f"/proc/{pid}/task/{pid}/children").read_text()
-    return [int(child) for child in text.split()]
-
-
-def _alive(pid: int) -> bool:
-    """Whether process ``pid`` still runs (a zombie that nobody has reaped yet does not)."""
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[0]
-    except (FileNotFoundError, IndexError):
-        return False
-    return state not in ("Z", "X")
 
 
 def test_results_already_there_need_resume(tmp_path: Path) -> None:

@@ -20,7 +20,7 @@ import signal
 from collections import deque
 from collections.abc import Callable, Sequence
 from contextlib import suppress
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 from multiprocessing.process import BaseProcess
 
@@ -34,7 +34,7 @@ _PR_SET_PDEATHSIG = 1
 class _Worker:
     process: BaseProcess
     pipe: Connection
-    spec: EpisodeSpec | None = field(default=None)
+    spec: EpisodeSpec | None = None
 
 
 def _serve(run: Run, pipe: Connection, inherited: Sequence[Connection]) -> None:

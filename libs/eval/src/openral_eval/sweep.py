@@ -46,7 +46,7 @@ def run_serial(
     specs: Sequence[EpisodeSpec], on_result: OnResult, on_ready: OnReady = _nothing
 ) -> None:
     """Every episode in this process, in order."""
-    build_scenes(sorted({spec.scene for spec in specs}))
+    build_scenes(_scene_paths(specs))
     on_ready()
     for spec in specs:
         on_result(run_episode(spec))
@@ -60,7 +60,7 @@ def run_pool(
 ) -> None:
     """Every episode in a :class:`~openral_eval.fork_pool.ForkPool` of ``workers``
     processes forked once the scenes are built here (see the module doc)."""
-    build_scenes(sorted({spec.scene for spec in specs}))  # before the forks: inherited
+    build_scenes(_scene_paths(specs))  # before the forks: inherited
     with ForkPool(run_episode, workers, RETRIES) as pool:
         on_ready()
         pool.run(specs, on_result, _died)
@@ -86,7 +86,7 @@ def run_ray(
     with ray_session(address, workers) as ray:
         from ray.exceptions import RayError
 
-        _warm_up(ray, sorted({spec.scene for spec in specs}), len(specs))
+        _warm_up(ray, _scene_paths(specs), len(specs))
         on_ready()
         task = ray.remote(num_cpus=1, max_retries=RETRIES)(run_episode)
         waiting = {task.remote(spec): spec for spec in specs}
@@ -100,6 +100,11 @@ def run_ray(
                     on_result(
                         EpisodeResult.unfinished(spec, f"Ray gave up on it: {type(error).__name__}")
                     )
+
+
+def _scene_paths(specs: Sequence[EpisodeSpec]) -> list[str]:
+    """The sweep's scene files, each once, sorted."""
+    return sorted({spec.scene for spec in specs})
 
 
 def build_scenes(paths: Sequence[str]) -> None:

@@ -137,9 +137,9 @@ class SweepClock:
     were ready, and when its last result was written [s]."""
 
     def __init__(self) -> None:
-        self.started = time.perf_counter()
         self.ready: float | None = None
         self.last_written: float | None = None
+        self.start()
 
     def start(self) -> None:
         self.started = time.perf_counter()
