@@ -27,10 +27,11 @@ import pytest
 from openral_core import open_robot
 from openral_core.loader import load_scene
 from openral_core.models import Backend, RobotDescription
+from openral_mujoco.robot_bodies import robot_bodies
 from openral_sim.camera_framing import FRAME_MARGIN, WORK_RANGE_M, fit_view
 from openral_sim.native_scene import NativeScene
 from openral_sim.scene_cameras import FORWARD_LOOKING
-from openral_sim.scene_geometry import geom_corners, robot_bodies
+from openral_sim.scene_geometry import geom_corners
 
 from tests.conftest import ROBOTS
 

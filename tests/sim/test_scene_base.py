@@ -18,9 +18,9 @@ from openral_core.models import LidarSensor
 from openral_mujoco.mjcf_confinement import ALLOW_OUTSIDE_ENV
 from openral_mujoco.mjcf_uri import resolve_mjcf_uri
 from openral_mujoco.model_cache import CACHE_ENV
+from openral_mujoco.robot_bodies import robot_bodies, root_body
 from openral_sim.lidar_scan import LidarScanner
 from openral_sim.native_scene import NativeScene
-from openral_sim.scene_geometry import robot_bodies, root_body
 
 from tests.conftest import ROBOTS
 

@@ -617,6 +617,51 @@ class DriveAxes(OpenralModel):
     """
 
 
+class Frames(OpenralModel):
+    """
+    The frames of `/tf` that are not bodies of the model. Every body of the robot is a frame named as in its MJCF; these name the fixed frame of the simulated world and the robot's base frame, the root of its URDF and the frame depth clouds are given in. A robot with a `mobile_base` names its base frame there (`mobile_base.base_frame`, beside `odom_frame`), not here.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    world: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")] = (
+        "world"
+    )
+    """
+    The fixed frame of the simulated world (MuJoCo's world frame): the parent of the base frame (or of the odometry frame) and of cameras fixed in the scene.
+    """
+    base: Annotated[
+        StrictStr,
+        Field(examples=["base_link"], pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$"),
+    ] = "base_link"
+    """
+    The robot's base frame, at its root body (the world's child that carries its first joint), turning and moving with it. It must not be the name of another body of the model; it may be the root body's own name (then that body is the base frame).
+    """
+
+
+class TrajectoryRules(OpenralModel):
+    """
+    How a joint trajectory starts and when it has succeeded, as ros2_control's joint_trajectory_controller decides it with its `constraints` parameters. A client's own tolerances (FollowJointTrajectory goal) take precedence over `goal_time_s` and `stopped_velocity_tolerance`.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    start_tolerance: Annotated[StrictFloat, Field(gt=0.0, le=1.0)] = 0.05
+    """
+    A trajectory whose first point (at time 0) is not where the joints are commanded is joined from where they are measured, if every joint is within this distance of it [rad or m]; farther, it is refused. Covers an arm that sags under gravity below its target, so a plan that starts where the arm is is never refused for it.
+    """
+    goal_time_s: Annotated[StrictFloat, Field(ge=0.0, le=600.0)] = 1.0
+    """
+    How long after a trajectory's last point the joints may take to come within the goal tolerance before the goal is aborted (GOAL_TOLERANCE_VIOLATED) [s], when the goal gives no `goal_time_tolerance`. 0: no limit (a goal tolerance that is never met keeps the goal running).
+    """
+    stopped_velocity_tolerance: Annotated[StrictFloat, Field(ge=0.0, le=10.0)] = 0.01
+    """
+    Largest joint speed at which a joint counts as stopped at the goal [rad/s or m/s], when the goal gives no velocity tolerance. 0: not checked.
+    """
+
+
 class MobileBase(OpenralModel):
     """
     A wheeled base the robot rides on: driven by planar velocity commands (cmd_vel) and reporting odometry. It sits on the robot, not inside `sim`, because its kind, limits, command timeout and frame names are facts about the robot that a real base driver and the ROS graph share; its MJCF fields tell a native scene how to build it: the base's own model, with the robot's model (`sim.mjcf_uri`) attached to `mount_body`, whose joint addresses keep their meaning in the robot's model. Needs `base: mobile`.
@@ -782,6 +827,14 @@ class RobotDescription(OpenralModel):
     mobile_base: MobileBase | None = None
     """
     The wheeled base the robot rides on (only with `base: mobile`); see MobileBase.
+    """
+    frames: Frames | None = None
+    """
+    Names of the ROS frames the graph adds to the model's bodies (see Frames). Absent: `world` and `base_link`.
+    """
+    trajectory: TrajectoryRules | None = None
+    """
+    How joint trajectories (the FollowJointTrajectory action and `/openral/joint_trajectory`) are joined and judged for this robot (see TrajectoryRules). Absent: every default.
     """
     sim: sim_schema.SimDescription | None = None
     """

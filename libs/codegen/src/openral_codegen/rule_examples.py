@@ -109,6 +109,20 @@ RULE_BREAKS = (
         "- name: agentview\n    kind: rgb\n    mount_position_m: [1.0, 0.0, 1.0]\n",
     ),
     RuleBreak(
+        SchemaName.ROBOT,
+        14,
+        MOBILE_FILE,
+        "base: mobile\n",
+        "base: mobile\nframes: {base: base_footprint}\n",
+    ),
+    RuleBreak(
+        SchemaName.ROBOT,
+        15,
+        ROBOT_FILE,
+        "frame_id: ft_sensor_link",
+        "frame_id: wrist_optical_frame",
+    ),
+    RuleBreak(
         SchemaName.SCENE,
         1,
         SCENE_FILE,

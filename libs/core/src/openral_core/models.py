@@ -13,6 +13,7 @@ from openral_generated.models.robot_schema import (
     DriveAxes,
     DriveKind,
     ForceTorqueSensor,
+    Frames,
     ImuSensor,
     LidarSensor,
     LimitedJoint,
@@ -20,6 +21,7 @@ from openral_generated.models.robot_schema import (
     PoseSensor,
     RgbSensor,
     RobotDescription,
+    TrajectoryRules,
 )
 from openral_generated.models.scene_schema import (
     Backend,
@@ -69,6 +71,7 @@ __all__ = [
     "DriveAxes",
     "DriveKind",
     "ForceTorqueSensor",
+    "Frames",
     "GripperHolds",
     "GripperReadMode",
     "GripperWriteMode",
@@ -99,4 +102,5 @@ __all__ = [
     "StateSensor",
     "SuccessPredicate",
     "TorquePdControl",
+    "TrajectoryRules",
 ]

@@ -20,7 +20,7 @@ from openral_core.models import (
     Shape,
     TorquePdControl,
 )
-from openral_core.tables import vla_slot
+from openral_core.tables import frame_names, vla_slot
 from openral_core.yaml_source import PathKey, format_field
 
 Finding = tuple[PathKey, str]
@@ -55,6 +55,7 @@ def robot_findings(robot: RobotDescription, folder_name: str | None) -> list[Fin
         *_sim_findings(robot),
         *_base_findings(robot),
         *_mount_findings(robot),
+        *_frame_findings(robot),
     ]
 
 
@@ -159,6 +160,26 @@ def _mount_findings(robot: RobotDescription) -> Iterator[Finding]:
                 ("sensors", index, "mount_position_m"),
                 "mount_position_m is a position on mount_body; name the mount_body",
             )
+
+
+def _frame_findings(robot: RobotDescription) -> Iterator[Finding]:
+    """Rules 14 and 15: a mobile robot's base frame is named by its mobile_base, and the
+    frames the graph adds (world, odometry, base, every sensor's frame_id) are distinct."""
+    frames = robot.frames
+    if robot.mobile_base is not None and frames is not None and "base" in frames.model_fields_set:
+        yield (
+            ("frames", "base"),
+            "a robot with a mobile_base names its base frame in mobile_base.base_frame",
+        )
+    names = frame_names(robot)
+    located: list[tuple[PathKey, str]] = [(("frames", "world"), names.world)]
+    if robot.mobile_base is not None:
+        located.append((("mobile_base", "odom_frame"), robot.mobile_base.odom_frame))
+        located.append((("mobile_base", "base_frame"), names.base))
+    else:
+        located.append((("frames", "base"), names.base))
+    located += [(("sensors", i, "frame_id"), s.frame_id) for i, s in enumerate(robot.sensors)]
+    yield from _unique(located, "frame")
 
 
 def _sim_findings(robot: RobotDescription) -> Iterator[Finding]:

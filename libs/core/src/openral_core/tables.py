@@ -13,6 +13,8 @@ tables computed in memory by :func:`robot_tables`):
 * **Joint-name map** — canonical joint name → MJCF joint name.
 * **Mobile-base wiring** — a wheeled base's model, mount, drive joints and actuators,
   limits and frames (None for a robot without ``mobile_base``).
+* **Frame names** — the world, base and odometry frames the ROS graph adds to the model's
+  bodies.
 
 Each file also records its origin: the manifest's path and the SHA-256 of the validated
 manifest's canonical JSON (:func:`manifest_sha256`), so a table made from an earlier
@@ -29,6 +31,7 @@ from typing import Any
 
 from openral_core.located import source_file
 from openral_core.models import (
+    Frames,
     MobileBase,
     RgbSensor,
     RobotDescription,
@@ -121,6 +124,18 @@ class MobileBaseWiring:
 
 
 @dataclass(frozen=True)
+class FrameNames:
+    """The TF frames that are not bodies of the model (see Frames and MobileBase)."""
+
+    world: str
+    """The simulated world's fixed frame."""
+    base: str
+    """The robot's base frame (a mobile base's ``base_frame``, else ``frames.base``)."""
+    odom: str | None
+    """A mobile base's odometry frame; None without a mobile base."""
+
+
+@dataclass(frozen=True)
 class VlaSlot:
     """One RGB sensor and the policy slot its frames are delivered under."""
 
@@ -141,6 +156,7 @@ class RobotTables:
     hal_wiring: HalWiring | None
     vla_slots: tuple[VlaSlot, ...]
     joint_name_map: dict[str, str]
+    frames: FrameNames
     mobile_base: MobileBaseWiring | None = None
 
     def to_json(self) -> str:
@@ -161,6 +177,7 @@ class RobotTables:
             vla_slots=tuple(VlaSlot(**slot) for slot in data["vla_slots"]),
             joint_name_map=dict(data["joint_name_map"]),
             mobile_base=None if base is None else MobileBaseWiring.from_dict(base),
+            frames=FrameNames(**data["frames"]),
         )
 
 
@@ -249,6 +266,15 @@ def mobile_base_wiring(robot: RobotDescription) -> MobileBaseWiring | None:
     )
 
 
+def frame_names(robot: RobotDescription) -> FrameNames:
+    """The robot's world, base and odometry frame names, defaults filled in."""
+    frames = robot.frames or Frames()
+    base = robot.mobile_base
+    if base is None:
+        return FrameNames(world=frames.world, base=frames.base, odom=None)
+    return FrameNames(world=frames.world, base=base.base_frame, odom=base.odom_frame)
+
+
 def manifest_sha256(robot: RobotDescription) -> str:
     """SHA-256 of the validated manifest's canonical JSON (sorted keys, defaults filled in):
     comments and formatting do not change it, any change of meaning does."""
@@ -283,6 +309,7 @@ def robot_tables(robot: RobotDescription, *, root: Path | None = None) -> RobotT
         vla_slots=vla_slots(robot),
         joint_name_map=joint_name_map(robot),
         mobile_base=mobile_base_wiring(robot),
+        frames=frame_names(robot),
     )
 
 

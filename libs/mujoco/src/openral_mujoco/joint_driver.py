@@ -218,6 +218,11 @@ class JointDriver:
         return positions, velocities, force[self._at.actuator]
 
     @property
+    def addresses(self) -> RobotAddresses:
+        """Where the robot's joints, fingers and actuators are in the driver's model."""
+        return self._at
+
+    @property
     def setpoint(self) -> FloatArray:
         """The arm joints' present set point (a copy), in arm-slot order."""
         return self._setpoint.copy()

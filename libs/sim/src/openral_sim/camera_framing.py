@@ -27,9 +27,10 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 from openral_core.models import DeployScene, DepthSensor, RgbSensor, RobotDescription
+from openral_mujoco.robot_bodies import robot_bodies
 
 from openral_sim.scene_cameras import rotate_about_z
-from openral_sim.scene_geometry import geom_corners, robot_bodies, start_pose
+from openral_sim.scene_geometry import geom_corners, start_pose
 
 VIEWS = ((1.0, 0.3, 0.55), (1.0, -0.3, 0.55), (0.3, 1.0, 0.55), (0.3, -1.0, 0.55))
 """Directions from what the camera shows towards the camera, in the base pose's frame, in

@@ -40,6 +40,7 @@ from openral_core.tables import HalWiring
 from openral_mujoco.errors import HalError
 from openral_mujoco.joint_driver import JointDriver
 from openral_mujoco.robot_addresses import RobotAddresses, locate_robot
+from openral_mujoco.robot_bodies import robot_bodies, root_body
 from openral_mujoco.state import FloatArray, JointStateSample
 
 from openral_sim.base_drive import BASE_UPDATE_STEPS, BaseDrive
@@ -50,7 +51,7 @@ from openral_sim.rollout import Observation, StepResult
 from openral_sim.scene_cameras import camera_sensors
 from openral_sim.scene_checks import physics_steps_per_control
 from openral_sim.scene_compose import BASE_WELD, compose
-from openral_sim.scene_geometry import place_floating_base, robot_bodies, root_body
+from openral_sim.scene_geometry import place_floating_base
 from openral_sim.state_sensors import StateSensors
 from openral_sim.success import SuccessCheck
 

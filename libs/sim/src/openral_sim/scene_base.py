@@ -15,11 +15,16 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
+from openral_core.loaded import LoadedRobot
+from openral_core.located import error_at
 from openral_core.models import RobotDescription, SiteSensor
 from openral_core.tables import mobile_base_wiring
+from openral_mujoco.errors import HalError
 from openral_mujoco.mjcf_uri import robot_model_file
 from openral_mujoco.mobile_base import base_model_file, base_spec, cached_base_model
-from openral_mujoco.model_check import cached_robot_model
+from openral_mujoco.model_cache import cached_model
+from openral_mujoco.model_check import cached_robot_model, require_agreement
+from openral_mujoco.robot_addresses import RobotAddresses, locate_robot
 
 
 @dataclass(frozen=True)
@@ -87,3 +92,45 @@ def add_sensor_sites(spec: mujoco.MjSpec, robot: RobotDescription) -> None:
         body = spec.body(sensor.mount_body)
         assert body is not None, "require_agreement checks mount bodies before composing"
         body.add_site(name=sensor.site, pos=list(sensor.mount_position_m or [0.0, 0.0, 0.0]))
+
+
+@dataclass(frozen=True)
+class RobotAlone:
+    """The robot by itself (on its mobile base, if it has one) at the world's origin: the
+    model its URDF is read from, and where its joints and actuators are in it."""
+
+    model: mujoco.MjModel
+    addresses: RobotAddresses
+
+
+def robot_alone(robot: LoadedRobot) -> RobotAlone:
+    """Compile (or load from the model cache) the robot with its mobile base and nothing
+    else, as :func:`attach_robot` composes them in a scene.
+
+    Raises:
+        ManifestError: At ``sim.mjcf_uri`` or ``mobile_base.mjcf_uri``, or when the manifest
+            disagrees with its model.
+    """
+    description, wiring = robot.description, robot.tables.hal_wiring
+    if wiring is None:
+        raise error_at(description, ("name",), f"robot {robot.name!r} has no sim block")
+    models = robot_models(description, robot.folder)
+    require_agreement(description, models.model, models.base_model)
+    model = models.model
+    if models.base_path is not None:
+        parts = None
+        if models.fingerprints is not None:
+            parts = ("robot-alone", *models.fingerprints, description.model_dump_json())
+        model = cached_model(parts, lambda: _alone(description, models))
+    try:
+        addresses = locate_robot(wiring, models.model, model)
+    except HalError as error:
+        raise error_at(description, ("joints",), str(error)) from None
+    return RobotAlone(model, addresses)
+
+
+def _alone(robot: RobotDescription, models: RobotModels) -> mujoco.MjModel:
+    spec = mujoco.MjSpec()
+    child = mujoco.MjSpec.from_file(str(models.path))
+    attach_robot(spec, child, robot, models, spec.worldbody.add_frame())
+    return spec.compile()

@@ -29,6 +29,7 @@ from openral_core.models import (
 )
 from openral_mujoco.model_cache import cached_model, code_digest
 from openral_mujoco.model_check import require_agreement, unloadable_model
+from openral_mujoco.robot_bodies import root_body
 
 from openral_sim.camera_framing import place_fixed_cameras
 from openral_sim.scene_base import (
@@ -39,7 +40,7 @@ from openral_sim.scene_base import (
 )
 from openral_sim.scene_cameras import add_fixed_cameras, add_mounted_cameras, rotate_about_z
 from openral_sim.scene_checks import check_object_names, check_weld
-from openral_sim.scene_geometry import lowest_static_point, root_body, yaw_quat
+from openral_sim.scene_geometry import lowest_static_point, yaw_quat
 from openral_sim.scene_lighting import add_scene_lights, balance_lights
 from openral_sim.state_sensors import add_state_sensors
 

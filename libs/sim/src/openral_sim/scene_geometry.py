@@ -1,5 +1,5 @@
-"""Where a robot's model puts things: its root body, its start pose, the boxes of its geoms
-and its lowest fixed part.
+"""Where a robot's model puts things: its start pose, the boxes of its geoms and its lowest
+fixed part (its root body and bodies: :mod:`openral_mujoco.robot_bodies`).
 
 A native scene frames its fixed cameras and places its floor with these.
 """
@@ -13,7 +13,7 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 from openral_core.models import BasePose, RobotDescription
-from openral_core.tables import joint_name_map
+from openral_mujoco.robot_bodies import root_body
 
 CORNERS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
 """The eight corners of a box of half-size 1."""
@@ -75,22 +75,3 @@ def place_floating_base(data: mujoco.MjData, free: int, pose: BasePose | None) -
 def yaw_quat(yaw: float) -> npt.NDArray[np.float64]:
     """The quaternion (w, x, y, z) of a turn by ``yaw`` [rad] about the world z axis."""
     return np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
-
-
-def root_body(model: mujoco.MjModel, robot: RobotDescription) -> int:
-    """The robot's root body (the world's child that carries its first manifest joint)."""
-    first = next(iter(joint_name_map(robot).values()))
-    joint = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, first)
-    return int(model.body_rootid[model.jnt_bodyid[joint]])
-
-
-def robot_bodies(model: mujoco.MjModel, robot: RobotDescription) -> frozenset[int]:
-    """Every body of the robot in ``model``: the whole tree under each world child that
-    carries a manifest joint (both arms of a bimanual robot; not a table or prop its file
-    brings), the bodies its own sensors must not see."""
-    roots = set()
-    for mjcf_name in joint_name_map(robot).values():
-        joint = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, mjcf_name)
-        if joint >= 0:
-            roots.add(int(model.body_rootid[model.jnt_bodyid[joint]]))
-    return frozenset(int(b) for b in np.flatnonzero(np.isin(model.body_rootid, list(roots))))
