@@ -20,8 +20,6 @@ from openral_bridge.joint_path import (
     PathRefused,
     PathStart,
     TrajectoryRequest,
-    _fastest,
-    _segment_at,
     plan_path,
 )
 from openral_bridge.trajectory_follower import TrajectoryFollower
@@ -183,7 +181,7 @@ def test_an_unlimited_joint_is_refused_an_unbounded_speed() -> None:
 def test_a_path_exactly_at_its_limit_passes() -> None:
     request = _request(("shoulder",), (1.5, (1.6,), ()))  # 1.5 rad in 1.5 s: 1 rad/s
     path = plan_path(request, LIMITS, START)
-    assert _fastest(path, 0) == pytest.approx([1.0], rel=1e-12)
+    assert path.segment(0).fastest() == pytest.approx([1.0], rel=1e-12)
 
 
 def test_the_start_knot_stands_for_a_point_at_time_zero_near_it() -> None:
@@ -248,7 +246,7 @@ def _speeds(path: JointPath, k: int, lo: float = 0.0, hi: float = 1.0) -> FloatA
     the segment's own limits (sample() there is the next segment's, or at rest)."""
     t0, t1 = float(path.times_s[k]), float(path.times_s[k + 1])
     times = t0 + (t1 - t0) * np.linspace(lo, hi, SAMPLES)
-    return np.array([np.abs(_segment_at(path, k, float(t))[1]) for t in times])
+    return np.array([np.abs(path.segment(k).at(float(t))[1]) for t in times])
 
 
 @settings(max_examples=60, deadline=None)
@@ -256,7 +254,7 @@ def _speeds(path: JointPath, k: int, lo: float = 0.0, hi: float = 1.0) -> FloatA
 def test_the_exact_speed_is_the_densely_sampled_maximum(k: Knots) -> None:
     path = _path(k)
     for segment in range(len(path.times_s) - 1):
-        exact, sampled = _fastest(path, segment), _speeds(path, segment).max(axis=0)
+        exact, sampled = path.segment(segment).fastest(), _speeds(path, segment).max(axis=0)
         assert np.all(exact >= sampled * (1.0 - 1e-12))  # a bound, never below (rounding)
         assert exact == pytest.approx(sampled, rel=1e-6, abs=1e-12)
 
@@ -312,7 +310,7 @@ def _positions(path: JointPath, k: int) -> FloatArray:
     """Positions of segment ``k`` at SAMPLES fractions of it, ends included."""
     t0, t1 = float(path.times_s[k]), float(path.times_s[k + 1])
     times = t0 + (t1 - t0) * np.linspace(0.0, 1.0, SAMPLES)
-    return np.array([_segment_at(path, k, float(t))[0] for t in times])
+    return np.array([path.segment(k).at(float(t))[0] for t in times])
 
 
 def _peak_speed(path: JointPath, k: int, joint: int) -> float:

@@ -1,5 +1,5 @@
-"""JointStatePublisher: /joint_states from a pacer job, read holding the HAL's lock, one
-message built per control tick's state."""
+"""JointStatePublisher: /joint_states and /openral/manifest_joint_states from a pacer job,
+read holding the HAL's lock, one message built per control tick's reading."""
 
 from __future__ import annotations
 
@@ -10,7 +10,11 @@ from typing import Any
 
 import numpy as np
 import pytest
-from openral_bridge.joint_state_publisher import JointStatePublisher
+from openral_bridge.joint_state_publisher import (
+    HalStates,
+    JointStatePublisher,
+    StateReading,
+)
 from openral_bridge.pacer import Pacer
 from openral_mujoco.state import JointStateSample
 from openral_nodes.runtime import Spinner
@@ -49,7 +53,8 @@ def received(
 ) -> list[Any]:
     """Start ``publisher`` on a pacer, return the first ``count`` messages, stop both; the
     job and the publisher are gone then."""
-    probe = Probe(ros_context, {"/joint_states": JointState}, name="joint_state_probe")
+    topics = {"/joint_states": JointState, "/openral/manifest_joint_states": JointState}
+    probe = Probe(ros_context, topics, name="joint_state_probe")
     publishers = len(list(node.publishers))
     pacer = Pacer()
     with Spinner(ros_context) as spinner:
@@ -70,7 +75,8 @@ def test_reads_the_hal_holding_its_lock_and_stamps_simulated_time(
 ) -> None:
     lock = threading.Lock()
     hal = StateHal(lock)
-    publisher = JointStatePublisher(node, hal, lock, 50.0)  # type: ignore[arg-type]
+    source = HalStates(hal, lock)  # type: ignore[arg-type]
+    publisher = JointStatePublisher(node, 50.0, source)
     messages = received(ros_context, node, publisher, 3)
     assert hal.reads >= 3 and hal.unlocked_reads == 0
     first = messages[0]
@@ -79,47 +85,66 @@ def test_reads_the_hal_holding_its_lock_and_stamps_simulated_time(
     assert (first.header.stamp.sec, first.header.stamp.nanosec) == (3, 250_000_000)
 
 
-def test_a_tick_state_is_built_once_and_sent_until_the_next(
+class FixedSource:
+    """One reading, for ever (as a control loop's between two ticks)."""
+
+    def __init__(self, reading: StateReading) -> None:
+        self.value = reading
+        self.calls = 0
+
+    def reading(self) -> StateReading:
+        self.calls += 1
+        return self.value
+
+
+def test_a_tick_reading_is_built_once_and_sent_until_the_next(
     ros_context: Context, node: Node
 ) -> None:
-    lock = threading.Lock()
-    hal = StateHal(lock)
-    tick_state = StateHal(threading.Lock(), sim_time_s=7.0).read_state()
-    publisher = JointStatePublisher(
-        node,
-        hal,  # type: ignore[arg-type]
-        lock,
-        50.0,
-        latest=lambda: tick_state,
-    )
+    joints = StateHal(threading.Lock(), sim_time_s=7.0).read_state()
+    manifest = joints._replace(positions=joints.positions / 10)
+    source = FixedSource(StateReading(joints, manifest))
+    publisher = JointStatePublisher(node, 50.0, source)
     built: list[object] = []
-    original = publisher._message_of
+    original = publisher._messages_of
 
-    def counted(sample: JointStateSample) -> object:
-        message = original(sample)
-        if not built or built[-1] is not message:
-            built.append(message)
-        return message
+    def counted(reading: StateReading) -> tuple[object, object]:
+        messages = original(reading)
+        if not built or built[-1] is not messages[0]:
+            built.append(messages[0])
+        return messages
 
-    publisher._message_of = counted  # type: ignore[method-assign]
+    publisher._messages_of = counted  # type: ignore[method-assign]
     messages = received(ros_context, node, publisher, 4)
-    assert hal.reads == 0 and len(built) == 1  # the HAL is not read; one message built
+    assert source.calls >= 4 and len(built) == 1  # one pair of messages built
     assert all(m.header.stamp.sec == 7 for m in messages)
-    assert all(list(m.position) == list(messages[0].position) for m in messages)
+    assert all(list(m.position) == [0.5, -1.0] for m in messages)
 
 
-def test_without_a_tick_state_or_simulated_time_it_reads_and_uses_the_node_clock(
+def test_the_manifest_view_goes_to_its_own_topic(ros_context: Context, node: Node) -> None:
+    joints = StateHal(threading.Lock(), sim_time_s=2.0).read_state()
+    manifest = joints._replace(names=("m",), positions=np.array([0.25]))
+    manifest = manifest._replace(velocities=np.zeros(1), efforts=np.zeros(1))
+    publisher = JointStatePublisher(node, 50.0, FixedSource(StateReading(joints, manifest)))
+    probe = Probe(ros_context, {"/openral/manifest_joint_states": JointState}, name="m_probe")
+    pacer = Pacer()
+    with Spinner(ros_context) as spinner:
+        spinner.add_node(probe.node)
+        spinner.add_node(node)
+        publisher.start(pacer)
+        pacer.start()
+        message = probe.wait_count("/openral/manifest_joint_states", 1)[0].msg
+        assert pacer.stop()
+        publisher.stop()
+    probe.node.destroy_node()
+    assert list(message.name) == ["m"] and list(message.position) == [0.25]
+
+
+def test_without_simulated_time_it_reads_and_uses_the_node_clock(
     ros_context: Context, node: Node
 ) -> None:
     lock = threading.Lock()
     hal = StateHal(lock, sim_time_s=None)
-    publisher = JointStatePublisher(
-        node,
-        hal,  # type: ignore[arg-type]
-        lock,
-        50.0,
-        latest=lambda: None,
-    )
+    publisher = JointStatePublisher(node, 50.0, HalStates(hal, lock))  # type: ignore[arg-type]
     before = time.time()
     messages = received(ros_context, node, publisher, 2)
     assert hal.reads >= 2

@@ -51,16 +51,16 @@ from typing import Any
 import numpy as np
 from openral_bridge import ros_messages
 from openral_bridge.control_loop import ControlLoop
-from openral_bridge.joint_state_publisher import JointStatePublisher, sim_stamp
+from openral_bridge.joint_state_publisher import sim_stamp
 from openral_bridge.pacer import PacedJob, Pacer
-from openral_bridge.topics import ACTION_SPEC, CLOCK, JOINT_STATES, TopicInfo
+from openral_bridge.topics import ACTION_SPEC, CLOCK, TopicInfo
 from openral_bridge.trajectory_follower import TrajectoryFollower, path_limits
 from openral_core import LoadedRobot
 from openral_core.errors import OpenralError
 from openral_core.models import DeployScene, RobotDescription
 from openral_hal.errors import NotConnected
 from openral_hal.factory import build_hal, can_tick
-from openral_hal.protocol import MobileBaseHal, RobotHal
+from openral_hal.protocol import RobotHal
 from openral_sim.rollout import SimRollout
 from openral_sim.scene import build_scene
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
@@ -71,6 +71,7 @@ from sensor_msgs.msg import JointState
 from openral_nodes.command_interfaces import CommandInterfaces
 from openral_nodes.lifecycle_guard import guard_change_state
 from openral_nodes.node_parameters import BOUNDS, PARAMETERS, check_rates, robot_and_scene
+from openral_nodes.robot_state_streams import RobotStateStreams
 from openral_nodes.runtime import LATCHED
 from openral_nodes.scene_bridges import SceneBridges
 
@@ -132,8 +133,8 @@ class ManifestLifecycleNode(LifecycleNode):
         """The control loop of a simulated HAL while active (None for a real one)."""
         self.pacer: Pacer | None = None
         """The thread of the periodic work while active."""
-        self.states: JointStatePublisher | None = None
-        """``/joint_states`` while active."""
+        self.states: RobotStateStreams | None = None
+        """``/joint_states``, ``/tf`` and ``/robot_description`` while active."""
         self.hal_lock = threading.Lock()
         """Held by whatever reads or changes the HAL (see the module doc)."""
         self.log_boot_errors = log_boot_errors
@@ -242,13 +243,10 @@ class ManifestLifecycleNode(LifecycleNode):
         """Every topic published now, with its nominal rate (None: latched or on change)."""
         if not self._entities:
             return []
-        rate = self.states.rate_hz if self.states else None
-        rows = [
-            TopicInfo(JOINT_STATES, "sensor_msgs/msg/JointState", rate),
-            TopicInfo(ACTION_SPEC, "sensor_msgs/msg/JointState", None),
-        ]
+        rows = [TopicInfo(ACTION_SPEC, "sensor_msgs/msg/JointState", None)]
+        rows = (self.states.topics() if self.states else []) + rows
         if self.loop is not None:
-            rows.insert(1, TopicInfo(CLOCK, "rosgraph_msgs/msg/Clock", 1.0 / self.loop.period_s))
+            rows.insert(0, TopicInfo(CLOCK, "rosgraph_msgs/msg/Clock", 1.0 / self.loop.period_s))
         rows += self.commands.topics() if self.commands is not None else []
         return rows + (self.bridge.topics() if self.bridge else [])
 
@@ -323,11 +321,7 @@ class ManifestLifecycleNode(LifecycleNode):
         spec_msg.header.stamp = sim_stamp(self, sim_time_s)
         spec.publish(spec_msg)
         rate_hz = float(self._param("joint_state_rate_hz"))
-        latest = (lambda: loop.state) if (loop := self.loop) is not None else None
-        base = hal.base if isinstance(hal, MobileBaseHal) else None
-        self.states = JointStatePublisher(
-            self, hal, self.hal_lock, rate_hz, latest=latest, base=base
-        )
+        self.states = RobotStateStreams(self, hal, self.hal_lock, self.loop, rate_hz, self._loaded)
         self.states.start(pacer)
         self.commands = CommandInterfaces(
             self, hal, self.hal_lock, self.loop, warn_every_s=WARN_EVERY_S
@@ -340,7 +334,10 @@ class ManifestLifecycleNode(LifecycleNode):
         self._log().error(text, throttle_duration_sec=WARN_EVERY_S)
 
     def _publish_sensors_now(self) -> None:
-        """After a reset: every camera and range sensor shows the start state at once."""
+        """After a reset: every camera and range sensor shows the start state at once, and
+        the static transforms are sent again."""
+        if self.states is not None:
+            self.states.after_reset()
         if self.bridge is not None:
             self.bridge.publish_now()
 

@@ -124,6 +124,10 @@ class ControlLoop:
         self.on_reset = on_reset
         self.followed = 0
         """Ticks that glided along a trajectory."""
+        self.readers: list[Callable[[], None]] = []
+        """Called in order, holding the HAL lock, right after every tick that stepped the scene
+        (and a reset's tick): each copies what it publishes from the live scene, so nothing
+        reads the scene in the middle of a step and the copies all show the same state."""
         self._pending: FloatArray | None = None
         self._reset: _ResetRequest | None = None
         self._pending_lock = threading.Lock()
@@ -157,6 +161,14 @@ class ControlLoop:
             reset.done.set()
         if self.follower is not None:
             self.follower.cancel()
+
+    def add_reader(self, read: Callable[[], None]) -> None:
+        """Run ``read`` after every tick that steps (see :attr:`readers`), and once now,
+        holding the HAL lock, when a tick already stepped (so it has a state at once)."""
+        self.readers.append(read)
+        if self.state is not None:
+            with self.lock:
+                read()
 
     def offer(self, action: FloatArray) -> bool:
         """Make ``action`` (already validated) the one the next tick applies (any thread);
@@ -210,6 +222,8 @@ class ControlLoop:
                 stepped = self.hal.tick(action, glide=sample is not None)
                 state = self.hal.read_state() if stepped else self.state
                 self.state = state
+                if stepped:
+                    self._read()
         except Exception as error:  # a diverged scene, or a bug: never the end of the graph
             self.state = None
             self._abort_trajectory()
@@ -259,6 +273,8 @@ class ControlLoop:
                 request.text = self.hal.reset()
                 stepped = self.hal.tick(None)
                 self.state = self.hal.read_state() if stepped else None
+                if stepped:
+                    self._read()
         except Exception as error:  # reported to the caller, never the end of the graph
             request.error = f"the reset failed ({type(error).__name__}: {error})"
             request.done.set()
@@ -271,6 +287,11 @@ class ControlLoop:
                 self.on_reset()
         finally:
             request.done.set()
+
+    def _read(self) -> None:
+        """Run the readers (holding the HAL lock)."""
+        for read in self.readers:
+            read()
 
     def _drop_pending(self) -> None:
         """Drop a waiting action, counted as superseded (holding ``_pending_lock``)."""

@@ -12,36 +12,61 @@ interface, and the manifest's envelope on top:
   point has them) are finite, one per joint; every position inside the joint's limits;
 - the path starts where the joints are commanded now (or where a running path will be at
   the new one's start time): that start is the first knot; a point at time 0 must lie
-  within :data:`START_TOLERANCE` of it; points whose time has already passed are dropped;
+  within :data:`START_TOLERANCE` of it, or else within the robot's ``start_tolerance``
+  (``trajectory.start_tolerance`` of the manifest) of where the joints are *measured*: then
+  the path is joined from the measured state (an arm that sags under gravity sits below its
+  target, and a plan starts where the arm is); points whose time has already passed are
+  dropped;
 - between two knots that both have velocities the path is a cubic Hermite spline, else a
   straight line; the last point's velocities, when given, must be 0 (the joints stop there);
 - nowhere may a joint move faster than its ``velocity_limit``: the fastest speed of every
   segment is computed exactly (the spline's derivative is a quadratic) and a path that
   would exceed a limit is refused, naming the joint and the speed it needs.
 
-Accelerations and efforts of a point are not used (no quintic segments).
+Accelerations and efforts of a point are not used (no quintic segments). Every check is
+linear in the size of the request (a hostile message cannot stall the graph), and each
+refusal carries its :class:`Refusal` kind, which the FollowJointTrajectory action turns into
+its result code.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from enum import StrEnum
 
 import numpy as np
 import numpy.typing as npt
 from openral_core.errors import OpenralError, did_you_mean
 from openral_mujoco.state import FloatArray
 
+from openral_bridge.path_segment import Segment
+
 START_TOLERANCE = 0.01
 """Largest distance of a point at time 0 from where its joint is commanded now [rad or m]."""
-MAX_POINTS = 100_000
-"""Most points one trajectory may have (resource use stays bounded)."""
+MAX_POINTS = 10_000
+"""Most points one trajectory may have (a point per millisecond for 10 s; resource use and
+the time a check takes stay bounded)."""
 SPEED_SLACK = 1e-9
 """Relative slack of the velocity check (a path planned exactly at a limit passes)."""
 
 
+class Refusal(StrEnum):
+    """Why a trajectory was refused, in joint_trajectory_controller's terms."""
+
+    INVALID_GOAL = "invalid_goal"
+    INVALID_JOINTS = "invalid_joints"
+    """A joint name that is no joint of the robot, repeated, or none at all."""
+    OLD_HEADER_TIMESTAMP = "old_header_timestamp"
+    """The trajectory ended before now."""
+
+
 class PathRefused(OpenralError):
     """A trajectory was refused whole; the message says which field and why."""
+
+    def __init__(self, message: str, kind: Refusal = Refusal.INVALID_GOAL) -> None:
+        super().__init__(message)
+        self.kind = kind
 
 
 @dataclass(frozen=True)
@@ -62,6 +87,8 @@ class TrajectoryRequest:
     points: tuple[PathPoint, ...]
     start_s: float | None = None
     """Simulated time the trajectory starts at [s]; None: now."""
+    source: str = "a joint trajectory"
+    """Who sent it, for messages (``a FollowJointTrajectory goal``)."""
 
 
 @dataclass(frozen=True)
@@ -83,6 +110,11 @@ class PathStart:
     time_s: float
     positions: FloatArray
     velocities: FloatArray
+    measured: FloatArray | None = None
+    """Where the joints are measured now, per action slot (None: unknown)."""
+    start_tolerance: float = 0.0
+    """How far a point at time 0 may be from :attr:`measured` to be joined from there
+    [rad or m] (0: never)."""
 
 
 @dataclass(frozen=True)
@@ -97,6 +129,8 @@ class JointPath:
     """Knot positions, one row per knot, one column per slot of :attr:`slots`."""
     velocities: FloatArray
     """Knot velocities (NaN rows: the knot has none)."""
+    source: str = field(default="a joint trajectory", compare=False)
+    """Who sent it (:attr:`TrajectoryRequest.source`)."""
 
     @property
     def start_s(self) -> float:
@@ -116,7 +150,18 @@ class JointPath:
             row = self.positions[0 if time_s <= times[0] else -1]
             return row.copy(), np.zeros_like(row)
         k = int(np.searchsorted(times, time_s, side="right")) - 1
-        return _segment_at(self, k, time_s)
+        return self.segment(k).at(time_s)
+
+    def segment(self, k: int) -> Segment:
+        """The segment from knot ``k`` to knot ``k + 1``."""
+        return Segment(
+            self.positions[k],
+            self.positions[k + 1],
+            self.velocities[k],
+            self.velocities[k + 1],
+            float(self.times_s[k]),
+            float(self.times_s[k + 1]),
+        )
 
 
 def plan_path(request: TrajectoryRequest, limits: PathLimits, start: PathStart) -> JointPath:
@@ -135,38 +180,50 @@ def plan_path(request: TrajectoryRequest, limits: PathLimits, start: PathStart) 
     begin = start.time_s if request.start_s is None else request.start_s
     times = begin + offsets
     keep = times > start.time_s
+    first, first_speed = start.positions[slots], start.velocities[slots]
     if offsets[0] == 0.0:  # the start itself: checked, then the start knot stands for it
-        _check_at_start(request.joint_names, positions[0], start.positions[slots])
+        if _joined_from_measured(request.joint_names, positions[0], start, slots):
+            first, first_speed = start.measured[slots], np.zeros(len(slots))  # type: ignore[index]
         keep[0] = False
     if not keep.any():
         raise PathRefused(
             f"the trajectory ended at t={times[-1]:.3f} s (simulated), before now "
-            f"(t={start.time_s:.3f} s)"
+            f"(t={start.time_s:.3f} s)",
+            Refusal.OLD_HEADER_TIMESTAMP,
         )
     first_time = max(start.time_s, begin)
     path = JointPath(
         names=request.joint_names,
         slots=slots,
         times_s=np.concatenate([[first_time], times[keep]]),
-        positions=np.vstack([start.positions[slots], positions[keep]]),
-        velocities=np.vstack([start.velocities[slots], velocities[keep]]),
+        positions=np.vstack([first, positions[keep]]),
+        velocities=np.vstack([first_speed, velocities[keep]]),
+        source=request.source,
     )
     _check_speeds(path, limits)
     return path
 
 
 def _slots(names: tuple[str, ...], slot_names: tuple[str, ...]) -> npt.NDArray[np.intp]:
-    """Action slots of ``names``, or PathRefused for an empty, repeated or unknown one."""
+    """Action slots of ``names``, or PathRefused for an empty, repeated or unknown one (one
+    pass: linear in the number of names)."""
     if not names:
-        raise PathRefused("joint_names is empty; name the joints the trajectory moves")
+        raise PathRefused(
+            "joint_names is empty; name the joints the trajectory moves", Refusal.INVALID_JOINTS
+        )
     index = {name: i for i, name in enumerate(slot_names)}
+    seen: set[str] = set()
     for name in names:
         if name not in index:
-            hint = did_you_mean(name, slot_names)
-            raise PathRefused(f"joint_names: {name!r} is not a joint of this robot{hint}")
-    repeated = sorted({n for n in names if names.count(n) > 1})
-    if repeated:
-        raise PathRefused(f"joint_names: {', '.join(repeated)} named more than once")
+            hint = did_you_mean(name[:200], slot_names)
+            shown = name if len(name) <= 80 else name[:80] + "…"
+            raise PathRefused(
+                f"joint_names: {shown!r} is not a joint of this robot{hint}",
+                Refusal.INVALID_JOINTS,
+            )
+        if name in seen:
+            raise PathRefused(f"joint_names: {name} named more than once", Refusal.INVALID_JOINTS)
+        seen.add(name)
     return np.array([index[n] for n in names], dtype=np.intp)
 
 
@@ -238,17 +295,30 @@ def _check_limits(
         )
 
 
-def _check_at_start(names: tuple[str, ...], first: FloatArray, now: FloatArray) -> None:
-    """A point at time 0 must be where the joints are commanded now."""
-    gap = np.abs(first - now)
-    far = np.flatnonzero(gap > START_TOLERANCE)
-    if far.size:
-        i = int(far[0])
-        raise PathRefused(
-            f"points[0] is at time 0 but {names[i]} is commanded to {now[i]:.6g} now, "
-            f"{gap[i]:.3g} away (at most {START_TOLERANCE:g}); a point at time 0 must be "
-            "the start, or give it a later time"
-        )
+def _joined_from_measured(
+    names: tuple[str, ...], first: FloatArray, start: PathStart, slots: npt.NDArray[np.intp]
+) -> bool:
+    """Whether a point at time 0 is joined from the measured state (False: from the
+    commanded one); PathRefused when it is near neither."""
+    commanded = start.positions[slots]
+    gap = np.abs(first - commanded)
+    if not np.any(gap > START_TOLERANCE):
+        return False
+    measured = start.measured[slots] if start.measured is not None else None
+    if measured is not None and start.start_tolerance > 0.0:
+        from_measured = np.abs(first - measured)
+        if not np.any(from_measured > start.start_tolerance):
+            return True
+    i = int(np.argmax(gap))
+    where = f"{names[i]} is commanded to {commanded[i]:.6g}"
+    if measured is not None:
+        where += f" and measured at {measured[i]:.6g}"
+    raise PathRefused(
+        f"points[0] is at time 0 but {where} now, {gap[i]:.3g} away from it (at most "
+        f"{START_TOLERANCE:g} from the command, or {start.start_tolerance:g} from the "
+        "measured position: the robot's trajectory.start_tolerance); a point at time 0 must "
+        "be where the joints are, or give it a later time"
+    )
 
 
 def _check_speeds(path: JointPath, limits: PathLimits) -> None:
@@ -256,112 +326,39 @@ def _check_speeds(path: JointPath, limits: PathLimits) -> None:
     unbounded speed), or leave its position limits between two knots."""
     vmax = limits.speed[path.slots]
     for k in range(len(path.times_s) - 1):
-        fastest = _fastest(path, k)
+        segment = path.segment(k)
+        fastest = segment.fastest()
         over = np.flatnonzero(~np.isfinite(fastest) | (fastest > vmax * (1.0 + SPEED_SLACK)))
-        segment = "the start" if k == 0 else f"knot {k}"
+        where = "the start" if k == 0 else f"knot {k}"
         if over.size:
             i = int(over[0])
             unit = limits.units[path.slots[i]] if limits.units else "(rad or m)"
             raise PathRefused(
-                f"{path.names[i]} would need {fastest[i]:.4g} {unit}/s between {segment} "
+                f"{path.names[i]} would need {fastest[i]:.4g} {unit}/s between {where} "
                 f"and t={path.times_s[k + 1]:.3f} s; its velocity_limit is {vmax[i]:g} {unit}/s"
             )
-        _check_between(path, k, limits, segment)
+        _check_between(path, segment, limits, where)
 
 
-def _check_between(path: JointPath, k: int, limits: PathLimits, segment: str) -> None:
+def _check_between(path: JointPath, segment: Segment, limits: PathLimits, where: str) -> None:
     """A cubic segment may bulge past its knots: its turning points must stay inside the
     position limits too (a line stays between its knots, which are checked)."""
-    cubic = _hermite(path, k)
+    cubic = segment.tangents
     if cubic is None:
         return
-    p0, p1, m0, m1, _ = cubic
-    unbounded = np.flatnonzero(~(np.isfinite(m0) & np.isfinite(m1)))
+    unbounded = np.flatnonzero(~(np.isfinite(cubic[0]) & np.isfinite(cubic[1])))
     if unbounded.size:
         i = int(unbounded[0])
         raise PathRefused(
-            f"{path.names[i]} would need an unbounded speed between {segment} and the next "
+            f"{path.names[i]} would need an unbounded speed between {where} and the next "
             "point (a velocity too large to interpolate)"
         )
-    a = 6 * p0 + 3 * m0 - 6 * p1 + 3 * m1  # q'(s)·T = a s² + b s + c
-    b = -6 * p0 - 4 * m0 + 6 * p1 - 2 * m1
     low, high = limits.low[path.slots], limits.high[path.slots]
     for i in range(len(path.slots)):
-        for s in _roots(float(a[i]), float(b[i]), float(m0[i])):
-            q = (2 * s**3 - 3 * s**2 + 1) * p0[i] + (s**3 - 2 * s**2 + s) * m0[i]
-            q += (-2 * s**3 + 3 * s**2) * p1[i] + (s**3 - s**2) * m1[i]
+        for time_s, q in segment.turning_points(i):
             if not low[i] <= q <= high[i]:
-                time_s = path.times_s[k] + s * (path.times_s[k + 1] - path.times_s[k])
                 raise PathRefused(
                     f"{path.names[i]} would reach {q:.6g} at t={time_s:.3f} s between "
-                    f"{segment} and the next point (the cubic bulges past them), outside its "
+                    f"{where} and the next point (the cubic bulges past them), outside its "
                     f"limits [{low[i]:.6g}, {high[i]:.6g}]"
                 )
-
-
-def _roots(a: float, b: float, c: float) -> list[float]:
-    """Roots of a s² + b s + c inside (0, 1)."""
-    if a == 0.0:
-        found = [-c / b] if b != 0.0 else []
-    else:
-        disc = b * b - 4 * a * c
-        found = [] if disc < 0 else [(-b - disc**0.5) / (2 * a), (-b + disc**0.5) / (2 * a)]
-    return [s for s in found if 0.0 < s < 1.0]
-
-
-def _hermite(
-    path: JointPath, k: int
-) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, float] | None:
-    """(p0, p1, m0, m1, duration) of segment ``k`` when it is cubic, else None."""
-    v0, v1 = path.velocities[k], path.velocities[k + 1]
-    if np.isnan(v0).any() or np.isnan(v1).any():
-        return None
-    duration = float(path.times_s[k + 1] - path.times_s[k])
-    with np.errstate(over="ignore"):  # a huge velocity: refused by _fastest's ends
-        m0, m1 = v0 * duration, v1 * duration
-    return path.positions[k], path.positions[k + 1], m0, m1, duration
-
-
-def _segment_at(path: JointPath, k: int, time_s: float) -> tuple[FloatArray, FloatArray]:
-    """(positions, velocities) inside segment ``k`` at ``time_s``."""
-    p0, p1 = path.positions[k], path.positions[k + 1]
-    duration = float(path.times_s[k + 1] - path.times_s[k])
-    s = (time_s - float(path.times_s[k])) / duration
-    cubic = _hermite(path, k)
-    if cubic is None:
-        return p0 + (p1 - p0) * s, (p1 - p0) / duration
-    _, _, m0, m1, _ = cubic
-    h00, h10, h01, h11 = (
-        2 * s**3 - 3 * s**2 + 1,
-        s**3 - 2 * s**2 + s,
-        -2 * s**3 + 3 * s**2,
-        s**3 - s**2,
-    )
-    d00, d10, d01, d11 = 6 * s**2 - 6 * s, 3 * s**2 - 4 * s + 1, -6 * s**2 + 6 * s, 3 * s**2 - 2 * s
-    position = h00 * p0 + h10 * m0 + h01 * p1 + h11 * m1
-    velocity = (d00 * p0 + d10 * m0 + d01 * p1 + d11 * m1) / duration
-    return position, velocity
-
-
-def _fastest(path: JointPath, k: int) -> FloatArray:
-    """Per joint, the largest |velocity| on segment ``k``: exact for both kinds."""
-    p0, p1 = path.positions[k], path.positions[k + 1]
-    duration = float(path.times_s[k + 1] - path.times_s[k])
-    cubic = _hermite(path, k)
-    if cubic is None:
-        speed: FloatArray = np.abs(p1 - p0) / duration
-        return speed
-    # The ends are the knots' own velocities: v·T may overflow for a huge finite v, and
-    # NaN would pass every "faster than the limit" test.
-    ends = np.maximum(np.abs(path.velocities[k]), np.abs(path.velocities[k + 1]))
-    _, _, m0, m1, _ = cubic
-    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
-        # q'(s)·T = a s² + b s + c with these coefficients (Hermite basis derivatives)
-        a = 6 * p0 + 3 * m0 - 6 * p1 + 3 * m1
-        b = -6 * p0 - 4 * m0 + 6 * p1 - 2 * m1
-        c = m0
-        vertex = np.where(a != 0.0, -b / (2 * a), -1.0)
-        inside = (vertex > 0.0) & (vertex < 1.0)  # False where NaN (an overflowed spline)
-        peak = np.abs(a * vertex**2 + b * vertex + c) / duration
-    fastest: FloatArray = np.where(inside, np.maximum(ends, peak), ends)
-    return fastest

@@ -1,43 +1,55 @@
-"""JointStatePublisher: ``/joint_states`` of a HAL at a fixed rate, from a pacer job.
+"""JointStatePublisher: ``/joint_states`` and ``/openral/manifest_joint_states`` at a fixed
+rate, from a pacer job.
 
-Each message carries every manifest joint (name, position, velocity, effort) of one
-:meth:`RobotHal.read_state`, stamped in simulated time (the node clock for a HAL without
-one). A robot with a mobile base adds its drive joints after them, under their MJCF names
-(``BaseDrive.joint_state``: the x and y slides [m] and the yaw hinge [rad]), so the scene's
-base pose is on ``/joint_states`` too; the action contract has no base slots.
-The state is read holding the HAL's lock, so it is never read in the middle of a
-control tick; the message is built and published after the lock is released.
+Two views of the same instant, both stamped in simulated time (the node clock for a HAL
+without one):
 
-A simulated scene changes only when the control loop ticks, and the loop reads the state
-right after each tick (:attr:`~openral_bridge.control_loop.ControlLoop.state`). Given that
-sample (``latest``), the publisher builds one message per tick and publishes it until the
-next: at 50 Hz over a 20 Hz loop each state goes out 2-3 times, exactly as reading the
-HAL each time would send it, for a fraction of the CPU.
+- ``/joint_states`` is what ROS tools read (robot_state_publisher, rviz2, MoveIt): every joint
+  of the robot's URDF (:class:`~openral_mujoco.robot_tree.RobotTree`) in SI units, a finger
+  in metres (not a 0-1 opening), the mimic fingers too, under the names the URDF gives
+  them; a mobile base adds its drive joints (MJCF names: x and y slides [m], yaw [rad]);
+- ``/openral/manifest_joint_states`` is what a policy sees in an episode: the manifest's
+  joints in manifest units, a gripper in its ``read_mode`` (the HAL's ``read_state``).
+
+A HAL without a frame tree (a robosuite scene, a real robot) publishes its ``read_state`` on
+both.
+
+Where a reading comes from (a :class:`StateSource`):
+
+- :class:`TickStates`: a simulated scene changes only when the control loop ticks, so the
+  loop copies both views right after each tick, holding the HAL's lock
+  (:attr:`~openral_bridge.control_loop.ControlLoop.readers`); the publisher builds the
+  messages once per tick and sends them until the next (at 50 Hz over a 20 Hz loop each
+  state goes out 2-3 times, as reading the HAL each time would send it);
+- :class:`HalStates`: a HAL without a control loop is read, holding its lock, at every
+  publication.
 """
 
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Protocol
 
+import mujoco
 import numpy as np
 from openral_hal.protocol import RobotHal
+from openral_mujoco.robot_tree import RobotTree
 from openral_mujoco.state import JointStateSample
 from openral_sim.base_drive import BaseDrive
 from sensor_msgs.msg import JointState
 
 from openral_bridge import ros_messages
 from openral_bridge.pacer import PacedJob, Pacer
-from openral_bridge.topics import JOINT_STATES
+from openral_bridge.topics import JOINT_STATES, MANIFEST_JOINT_STATES
 
 if TYPE_CHECKING:
     from rclpy.node import Node
 
+    from openral_bridge.control_loop import ControlLoop
+
 QUEUE_DEPTH = 10
-"""Queue of the ``/joint_states`` publisher."""
-LatestFn = Callable[[], JointStateSample | None]
-"""The state as of the last control tick, or None when the HAL must be read."""
+"""Queue of each publisher."""
 
 
 def sim_stamp(node: Node, sim_time_s: float | None) -> Any:
@@ -47,89 +59,159 @@ def sim_stamp(node: Node, sim_time_s: float | None) -> Any:
     return ros_messages.stamp(sim_time_s)
 
 
-class JointStatePublisher:
-    """Publishes a HAL's joint state once at :meth:`start`, then at ``rate_hz`` on a pacer."""
+@dataclass(frozen=True)
+class StateReading:
+    """Both views of one instant (see the module doc)."""
+
+    joints: JointStateSample
+    """``/joint_states``: the URDF's joints in SI units (and a mobile base's drive joints)."""
+    manifest: JointStateSample
+    """``/openral/manifest_joint_states``: the manifest's joints in manifest units."""
+
+
+class StateSource(Protocol):
+    """Where the publisher gets the newest reading."""
+
+    def reading(self) -> StateReading:
+        """The newest reading (the same object until the state changes)."""
+        ...
+
+
+class TickStates:
+    """The readings a control loop copies after every tick (see the module doc)."""
 
     def __init__(
         self,
-        node: Node,
-        hal: RobotHal,
-        lock: threading.Lock,
-        rate_hz: float,
-        *,
-        latest: LatestFn | None = None,
+        loop: ControlLoop,
+        tree: RobotTree | None = None,
+        data: mujoco.MjData | None = None,
         base: BaseDrive | None = None,
     ) -> None:
+        """Register with ``loop``, which captures the state it holds now at once.
+
+        Args:
+            loop: The control loop (its ``state`` is the manifest view).
+            tree: The robot's tree in the scene's model, for the SI view (None: the
+                manifest view on both topics).
+            data: The scene's live data (with ``tree``).
+            base: The mobile base, whose drive joints join the SI view.
+        """
+        self.loop, self.tree, self.data, self.base = loop, tree, data, base
+        self._latest: StateReading | None = None
+        loop.add_reader(self.capture)
+
+    def capture(self) -> None:
+        """Copy both views (the control loop calls it holding the HAL's lock)."""
+        manifest = self.loop.state
+        if manifest is None:
+            return
+        joints = manifest
+        if self.tree is not None and self.data is not None:
+            joints = self.tree.read_joints(self.data)
+        if self.base is not None:
+            joints = _joined(joints, self.base.joint_state())
+        self._latest = StateReading(joints, manifest)
+
+    def reading(self) -> StateReading:
+        """The last tick's reading.
+
+        Raises:
+            RuntimeError: No tick has stepped the scene yet (the loop ticks at start).
+        """
+        if self._latest is None:
+            raise RuntimeError("no control tick has stepped the scene yet")
+        return self._latest
+
+
+class HalStates:
+    """A HAL read at every publication, holding its lock."""
+
+    def __init__(self, hal: RobotHal, lock: threading.Lock) -> None:
+        self.hal, self.lock = hal, lock
+
+    def reading(self) -> StateReading:
+        """The HAL's state now (both views alike)."""
+        with self.lock:
+            sample = self.hal.read_state()
+        return StateReading(sample, sample)
+
+
+class JointStatePublisher:
+    """Publishes both views once at :meth:`start`, then at ``rate_hz`` on a pacer."""
+
+    def __init__(self, node: Node, rate_hz: float, source: StateSource) -> None:
         """Nothing is created until :meth:`start`.
 
         Args:
-            node: The node that owns the publisher.
-            hal: A connected HAL.
-            lock: The HAL's lock, held while the state is read.
+            node: The node that owns the publishers.
             rate_hz: Publish rate [Hz].
-            latest: The state as of the last control tick (see the module doc); None, or
-                a None from it, reads the HAL.
-            base: The robot's mobile base, whose drive joints are appended (None: none).
+            source: Where the readings come from.
         """
         self.node = node
-        self.hal = hal
-        self.lock = lock
         self.rate_hz = float(rate_hz)
-        self.latest = latest
-        self.base = base
+        self.source = source
         self.published = 0
-        """Messages published since :meth:`start`."""
-        self._publisher: Any = None
+        """Readings published since :meth:`start`."""
+        self._publishers: tuple[Any, Any] | None = None
         self._job: tuple[Pacer, PacedJob] | None = None
-        self._message: tuple[JointStateSample, Any] | None = None
+        self._messages: tuple[StateReading, Any, Any] | None = None
 
     def start(self, pacer: Pacer) -> None:
-        """Create the publisher, publish once, then once per period on ``pacer``."""
+        """Create the publishers, publish once, then once per period on ``pacer``."""
         self.stop()
-        self._publisher = self.node.create_publisher(JointState, JOINT_STATES, QUEUE_DEPTH)
+        node = self.node
+        self._publishers = (
+            node.create_publisher(JointState, JOINT_STATES, QUEUE_DEPTH),
+            node.create_publisher(JointState, MANIFEST_JOINT_STATES, QUEUE_DEPTH),
+        )
         self.published = 0
         self.publish()
         self._job = (pacer, pacer.every(1.0 / self.rate_hz, self.publish, "joint_states"))
 
     def stop(self) -> None:
-        """Unschedule the job and destroy the publisher (idempotent)."""
+        """Unschedule the job and destroy the publishers (idempotent)."""
         if self._job is not None:
             pacer, job = self._job
             self._job = None
             pacer.cancel(job)
-        if self._publisher is not None:
-            publisher, self._publisher = self._publisher, None
-            self.node.destroy_publisher(publisher)
-        self._message = None
+        if self._publishers is not None:
+            publishers, self._publishers = self._publishers, None
+            for publisher in publishers:
+                self.node.destroy_publisher(publisher)
+        self._messages = None
 
     def publish(self) -> None:
-        """Publish the state as of now."""
-        publisher = self._publisher
-        if publisher is not None:
-            publisher.publish(self._message_of(self._sample()))
-            self.published += 1
+        """Publish the newest reading."""
+        publishers = self._publishers
+        if publishers is None:
+            return
+        joints, manifest = self._messages_of(self.source.reading())
+        publishers[0].publish(joints)
+        publishers[1].publish(manifest)
+        self.published += 1
 
-    def _sample(self) -> JointStateSample:
-        sample = self.latest() if self.latest is not None else None
-        if sample is None:
-            with self.lock:
-                sample = self.hal.read_state()
-        return sample
+    def _messages_of(self, reading: StateReading) -> tuple[Any, Any]:
+        """The two messages of ``reading``, built once per reading."""
+        if self._messages is not None and self._messages[0] is reading:
+            return self._messages[1], self._messages[2]
+        joints = self._message(reading.joints)
+        manifest = joints if reading.manifest is reading.joints else None
+        manifest = manifest or self._message(reading.manifest)
+        self._messages = (reading, joints, manifest)
+        return joints, manifest
 
-    def _message_of(self, sample: JointStateSample) -> Any:
-        """The message of ``sample``, built once per sample."""
-        if self._message is not None and self._message[0] is sample:
-            return self._message[1]
+    def _message(self, sample: JointStateSample) -> Any:
         stamp = sim_stamp(self.node, sample.sim_time_s)
-        names, positions = sample.names, sample.positions
-        velocities, efforts = sample.velocities, sample.efforts
-        if self.base is not None:  # read on the pacer's thread, which also ticks: same state
-            with self.lock:
-                base = self.base.joint_state()
-            names += base.names
-            positions = np.concatenate([positions, base.positions])
-            velocities = np.concatenate([velocities, base.velocities])
-            efforts = np.concatenate([efforts, base.efforts])
-        message = ros_messages.joint_state_msg(names, positions, velocities, efforts, stamp)
-        self._message = (sample, message)
-        return message
+        return ros_messages.joint_state_msg(
+            sample.names, sample.positions, sample.velocities, sample.efforts, stamp
+        )
+
+
+def _joined(first: JointStateSample, second: JointStateSample) -> JointStateSample:
+    """``second``'s joints after ``first``'s (one instant)."""
+    return first._replace(
+        names=first.names + second.names,
+        positions=np.concatenate([first.positions, second.positions]),
+        velocities=np.concatenate([first.velocities, second.velocities]),
+        efforts=np.concatenate([first.efforts, second.efforts]),
+    )

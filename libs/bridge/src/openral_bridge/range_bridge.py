@@ -10,9 +10,9 @@ manifest ``rate_hz``:
   in the robot's base frame, without the robot (segmentation, and a margin of 1 cm plus a
   pixel around what the camera sees of it) and without anything out of range.
 
-The base frame is the manifest's ``mobile_base.base_frame`` for a mobile robot (the cloud
-moved by the static offset of the base's root body, ``BaseDrive.root_in_base_frame``), and
-``base_link`` at the robot's root body (the first body of its model) otherwise.
+The base frame is the robot's (``FrameNames.base``: the manifest's ``mobile_base.base_frame``,
+the cloud moved by the static offset of the base's root body,
+``BaseDrive.root_in_base_frame``; else ``frames.base``, at the robot's root body).
 
 A depth frame is rendered, and its cloud built, on a thread of the sensor's own
 (:class:`~openral_bridge.frame_renderer.FrameRenderer`, from a snapshot taken between two
@@ -44,8 +44,6 @@ if TYPE_CHECKING:
     from rclpy.node import Node
 
 QUEUE_DEPTH = 5
-FIXED_BASE_FRAME = "base_link"
-"""Frame of the clouds of a robot without a mobile base: its root body."""
 
 
 @dataclass
@@ -72,10 +70,9 @@ class RangeBridge:
             lock: The HAL's lock.
         """
         self.node, self.scene, self.lock = node, scene, lock
-        self.base_frame = FIXED_BASE_FRAME
+        self.base_frame = scene.robot.tables.frames.base
         self.base_offset = np.zeros(3, dtype=np.float32)
         if scene.base is not None:
-            self.base_frame = scene.base.wiring.base_frame
             self.base_offset = np.asarray(scene.base.root_in_base_frame, dtype=np.float32)
         self._streams: dict[str, _Stream] = {}
         self._pacer: Pacer | None = None

@@ -9,7 +9,7 @@ For each such sensor of the manifest (:mod:`openral_sim.state_sensors`):
 - ``force_torque`` → ``geometry_msgs/WrenchStamped`` on ``/openral/wrench/<name>``, in the
   site's frame (header frame ``frame_id``);
 - ``pose`` → ``geometry_msgs/PoseStamped`` on ``/openral/pose/<name>``, in the world frame
-  (header frame ``world``).
+  (header frame: the robot's world frame, ``frames.world``).
 
 A reading changes only when the control loop steps the scene, so each sensor publishes at
 its ``rate_hz`` or the control rate, whichever is lower (publishing faster would repeat
@@ -36,8 +36,6 @@ if TYPE_CHECKING:
     from rclpy.node import Node
 
 QUEUE_DEPTH = 10
-WORLD_FRAME = "world"
-"""Header frame of a pose sensor's messages: MuJoCo's world frame."""
 
 
 @dataclass
@@ -114,7 +112,7 @@ class StateSensorBridge:
         topic, msg_type, frame = {
             "imu": (imu(name), Imu, frame_id),
             "force_torque": (wrench(name), WrenchStamped, frame_id),
-            "pose": (pose(name), PoseStamped, WORLD_FRAME),
+            "pose": (pose(name), PoseStamped, self.scene.robot.tables.frames.world),
         }[kind]
         rate = min(float(rate_hz), self.control_rate_hz)
         package = msg_type.__module__.split(".")[0]

@@ -9,7 +9,19 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 JOINT_STATES = "/joint_states"
-"""sensor_msgs/JointState: every manifest joint under its canonical name."""
+"""sensor_msgs/JointState: every joint of the robot's URDF in SI units (manifest joints under
+their canonical names)."""
+MANIFEST_JOINT_STATES = "/openral/manifest_joint_states"
+"""sensor_msgs/JointState: the manifest's joints in manifest units (a gripper in its read
+mode), as a policy sees them in an episode."""
+TF = "/tf"
+"""tf2_msgs/TFMessage: the transforms that move (links on joints, a moving base)."""
+TF_STATIC = "/tf_static"
+"""tf2_msgs/TFMessage, latched: the transforms fixed between resets."""
+ROBOT_DESCRIPTION = "/robot_description"
+"""std_msgs/String, latched: the robot's URDF."""
+FOLLOW_JOINT_TRAJECTORY = "/openral/joint_trajectory_controller/follow_joint_trajectory"
+"""control_msgs/action/FollowJointTrajectory: the joint trajectory action (MoveIt's)."""
 CLOCK = "/clock"
 """rosgraph_msgs/Clock: simulation time."""
 ACTION_SPEC = "/openral/action_spec"

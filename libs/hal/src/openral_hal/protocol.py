@@ -9,7 +9,9 @@ spec's slots, and latches an E-stop. Capabilities are separate Protocols, checke
   HALs only; a real HAL never is);
 * :class:`MujocoBacked` exposes the live MuJoCo model and data;
 * :class:`MobileBaseHal` drives a mobile base with velocity commands and reports its
-  odometry (when its ``base`` is not None).
+  odometry (when its ``base`` is not None);
+* :class:`FramesHal` knows the TF frames of the robot and its sensors in its MuJoCo model
+  (:class:`~openral_sim.frame_tree.FrameTree`), read from its ``mujoco_handles``.
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ import numpy.typing as npt
 from openral_core.models import RobotDescription
 from openral_mujoco.state import FloatArray, JointStateSample
 from openral_sim.base_drive import BaseCommand, BaseDrive, BaseOdometry
+from openral_sim.frame_tree import FrameTree
 
 from openral_hal.errors import EStopLatched
 
@@ -158,6 +161,19 @@ class MobileBaseHal(RobotHal, Protocol):
 
     def base_odometry(self) -> BaseOdometry:
         """The base's pose in the odometry frame and twist in the base frame now."""
+        ...
+
+
+@runtime_checkable
+class FramesHal(MujocoBacked, Protocol):
+    """A simulated HAL whose robot and sensor frames can be read from its MuJoCo data."""
+
+    def frame_tree(self) -> FrameTree | None:
+        """The TF frames (None: this backend has none), laid out once.
+
+        Raises:
+            HalError: The model's layout cannot be stated as a tree.
+        """
         ...
 
 

@@ -26,6 +26,7 @@ from openral_core.models import RgbSensor, RobotDescription
 from openral_mujoco.action import validated_action
 from openral_mujoco.state import FloatArray, JointStateSample
 from openral_sim.base_drive import BaseCommand, BaseDrive, BaseOdometry
+from openral_sim.frame_tree import FrameTree
 from openral_sim.native_scene import NativeScene
 from openral_sim.rollout import (
     HoldingRollout,
@@ -165,6 +166,15 @@ class SimAttachedHAL(EStopLatch):
     def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
         """The scene's live MuJoCo (model, data), or None for a non-MuJoCo backend."""
         return self.env.mujoco_handles()
+
+    def frame_tree(self) -> FrameTree | None:
+        """The TF frames of the robot and its sensors in a native scene (None for another
+        backend; see :mod:`openral_sim.frame_tree`).
+
+        Raises:
+            HalError: The model's layout cannot be stated as a tree (see the message).
+        """
+        return self.env.frame_tree if isinstance(self.env, NativeScene) else None
 
     def camera_fovy_deg(self, sensor: str) -> float | None:
         """Vertical field of view of the scene camera that renders ``sensor`` (None when the

@@ -26,24 +26,31 @@ joint below the root, a second root body on a moving base, an unnamed joint) is 
 
 from __future__ import annotations
 
+import functools
 import math
+import time
 from dataclasses import dataclass
 from enum import StrEnum
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 from openral_core.models import LimitedJoint, RobotDescription
 from openral_core.tables import RobotTables, joint_name_map
 
 from openral_mujoco.errors import HalError
+from openral_mujoco.joint_coupling import effort_limit, followers
 from openral_mujoco.mobile_base import drive_geometry
 from openral_mujoco.robot_addresses import RobotAddresses
 from openral_mujoco.robot_bodies import robot_bodies, root_body
-from openral_mujoco.state import FloatArray
+from openral_mujoco.state import FloatArray, JointStateSample
 
+IntArray = npt.NDArray[np.intp]
 Vector = tuple[float, float, float]
 Quaternion = tuple[float, float, float, float]
 """w, x, y, z."""
+ORIGIN: Vector = (0.0, 0.0, 0.0)
+IDENTITY: Quaternion = (1.0, 0.0, 0.0, 0.0)
 UNLIMITED_SLIDE_M = 1000.0
 """Range written for a slide joint the model leaves unlimited [m] (a URDF slide needs one)."""
 
@@ -132,6 +139,26 @@ class RobotTree:
         joints = [link.joint for link in self.links if link.joint is not None]
         return tuple(sorted(joints, key=lambda j: not j.manifest))
 
+    @functools.cached_property
+    def _addresses(self) -> tuple[tuple[str, ...], IntArray, IntArray]:
+        joints = self.joints
+        qpos = np.array([j.qpos for j in joints], dtype=np.intp)
+        return tuple(j.name for j in joints), qpos, np.array([j.dof for j in joints], np.intp)
+
+    def read_joints(self, data: mujoco.MjData) -> JointStateSample:
+        """Every joint of the tree as ``data`` holds it, in SI units (positions [rad or m],
+        velocities, actuator forces [N·m or N]), in :attr:`joints` order; ``data`` must
+        belong to the model the tree was read from."""
+        names, qpos, dof = self._addresses
+        return JointStateSample(
+            names=names,
+            positions=data.qpos[qpos].copy(),
+            velocities=data.qvel[dof].copy(),
+            efforts=data.qfrc_actuator[dof].copy(),
+            stamp_ns=time.monotonic_ns(),
+            sim_time_s=float(data.time),
+        )
+
     def link(self, name: str) -> TreeLink:
         """The link called ``name``.
 
@@ -178,7 +205,7 @@ def robot_tree(
     joints = _JointReader(model, robot, addresses)
     links: list[TreeLink] = []
     if names[root] != base:
-        links.append(TreeLink(base, -1, None, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0), None))
+        links.append(TreeLink(base, -1, None, ORIGIN, IDENTITY, None))
     for body in bodies:
         parent = int(model.body_parentid[body])
         if parent == 0:  # a root body: under the base frame
@@ -187,7 +214,9 @@ def robot_tree(
                     f"body {names[body]!r} is a second root of the robot on a moving base"
                 )
             if body == root and names[root] == base:
-                links.append(TreeLink(base, root, None, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0), None))
+                links.append(
+                    TreeLink(base, root, None, (0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0), None)
+                )
                 continue
             position, quat = _relative(base_pose, _pose(zero, body))
             joint = None if body == root else joints.of(body, names[body])
@@ -240,7 +269,7 @@ class _JointReader:
         self.model = model
         mjcf_names = joint_name_map(robot)
         self.manifest = {mjcf_names[j.name]: j for j in robot.joints}
-        self.followers = _followers(model, robot, addresses)
+        self.followers = followers(model, robot, addresses)
 
     def of(self, body: int, body_name: str) -> TreeJoint | None:
         """The joint moving ``body`` (None: fixed), or TreeUnsupported."""
@@ -281,7 +310,9 @@ class _JointReader:
             lower=lower,
             upper=upper,
             velocity=float(declared.velocity_limit) if declared is not None else 0.0,
-            effort=float(declared.effort_limit) if declared is not None else _effort(model, joint),
+            effort=float(declared.effort_limit)
+            if declared is not None
+            else effort_limit(model, joint),
             qpos=int(model.jnt_qposadr[joint]),
             dof=int(model.jnt_dofadr[joint]),
             manifest=declared is not None,
@@ -311,54 +342,6 @@ class _JointReader:
             )
             out.append(TreeLink(**{**link.__dict__, "joint": followed}))
         return out
-
-
-def _followers(
-    model: mujoco.MjModel, robot: RobotDescription, addresses: RobotAddresses
-) -> dict[str, tuple[str, float, float]]:
-    """MJCF joint → (MJCF joint it follows, multiplier, offset) for every joint coupled to a
-    manifest joint it is not itself."""
-    manifest = set(joint_name_map(robot).values())
-
-    def name(joint: int) -> str:
-        return mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, int(joint)) or ""
-
-    found: dict[str, tuple[str, float, float]] = {}
-    for eq in range(model.neq):
-        if model.eq_type[eq] != mujoco.mjtEq.mjEQ_JOINT or not model.eq_active0[eq]:
-            continue
-        first, second = int(model.eq_obj1id[eq]), int(model.eq_obj2id[eq])
-        c0, c1, *higher = (float(v) for v in model.eq_data[eq, :5])
-        if second < 0 or c1 == 0.0 or any(higher):
-            continue  # a fixed joint, or not an affine coupling
-        q1 = float(model.qpos0[model.jnt_qposadr[first]])
-        q2 = float(model.qpos0[model.jnt_qposadr[second]])
-        # MuJoCo: q1 - q1_0 = c0 + c1 (q2 - q2_0)
-        if name(first) in manifest and name(second) not in manifest:
-            found[name(second)] = (name(first), 1.0 / c1, q2 - (q1 + c0) / c1)
-        elif name(second) in manifest and name(first) not in manifest:
-            found[name(first)] = (name(second), c1, q1 + c0 - c1 * q2)
-    for gripper in addresses.grippers:
-        mirror = gripper.mirror_actuator
-        if mirror is None or model.actuator_trntype[mirror] != mujoco.mjtTrn.mjTRN_JOINT:
-            continue
-        leader_qpos = int(addresses.qpos[gripper.slot])
-        leader = int(np.flatnonzero(model.jnt_qposadr == leader_qpos)[0])
-        found[name(model.actuator_trnid[mirror, 0])] = (name(leader), -1.0, 0.0)
-    return found
-
-
-def _effort(model: mujoco.MjModel, joint: int) -> float:
-    """Effort limit of a joint the manifest does not name: its actuator force range, else
-    the force range of an actuator driving it, else 0 (unknown)."""
-    if model.jnt_actfrclimited[joint]:
-        return float(np.max(np.abs(model.jnt_actfrcrange[joint])))
-    for actuator in range(model.nu):
-        driven = model.actuator_trntype[actuator] == mujoco.mjtTrn.mjTRN_JOINT
-        if driven and model.actuator_trnid[actuator, 0] == joint:
-            if model.actuator_forcelimited[actuator]:
-                return float(np.max(np.abs(model.actuator_forcerange[actuator])))
-    return 0.0
 
 
 # -- poses -----------------------------------------------------------------------------------

@@ -146,6 +146,13 @@ class BaseDrive:
         self._origin, self._origin_heading = self.geometry.pose(self._data.qpos)
 
     @property
+    def origin(self) -> tuple[float, float, float]:
+        """The odometry frame in the world: where the base frame was at the last reset, (x, y)
+        [m] and heading [rad]."""
+        x, y = (float(v) for v in self._origin)
+        return x, y, float(self._origin_heading)
+
+    @property
     def root_in_base_frame(self) -> tuple[float, float, float]:
         """Where the base's root body (``NativeScene.base_frame``, the frame depth clouds are
         given in) sits in the base frame (x, y, z) [m]: a static transform from

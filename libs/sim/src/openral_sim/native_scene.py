@@ -27,6 +27,7 @@ from any ``MjData`` of this model (``deploy sim`` renders snapshots on a thread 
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Iterable
 
@@ -45,6 +46,7 @@ from openral_mujoco.state import FloatArray, JointStateSample
 
 from openral_sim.base_drive import BASE_UPDATE_STEPS, BaseDrive
 from openral_sim.depth_cloud import DepthCamera, DepthFrame
+from openral_sim.frame_tree import FrameTree, scene_frame_tree
 from openral_sim.randomization import Randomizer
 from openral_sim.range_sensors import RangeSensors
 from openral_sim.rollout import Observation, StepResult
@@ -131,6 +133,7 @@ class NativeScene:
         """The scene file's seeded randomisation and success predicates."""
         self.addresses = addresses
         """Where the robot's joints are in :attr:`model` (per manifest joint)."""
+        self._cameras = dict(cameras)
         fixed = [  # the cameras the scene places (not on the robot, not the model's own)
             cameras[s.name]
             for s in description.sensors
@@ -175,6 +178,16 @@ class NativeScene:
     def base_frame(self) -> str:
         """MJCF name of the robot's root body, the frame depth clouds are given in."""
         return mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_BODY, self._root_body) or ""
+
+    @functools.cached_property
+    def frame_tree(self) -> FrameTree:
+        """The TF frames of the robot and of the sensors this scene serves
+        (:mod:`openral_sim.frame_tree`), laid out once.
+
+        Raises:
+            HalError: A layout a URDF tree cannot state, or two frames of one name.
+        """
+        return scene_frame_tree(self.model, self.robot, self.addresses, self._cameras, self.base)
 
     @property
     def depth_cameras(self) -> dict[str, DepthCamera]:

@@ -1,4 +1,5 @@
-"""``openral robot``: list, show, validate, check and scaffold the robots under robots/.
+"""``openral robot``: list, show, validate, check, scaffold and export (URDF) the robots
+under robots/.
 
 Examples::
 
@@ -8,6 +9,7 @@ Examples::
     openral robot validate path/to/robot.yaml
     openral robot check --all
     openral robot scaffold --mjcf pkg:<distribution>/<path>.xml --name my_arm
+    openral robot urdf franka_panda --out panda.urdf
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from openral_core.models import LimitedJoint
 from openral_core.registry import MANIFEST_NAME
 
 from openral_cli.console import err, highlighted, line, out, styled
+from openral_cli.console import error as print_error
 from openral_cli.help_text import command_group
 
 if TYPE_CHECKING:
@@ -327,3 +330,38 @@ def scaffold(
         f"`openral robot validate {typed}` and `openral robot check {typed}`",
         highlight=True,
     )
+
+
+@app.command("urdf")
+def urdf(
+    target: Annotated[str, typer.Argument(help="Robot id, manifest file or robot folder.")],
+    out_file: Annotated[
+        Path | None,
+        typer.Option("--out", help="File to write the URDF to.", show_default="standard output"),
+    ] = None,
+) -> None:
+    """The robot's URDF, as the ROS graph publishes it on /robot_description.
+
+    Mesh files (STL) are written once to the model cache and named by absolute path.
+    Exits 1 when the robot does not load or its model has no URDF form.
+    """
+    from openral_core import open_robot
+    from openral_mujoco.robot_tree import TreeUnsupported
+    from openral_sim.robot_description import robot_description
+
+    file = _manifest_file(target)
+    robot = open_robot(file, check_folder_name=file.name == MANIFEST_NAME)
+    try:
+        text = robot_description(robot)
+    except TreeUnsupported as problem:
+        print_error(f"robot {robot.name!r} has no URDF: {one_line(str(problem))}")
+        raise typer.Exit(1) from None
+    if out_file is None:
+        typer.echo(text, nl=False)
+        return
+    try:
+        out_file.write_text(text, encoding="utf-8")
+    except OSError as problem:
+        print_error(f"cannot write {out_file}: {problem.strerror or problem}")
+        raise typer.Exit(1) from None
+    err.print(f"wrote the URDF of {robot.name} to {out_file}", highlight=True)

@@ -1,0 +1,121 @@
+"""RobotStateStreams: what the manifest node publishes about the robot's own state.
+
+- ``/joint_states`` and ``/openral/manifest_joint_states``
+  (:class:`~openral_bridge.joint_state_publisher.JointStatePublisher`);
+- ``/tf`` and ``/tf_static`` (:class:`~openral_bridge.tf_publisher.TfPublisher`) and the
+  URDF on ``/robot_description`` (:class:`~openral_bridge.description_publisher.
+  DescriptionPublisher`), for a simulated HAL with a frame tree (a native scene).
+
+A model whose frames cannot be laid out as a tree is said once in the log; the graph then
+runs without ``/tf`` and ``/robot_description`` and ``/joint_states`` carries the manifest's
+joints.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import TYPE_CHECKING, Any
+
+from openral_bridge.control_loop import ControlLoop
+from openral_bridge.description_publisher import DescriptionPublisher
+from openral_bridge.joint_state_publisher import (
+    HalStates,
+    JointStatePublisher,
+    StateSource,
+    TickStates,
+)
+from openral_bridge.pacer import Pacer
+from openral_bridge.tf_publisher import TfPublisher
+from openral_bridge.topics import JOINT_STATES, MANIFEST_JOINT_STATES, TopicInfo
+from openral_core.loaded import LoadedRobot
+from openral_hal.errors import HalError
+from openral_hal.protocol import FramesHal, MobileBaseHal, RobotHal
+from openral_sim.frame_tree import FrameTree
+from openral_sim.robot_description import robot_description
+
+if TYPE_CHECKING:
+    from rclpy.node import Node
+
+
+class RobotStateStreams:
+    """The joint-state, TF and description publishers of one active node."""
+
+    def __init__(
+        self,
+        node: Node,
+        hal: RobotHal,
+        lock: threading.Lock,
+        loop: ControlLoop | None,
+        rate_hz: float,
+        robot: LoadedRobot | None,
+    ) -> None:
+        """Lay out the frames (nothing is published until :meth:`start`).
+
+        Args:
+            node: The node that owns the publishers and logs.
+            hal: The connected HAL.
+            lock: The HAL's lock.
+            loop: The control loop of a simulated HAL (None for a real one).
+            rate_hz: The joint-state rate, also the highest ``/tf`` rate [Hz].
+            robot: The loaded robot (for its URDF).
+        """
+        self.node, self.loop = node, loop
+        tree = self._frame_tree(hal) if loop is not None else None
+        data = _data(hal) if tree is not None else None
+        base = hal.base if isinstance(hal, MobileBaseHal) else None
+        source: StateSource = HalStates(hal, lock)
+        if loop is not None:
+            source = TickStates(loop, tree.tree if tree else None, data, base)
+        self.states = JointStatePublisher(node, rate_hz, source)
+        self.tf = TfPublisher(node, tree, data, rate_hz) if tree and data is not None else None
+        self.description = None
+        if self.tf is not None and robot is not None:
+            self.description = DescriptionPublisher(node, lambda: robot_description(robot))
+
+    def start(self, pacer: Pacer) -> None:
+        """Publish the joint states and transforms once now, then on ``pacer``; start
+        making the URDF."""
+        self.states.start(pacer)
+        if self.tf is not None and self.loop is not None:
+            self.tf.start(pacer, self.loop)
+        if self.description is not None:
+            self.description.start()
+
+    def after_reset(self) -> None:
+        """The static transforms again (a reset may move a camera and the odometry frame)."""
+        if self.tf is not None:
+            self.tf.publish_static()
+            self.tf.publish()
+
+    def stop(self) -> None:
+        """Stop every publisher (idempotent)."""
+        self.states.stop()
+        if self.tf is not None:
+            self.tf.stop()
+        if self.description is not None:
+            self.description.stop()
+
+    def topics(self) -> list[TopicInfo]:
+        """What these publish, with their nominal rates."""
+        kind, rate = "sensor_msgs/msg/JointState", self.states.rate_hz
+        rows = [TopicInfo(JOINT_STATES, kind, rate), TopicInfo(MANIFEST_JOINT_STATES, kind, rate)]
+        rows += self.tf.topics() if self.tf is not None else []
+        return rows + (self.description.topics() if self.description is not None else [])
+
+    def _frame_tree(self, hal: RobotHal) -> FrameTree | None:
+        if not isinstance(hal, FramesHal):
+            return None
+        try:
+            return hal.frame_tree()
+        except HalError as error:
+            self._log().error(f"no /tf or /robot_description for this robot: {error}")
+            return None
+
+    def _log(self) -> Any:
+        return self.node.get_logger()  # type: ignore[no-untyped-call]
+
+
+def _data(hal: RobotHal) -> Any:
+    """The HAL's live MuJoCo data (a FramesHal has it)."""
+    handles = hal.mujoco_handles() if isinstance(hal, FramesHal) else None
+    return handles[1] if handles is not None else None
