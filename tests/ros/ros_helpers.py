@@ -111,6 +111,7 @@ def info_topic(camera: str) -> str:
 
 PROBE_TOPICS: dict[str, Any] = {
     "/joint_states": JointState,
+    "/openral/manifest_joint_states": JointState,
     "/clock": Clock,
     ACTION_SPEC: JointState,
     **{image_topic(c): Image for c in CAMERAS},

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 from openral_bridge.topics import ACTION_SPEC, ESTOP, RELEASE_ESTOP, SAFE_ACTION
 from openral_core.models import RgbSensor
 from openral_mujoco.png import encode_png
@@ -60,6 +61,9 @@ def call_trigger(deployed: Deployed, service: str) -> Any:
         deployed.probe.node.destroy_client(client)
 
 
+MANIFEST_STATES = "/openral/manifest_joint_states"
+
+
 def test_deploy_publishes_joint_states_cameras_and_action_spec(deployed: Deployed) -> None:
     probe, description = deployed.probe, deployed.description
     for topic in [
@@ -70,10 +74,23 @@ def test_deploy_publishes_joint_states_cameras_and_action_spec(deployed: Deploye
     ]:
         probe.wait_count(topic, 1)
 
-    joints = probe.latest("/joint_states")
-    assert list(joints.name) == [j.name for j in description.joints]
-    assert len(joints.position) == len(description.joints)
+    manifest_joints = [j.name for j in description.joints]
+    probe.wait_count("/openral/manifest_joint_states", 1)
+
+    def same_tick() -> bool:
+        stamps = [probe.latest(t).header.stamp for t in ("/joint_states", MANIFEST_STATES)]
+        return stamps[0] == stamps[1]
+
+    probe.wait(same_tick, WAIT_S, "both joint-state views of one tick")
+    joints = probe.latest("/joint_states")  # the URDF's joints, SI: the mimic finger too
+    assert list(joints.name) == [*manifest_joints, "finger_joint2"]
     assert all(math.isfinite(v) for v in joints.position)
+    finger, mimic = joints.position[7], joints.position[8]
+    assert 0.0 <= finger <= 0.04 and abs(finger - mimic) < 1e-3  # metres, both fingers
+    manifest = probe.latest(MANIFEST_STATES)  # what a policy sees
+    assert list(manifest.name) == manifest_joints
+    assert list(manifest.position[:7]) == list(joints.position[:7])
+    assert manifest.position[7] == pytest.approx((finger + mimic) / 0.08, abs=1e-9)  # read mode
 
     sensors = {s.name: s for s in description.sensors if isinstance(s, RgbSensor)}
     for camera in CAMERAS:

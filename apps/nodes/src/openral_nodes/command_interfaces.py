@@ -6,13 +6,19 @@
 - ``/openral/joint_trajectory`` (``trajectory_msgs/JointTrajectory``): joints by manifest
   name, followed by the control loop (:mod:`openral_bridge.joint_path` says what is
   accepted); ``/openral/joint_trajectory/state`` (``sensor_msgs/JointState``) carries the
-  desired point after every tick that followed one, stamped in simulated time;
+  desired point after every tick that followed one, stamped in simulated time; a refused
+  trajectory's reason is published on ``/openral/joint_trajectory/refused``
+  (``std_msgs/String``), every one of them, since a topic has no reply;
+- the FollowJointTrajectory action (:mod:`openral_nodes.trajectory_action`), which shares
+  the follower and its rules with the topic;
 - ``/openral/estop`` and ``/openral/release_estop`` (``std_srvs/Trigger``); the E-stop also
   aborts a trajectory;
 - ``/openral/reset`` (``std_srvs/Trigger``): the scene back to its seed and start pose,
   carried out by the control loop's next tick; the answer says what was reset.
 
-Every refusal is a throttled warning naming the topic and the reason, and changes nothing.
+The three services run on a thread of their own (:mod:`openral_nodes.safety_services`).
+Every refusal is a warning naming the topic and the reason, throttled in the log, and
+changes nothing; an accepted trajectory is logged at debug level only.
 """
 
 from __future__ import annotations
@@ -25,23 +31,24 @@ from openral_bridge.control_loop import ControlLoop, ResetFailed
 from openral_bridge.joint_path import PathRefused
 from openral_bridge.joint_state_publisher import sim_stamp
 from openral_bridge.topics import (
-    ESTOP,
     JOINT_TRAJECTORY,
+    JOINT_TRAJECTORY_REFUSED,
     JOINT_TRAJECTORY_STATE,
-    RELEASE_ESTOP,
     RESET,
     SAFE_ACTION,
     TopicInfo,
 )
 from openral_bridge.trajectory_follower import DesiredPoint
+from openral_core.models import TrajectoryRules
 from openral_hal.errors import EStopLatched, HalError
 from openral_hal.protocol import RobotHal
 from openral_mujoco.action import validated_action
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray
-from std_srvs.srv import Trigger
+from std_msgs.msg import Float64MultiArray, String
 from trajectory_msgs.msg import JointTrajectory
 
+from openral_nodes.safety_services import SafetyServices
+from openral_nodes.trajectory_action import TrajectoryAction
 from openral_nodes.trajectory_request import request_from_msg
 
 if TYPE_CHECKING:
@@ -49,6 +56,8 @@ if TYPE_CHECKING:
 
 Entity = tuple[str, Any]
 """(``publisher`` | ``subscription`` | ``service``, the rclpy entity)."""
+TOPIC_SOURCE = JOINT_TRAJECTORY
+"""How a path from the topic is named in messages (``replaced by /openral/joint_trajectory``)."""
 
 
 class CommandInterfaces:
@@ -62,6 +71,7 @@ class CommandInterfaces:
         loop: ControlLoop | None,
         *,
         warn_every_s: float,
+        rules: TrajectoryRules | None = None,
     ) -> None:
         """Nothing is created until :meth:`create`.
 
@@ -71,6 +81,7 @@ class CommandInterfaces:
             lock: The HAL's lock.
             loop: The control loop of a simulated HAL (None for a real one).
             warn_every_s: At most one warning per this long for a stream of refusals [s].
+            rules: The robot's trajectory rules (default: the schema's defaults).
         """
         self.node = node
         self.hal = hal
@@ -83,16 +94,21 @@ class CommandInterfaces:
         """Actions refused."""
         self.trajectories_accepted = 0
         self.trajectories_refused = 0
+        self.rules = rules or TrajectoryRules()
+        self.action: TrajectoryAction | None = None
+        """The FollowJointTrajectory action while created (None: no trajectories here)."""
+        self._safety = SafetyServices(node.context, node.get_name())
         self._state_pub: Any = None
+        self._refused_pub: Any = None
 
     def create(self) -> list[Entity]:
-        """Create the subscriptions, services and the trajectory state publisher."""
+        """Create the subscriptions, the publishers, the action and the safety services."""
         node = self.node
         self._state_pub = node.create_publisher(JointState, JOINT_TRAJECTORY_STATE, 10)
-        if self.loop is not None:
-            self.loop.on_sample = self._publish_desired
-        return [
+        self._refused_pub = node.create_publisher(String, JOINT_TRAJECTORY_REFUSED, 10)
+        entities: list[Entity] = [
             ("publisher", self._state_pub),
+            ("publisher", self._refused_pub),
             (
                 "subscription",
                 node.create_subscription(Float64MultiArray, SAFE_ACTION, self._on_action, 10),
@@ -103,10 +119,23 @@ class CommandInterfaces:
                     JointTrajectory, JOINT_TRAJECTORY, self._on_trajectory, 10
                 ),
             ),
-            ("service", node.create_service(Trigger, ESTOP, self._on_estop)),
-            ("service", node.create_service(Trigger, RELEASE_ESTOP, self._on_release_estop)),
-            ("service", node.create_service(Trigger, RESET, self._on_reset)),
         ]
+        loop = self.loop
+        if loop is not None:
+            loop.on_sample = self._publish_desired
+        if loop is not None and loop.follower is not None:
+            action = TrajectoryAction(node, self.hal, self.lock, loop, loop.follower, self.rules)
+            action.create()
+            self.action = action
+        self._safety.start(self._on_estop, self._on_release_estop, self._on_reset)
+        return entities
+
+    def destroy(self) -> None:
+        """Stop the safety thread and the action (the node removes the other entities)."""
+        self._safety.stop()
+        if self.action is not None:
+            self.action.destroy()
+            self.action = None
 
     @property
     def follows_trajectories(self) -> bool:
@@ -115,10 +144,13 @@ class CommandInterfaces:
         return self.loop is not None and self.loop.follower is not None
 
     def topics(self) -> list[TopicInfo]:
-        """The trajectory state topic (published once per tick while a trajectory runs)."""
+        """The trajectory state topic (published once per tick while a trajectory runs) and
+        the refusals topic."""
         rate = 1.0 / self.loop.period_s if self.loop is not None else None
-        kind = "sensor_msgs/msg/JointState"
-        return [TopicInfo(JOINT_TRAJECTORY_STATE, kind, rate, "while moving")]
+        return [
+            TopicInfo(JOINT_TRAJECTORY_STATE, "sensor_msgs/msg/JointState", rate, "while moving"),
+            TopicInfo(JOINT_TRAJECTORY_REFUSED, "std_msgs/msg/String", None, "on a refusal"),
+        ]
 
     # -- topics ----------------------------------------------------------------------------
 
@@ -147,19 +179,20 @@ class CommandInterfaces:
                 raise PathRefused(self._why_no_trajectories())
             if self.hal.estopped:
                 raise PathRefused("the E-stop is latched")
-            request = request_from_msg(msg)
+            request = request_from_msg(msg, TOPIC_SOURCE)
             with self.lock:
                 hold = np.asarray(self.hal.hold_action(), dtype=np.float64)
-                now_s = loop.state.sim_time_s if loop.state is not None else None
-            if now_s is None:
+                state = loop.state
+            if state is None or state.sim_time_s is None:
                 raise PathRefused("the scene has no simulated time yet")
-            path = follower.submit(request, hold, now_s)
+            path = follower.submit(request, hold, state.sim_time_s, state.positions)
         except PathRefused as error:
             self.trajectories_refused += 1
             self._warn(f"{JOINT_TRAJECTORY}: trajectory refused: {error}")
+            self._refused_pub.publish(String(data=str(error)))
             return
         self.trajectories_accepted += 1
-        self._log().info(
+        self._log().debug(
             f"following a joint trajectory over {', '.join(path.names)}: "
             f"{len(path.times_s) - 1} point(s) from t={path.start_s:.3f} s to "
             f"t={path.end_s:.3f} s (simulated)"
@@ -181,7 +214,7 @@ class CommandInterfaces:
         with self.lock:  # a tick in progress ends first; none follows
             self.hal.estop()
         follower = self.loop.follower if self.loop is not None else None
-        aborted = follower is not None and follower.cancel()
+        aborted = follower is not None and follower.cancel("the E-stop latched")
         note = "; the joint trajectory is aborted" if aborted else ""
         self._log().warning(f"E-stop latched: actions are refused and the scene is frozen{note}")
         response.success, response.message = True, f"E-stop latched{note}"

@@ -54,7 +54,7 @@ from openral_bridge.control_loop import ControlLoop
 from openral_bridge.joint_state_publisher import sim_stamp
 from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.topics import ACTION_SPEC, CLOCK, TopicInfo
-from openral_bridge.trajectory_follower import TrajectoryFollower, path_limits
+from openral_bridge.trajectory_follower import follower_for
 from openral_core import LoadedRobot
 from openral_core.errors import OpenralError
 from openral_core.models import DeployScene, RobotDescription
@@ -298,7 +298,7 @@ class ManifestLifecycleNode(LifecycleNode):
         if can_tick(hal):
             robot = self._loaded
             joints = robot is not None and hal.action_names == hal.joint_names
-            follower = TrajectoryFollower(path_limits(robot)) if robot and joints else None
+            follower = follower_for(robot) if robot and joints else None
             self.loop = ControlLoop(
                 self,
                 hal,
@@ -323,8 +323,9 @@ class ManifestLifecycleNode(LifecycleNode):
         rate_hz = float(self._param("joint_state_rate_hz"))
         self.states = RobotStateStreams(self, hal, self.hal_lock, self.loop, rate_hz, self._loaded)
         self.states.start(pacer)
+        rules = self.description.trajectory if self.description is not None else None
         self.commands = CommandInterfaces(
-            self, hal, self.hal_lock, self.loop, warn_every_s=WARN_EVERY_S
+            self, hal, self.hal_lock, self.loop, warn_every_s=WARN_EVERY_S, rules=rules
         )
         self._entities += [("publisher", spec), *self.commands.create()]
 
@@ -351,6 +352,8 @@ class ManifestLifecycleNode(LifecycleNode):
             pacer, self.pacer = self.pacer, None
             if not pacer.stop():
                 self._log().warning("the periodic work did not stop within its timeout")
+        if self.commands is not None:  # its goals end before the loop that follows them
+            self.commands.destroy()
         if self.loop is not None:
             self.loop.stop()
             self.loop = None

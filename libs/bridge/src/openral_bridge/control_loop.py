@@ -124,6 +124,9 @@ class ControlLoop:
         self.on_reset = on_reset
         self.followed = 0
         """Ticks that glided along a trajectory."""
+        self.watchers: list[Callable[[JointStateSample], None]] = []
+        """Called in order with the state after every tick that stepped the scene (the HAL
+        lock not held), e.g. to judge a trajectory goal against its path."""
         self.readers: list[Callable[[], None]] = []
         """Called in order, holding the HAL lock, right after every tick that stepped the scene
         (and a reset's tick): each copies what it publishes from the live scene, so nothing
@@ -160,7 +163,7 @@ class ControlLoop:
             reset.error = "the control loop stopped before the reset"
             reset.done.set()
         if self.follower is not None:
-            self.follower.cancel()
+            self.follower.cancel("the control loop stopped")
 
     def add_reader(self, read: Callable[[], None]) -> None:
         """Run ``read`` after every tick that steps (see :attr:`readers`), and once now,
@@ -173,7 +176,8 @@ class ControlLoop:
     def offer(self, action: FloatArray) -> bool:
         """Make ``action`` (already validated) the one the next tick applies (any thread);
         it pre-empts a joint trajectory. True when it ended one."""
-        preempted = self.follower.cancel() if self.follower is not None else False
+        follower = self.follower
+        preempted = follower.cancel("a safe_action pre-empted it") if follower else False
         with self._pending_lock:
             if self._pending is not None:
                 self.superseded += 1
@@ -226,12 +230,12 @@ class ControlLoop:
                     self._read()
         except Exception as error:  # a diverged scene, or a bug: never the end of the graph
             self.state = None
-            self._abort_trajectory()
+            self._abort_trajectory(f"the control tick failed ({type(error).__name__})")
             self._failed(error)
             return
         if not stepped:  # E-stopped: time is frozen on purpose, the action is dropped
             self.watch.restart()
-            self._abort_trajectory()
+            self._abort_trajectory("the E-stop is latched: the scene did not step")
             if action is not None and sample is None:
                 with self._pending_lock:
                     self.superseded += 1
@@ -260,6 +264,9 @@ class ControlLoop:
             self.followed += 1
             if self.on_sample is not None:
                 self.on_sample(sample)
+        if state is not None:
+            for watch in self.watchers:
+                watch(state)
         if sim_time is not None:
             self._check_pace(sim_time)
 
@@ -269,7 +276,7 @@ class ControlLoop:
         try:
             with self.lock:
                 if self.follower is not None:  # the old path never runs from the reset pose
-                    self.follower.cancel()
+                    self.follower.cancel("the scene was reset")
                 request.text = self.hal.reset()
                 stepped = self.hal.tick(None)
                 self.state = self.hal.read_state() if stepped else None
@@ -299,9 +306,9 @@ class ControlLoop:
             self.superseded += 1
             self._pending = None
 
-    def _abort_trajectory(self) -> None:
-        if self.follower is not None and self.follower.cancel():
-            self._log().warning("joint trajectory aborted: the scene did not step")
+    def _abort_trajectory(self, reason: str) -> None:
+        if self.follower is not None and self.follower.cancel(reason):
+            self._log().warning(f"joint trajectory aborted: {reason}")
 
     def _check_pace(self, sim_time: float) -> None:
         factor = self.watch.update(time.monotonic(), sim_time)

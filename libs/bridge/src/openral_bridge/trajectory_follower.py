@@ -10,16 +10,20 @@ does not name keep their targets.
 Replacement follows joint_trajectory_controller: a new trajectory starts at its start time
 (its header stamp in simulated time, or now), from where the running one will be then; a
 waiting one is dropped by a newer one. :meth:`cancel` ends both (a ``safe_action``, the
-E-stop, a reset). Every method may be called from any thread.
+E-stop, a reset, a cancelled goal). Whoever sent a path learns when it ends early, and why,
+through :attr:`TrajectoryFollower.on_end` (a FollowJointTrajectory goal is aborted then).
+Every method may be called from any thread.
 """
 
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from openral_core.loaded import LoadedRobot
+from openral_core.models import TrajectoryRules
 from openral_mujoco.command_limits import CommandLimits
 from openral_mujoco.state import FloatArray
 
@@ -54,6 +58,13 @@ def path_limits(robot: LoadedRobot) -> PathLimits:
     )
 
 
+def follower_for(robot: LoadedRobot) -> TrajectoryFollower:
+    """The follower of a HAL whose action slots are ``robot``'s manifest joints, with its
+    envelope and start tolerance."""
+    rules = robot.description.trajectory or TrajectoryRules()
+    return TrajectoryFollower(path_limits(robot), rules.start_tolerance)
+
+
 @dataclass(frozen=True)
 class DesiredPoint:
     """Where a path wants its joints at one instant."""
@@ -68,9 +79,20 @@ class DesiredPoint:
 class TrajectoryFollower:
     """The running and waiting paths of one control loop (see the module doc)."""
 
-    def __init__(self, limits: PathLimits) -> None:
-        """Follow paths over the action slots ``limits`` describes."""
+    def __init__(self, limits: PathLimits, start_tolerance: float = 0.0) -> None:
+        """Follow paths over the action slots ``limits`` describes.
+
+        Args:
+            limits: The manifest's envelope per action slot.
+            start_tolerance: How far a first point at time 0 may be from the measured
+                position to be joined from there [rad or m] (the manifest's
+                ``trajectory.start_tolerance``; 0: never).
+        """
         self.limits = limits
+        self.start_tolerance = float(start_tolerance)
+        self.on_end: Callable[[JointPath, str], None] | None = None
+        """Told about each path that ends before its last point, and why (any thread, no
+        lock of the follower held)."""
         self._lock = threading.Lock()
         self._running: JointPath | None = None
         self._waiting: JointPath | None = None
@@ -85,7 +107,13 @@ class TrajectoryFollower:
         with self._lock:
             return self._running is not None or self._waiting is not None
 
-    def submit(self, request: TrajectoryRequest, targets: FloatArray, now_s: float) -> JointPath:
+    def submit(
+        self,
+        request: TrajectoryRequest,
+        targets: FloatArray,
+        now_s: float,
+        measured: FloatArray | None = None,
+    ) -> JointPath:
         """Plan ``request`` from where the joints will be at its start and make it the next
         path (waiting until its start time, or running from the next tick).
 
@@ -93,6 +121,8 @@ class TrajectoryFollower:
             request: The trajectory as received.
             targets: The action in force now (the hold action), one value per slot.
             now_s: Simulated time now [s] (the last tick's).
+            measured: Where the joints are measured now, one value per slot (None: unknown;
+                a first point far from the targets is then refused).
 
         Raises:
             PathRefused: The trajectory breaks a rule; nothing changes.
@@ -104,19 +134,39 @@ class TrajectoryFollower:
                 point, speed = self._running.sample(begin)
                 positions[self._running.slots] = point
                 velocities[self._running.slots] = speed
-            path = plan_path(request, self.limits, PathStart(now_s, positions, velocities))
-            if self._waiting is not None:
+            start = PathStart(now_s, positions, velocities, measured, self.start_tolerance)
+            path = plan_path(request, self.limits, start)
+            dropped, self._waiting = self._waiting, path
+            if dropped is not None:
                 self.cancelled += 1
-            self._waiting = path
-            return path
+        if dropped is not None:
+            self._ended(dropped, f"replaced by {path.source} before it started")
+        return path
 
-    def cancel(self) -> bool:
-        """End the running and the waiting path; True when there was one."""
+    def cancel(self, reason: str = "cancelled", path: JointPath | None = None) -> bool:
+        """End the running and the waiting path (only ``path``, when given); True when one
+        ended. ``reason`` goes to :attr:`on_end`."""
         with self._lock:
             ended = [p for p in (self._running, self._waiting) if p is not None]
-            self._running = self._waiting = None
+            if path is not None:
+                ended = [p for p in ended if p is path]
+            if self._running in ended:
+                self._running = None
+            if self._waiting in ended:
+                self._waiting = None
             self.cancelled += len(ended)
-            return bool(ended)
+        for gone in ended:
+            self._ended(gone, reason)
+        return bool(ended)
+
+    def follows(self, path: JointPath) -> bool:
+        """True while ``path`` runs or waits for its start time."""
+        with self._lock:
+            return path is self._running or path is self._waiting
+
+    def _ended(self, path: JointPath, reason: str) -> None:
+        if self.on_end is not None:
+            self.on_end(path, reason)
 
     def next_action(
         self, hold: FloatArray, now_s: float, period_s: float
@@ -130,14 +180,19 @@ class TrajectoryFollower:
             period_s: The control period [s].
         """
         end_s = now_s + period_s
+        replaced = None
         with self._lock:
             waiting = self._waiting
             if waiting is not None and waiting.start_s < end_s - SAME_TIME_S:
                 if self._running is not None:
                     self.cancelled += 1
+                    replaced = self._running
                 self._running, self._waiting = waiting, None
             path = self._running
-            if path is None:
+        if replaced is not None and path is not None:
+            self._ended(replaced, f"replaced by {path.source}")
+        with self._lock:
+            if path is None or path is not self._running:
                 return None
             finishing = end_s >= path.end_s - SAME_TIME_S
             # the last period ends exactly on the last point, even a rounding error early
