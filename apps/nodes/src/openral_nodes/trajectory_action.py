@@ -211,8 +211,8 @@ class TrajectoryAction:
         if progress.outcome is Outcome.SUCCEEDED:
             self._end(goal, "succeed", Result.SUCCESSFUL, progress.message)
         elif progress.outcome in VIOLATIONS:
-            self.follower.cancel(progress.message, goal.path)  # hold where they are
             self._end(goal, "abort", VIOLATIONS[progress.outcome], progress.message)
+            self.follower.cancel(progress.message, goal.path)  # hold where they are
 
     def _path_ended(self, path: JointPath, reason: str) -> None:
         """The follower ended ``path`` early (any thread)."""

@@ -1,12 +1,14 @@
 """Send one joint trajectory to a live graph and watch it run, as a ROS client would.
 
-What ``openral rskill trajectory`` does: read where the joints are on ``/joint_states``,
-send a two-point ``trajectory_msgs/JointTrajectory`` on ``/openral/joint_trajectory``
+What ``openral rskill trajectory`` does: read where the joints are on
+``/openral/manifest_joint_states`` (the manifest's units, the units a trajectory is given
+in), send a two-point ``trajectory_msgs/JointTrajectory`` on ``/openral/joint_trajectory``
 (from there at time 0 to the goals at ``seconds``; with ``cubic`` both points carry zero
 velocities, so the path starts and stops smoothly), then follow
 ``/openral/joint_trajectory/state`` until the last desired point and compare each desired
-point with ``/joint_states`` of the same simulated time: the tracking error. A refusal is
-read where a ROS user reads it, on ``/rosout`` (the node's warning), and reported at once.
+point with the joint states of the same simulated time: the tracking error. A refusal is
+read on ``/openral/joint_trajectory/refused``, where the graph publishes every one (its log
+warnings are throttled), and reported at once with its reason.
 """
 
 from __future__ import annotations
@@ -19,19 +21,22 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from openral_bridge.topics import JOINT_STATES, JOINT_TRAJECTORY, JOINT_TRAJECTORY_STATE
+from openral_bridge.topics import (
+    JOINT_TRAJECTORY,
+    JOINT_TRAJECTORY_REFUSED,
+    JOINT_TRAJECTORY_STATE,
+    MANIFEST_JOINT_STATES,
+)
 from openral_core.errors import OpenralError, did_you_mean
-from rcl_interfaces.msg import Log
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
+from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory
 
 from openral_nodes.trajectory_request import trajectory_msg
 
-ROSOUT = "/rosout"
-"""Where every node's log lines go (rcl_interfaces/Log)."""
-REFUSED = f"{JOINT_TRAJECTORY}: trajectory refused: "
-"""How the manifest node's warning about a refused trajectory begins."""
+JOINT_STATES = MANIFEST_JOINT_STATES
+"""Where the joints are read: in the manifest's units, as trajectories give them."""
 SETTLE_S = 1.0
 """How long after the last desired point the joints are read as reached [s, wall]."""
 
@@ -88,7 +93,7 @@ class TrajectorySender:
         self._desired: list[Any] = []
         self._refusals: list[str] = []
         node.create_subscription(JointState, JOINT_STATES, self._on_state, 50)
-        node.create_subscription(Log, ROSOUT, self._on_log, 50)
+        node.create_subscription(String, JOINT_TRAJECTORY_REFUSED, self._on_refused, 50)
         node.create_subscription(JointState, JOINT_TRAJECTORY_STATE, self._on_desired, 50)
         self.publisher = node.create_publisher(JointTrajectory, JOINT_TRAJECTORY, 10)
 
@@ -107,7 +112,7 @@ class TrajectorySender:
 
         Raises:
             TrajectoryNotRun: No joint states or subscriber within ``timeout_s``, an unknown
-                joint, the graph refused the trajectory (its warning on ``/rosout``), or no
+                joint, the graph refused the trajectory (the reason it published), or no
                 desired point arrived.
         """
         now = self._wait(lambda: bool(self._states), timeout_s, f"no {JOINT_STATES}")
@@ -196,12 +201,10 @@ class TrajectorySender:
             del self._states[:-2000]  # bounded: ~40 s of joint states at 50 Hz
             self._lock.notify_all()
 
-    def _on_log(self, msg: Any) -> None:
-        text = str(msg.msg)
-        if text.startswith(REFUSED):
-            with self._lock:
-                self._refusals.append(text.removeprefix(REFUSED))
-                self._lock.notify_all()
+    def _on_refused(self, msg: Any) -> None:
+        with self._lock:
+            self._refusals.append(str(msg.data))
+            self._lock.notify_all()
 
     def _on_desired(self, msg: Any) -> None:
         with self._lock:

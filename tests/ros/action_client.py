@@ -1,0 +1,102 @@
+"""A FollowJointTrajectory client of a live graph, as MoveIt's controller handle is one: send
+a goal, collect its feedback, cancel it, read its result."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+from builtin_interfaces.msg import Duration
+from control_msgs.action import FollowJointTrajectory
+from control_msgs.msg import JointTolerance
+from openral_bridge.topics import FOLLOW_JOINT_TRAJECTORY
+from rclpy.action import ActionClient
+from rclpy.node import Node
+from trajectory_msgs.msg import JointTrajectoryPoint
+
+from tests.ros.ros_helpers import wait_until
+
+PANDA_ARM = tuple(f"panda_joint{i}" for i in range(1, 8))
+
+
+def duration(seconds: float) -> Any:
+    """A builtin_interfaces/Duration of ``seconds`` (>= 0)."""
+    nanoseconds = round(seconds * 1e9)
+    return Duration(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
+
+
+def goal(
+    names: tuple[str, ...],
+    points: list[tuple[float, list[float]]],
+    *,
+    goal_tolerance: float = 0.0,
+    goal_time_s: float = 0.0,
+    path_tolerance: float = 0.0,
+) -> Any:
+    """A goal through ``points`` ((time [s], positions)), at rest at each point."""
+    message = FollowJointTrajectory.Goal()
+    message.trajectory.joint_names = list(names)
+    for time_s, positions in points:
+        message.trajectory.points.append(
+            JointTrajectoryPoint(
+                positions=[float(v) for v in positions],
+                velocities=[0.0] * len(names),
+                time_from_start=duration(time_s),
+            )
+        )
+    if goal_tolerance:
+        message.goal_tolerance = [JointTolerance(name=n, position=goal_tolerance) for n in names]
+    if path_tolerance:
+        message.path_tolerance = [JointTolerance(name=n, position=path_tolerance) for n in names]
+    message.goal_time_tolerance = duration(goal_time_s)
+    return message
+
+
+@dataclass
+class Sent:
+    """One goal sent: its handle, the feedback received (wall time, message), its result."""
+
+    handle: Any
+    feedback: list[tuple[float, Any]] = field(default_factory=list)
+
+
+class TrajectoryActionClient:
+    """FollowJointTrajectory on a node spun by the caller."""
+
+    def __init__(self, node: Node, timeout_s: float = 30.0) -> None:
+        self.client = ActionClient(node, FollowJointTrajectory, FOLLOW_JOINT_TRAJECTORY)
+        assert self.client.wait_for_server(timeout_sec=timeout_s), "no action server"
+
+    def send(self, message: Any, timeout_s: float = 10.0) -> Sent:
+        """Send ``message`` and wait for its acceptance."""
+        feedback: list[tuple[float, Any]] = []
+        future = self.client.send_goal_async(
+            message, feedback_callback=lambda f: feedback.append((time.monotonic(), f.feedback))
+        )
+        wait_until(future.done, timeout_s, "the goal's acceptance")
+        handle = future.result()
+        assert handle.accepted, "the server rejected the goal"
+        return Sent(handle, feedback)
+
+    def result(self, sent: Sent, timeout_s: float = 30.0) -> tuple[int, Any]:
+        """(status, result) once the goal has ended."""
+        future = sent.handle.get_result_async()
+        wait_until(future.done, timeout_s, "the goal's result")
+        response = future.result()
+        return int(response.status), response.result
+
+    def cancel(self, sent: Sent, timeout_s: float = 10.0) -> Any:
+        """Ask to cancel ``sent``; the cancel response."""
+        future = sent.handle.cancel_goal_async()
+        wait_until(future.done, timeout_s, "the cancel response")
+        return future.result()
+
+    def run(self, message: Any, timeout_s: float = 30.0) -> tuple[int, Any, Sent]:
+        """Send ``message`` and wait for its end: (status, result, sent)."""
+        sent = self.send(message)
+        status, result = self.result(sent, timeout_s)
+        return status, result, sent
+
+    def destroy(self) -> None:
+        self.client.destroy()

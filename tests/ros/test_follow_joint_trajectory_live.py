@@ -1,0 +1,183 @@
+"""FollowJointTrajectory against the live franka tabletop, from outside, as MoveIt uses it.
+
+``openral deploy sim`` runs as a subprocess; an rclpy action client on its domain sends
+goals to ``/openral/joint_trajectory_controller/follow_joint_trajectory``:
+
+- 3 points over 3 s on panda_joint1..7 succeed with goal tolerance 0.01 rad, with feedback
+  every control tick (stamps 0.05 s of simulated time apart);
+- an unknown joint ends ABORTED with INVALID_JOINTS, a trajectory that ended before now with
+  OLD_HEADER_TIMESTAMP, a tiny path tolerance with PATH_TOLERANCE_VIOLATED and an unmeetable
+  goal tolerance with GOAL_TOLERANCE_VIOLATED after goal_time_tolerance, each with its
+  reason;
+- the E-stop aborts a running goal (and refuses the next); a newer goal pre-empts the
+  running one; a cancelled goal ends CANCELED and its path stops within one control tick.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+from action_msgs.msg import GoalStatus
+from control_msgs.action import FollowJointTrajectory
+from openral_bridge.topics import ESTOP, JOINT_STATES, JOINT_TRAJECTORY_STATE, RELEASE_ESTOP
+
+from tests.ros.action_client import PANDA_ARM, TrajectoryActionClient, goal
+from tests.ros.trajectory_client import Client, franka_graph, stamp_s
+
+Result = FollowJointTrajectory.Result
+PERIOD_S = 0.05
+"""The franka tabletop's control period [s]."""
+
+
+@pytest.fixture(scope="module")
+def client(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Client]:
+    yield from franka_graph(tmp_path_factory.mktemp("follow_joint_trajectory"))
+
+
+@pytest.fixture(scope="module")
+def action(client: Client) -> Iterator[TrajectoryActionClient]:
+    action = TrajectoryActionClient(client.probe.node)
+    yield action
+    action.destroy()
+
+
+def _arm(client: Client) -> np.ndarray:
+    """Where panda_joint1..7 are now (/joint_states)."""
+    msg = client.probe.latest(JOINT_STATES)
+    names = list(msg.name)
+    return np.array([msg.position[names.index(n)] for n in PANDA_ARM])
+
+
+def _move(q: np.ndarray, by: float, seconds: float = 2.0, **tolerances: float) -> object:
+    return goal(PANDA_ARM, [(0.0, q.tolist()), (seconds, (q + by).tolist())], **tolerances)
+
+
+def test_a_three_point_goal_succeeds_within_0_01_rad_with_feedback_every_tick(
+    client: Client, action: TrajectoryActionClient
+) -> None:
+    q0 = _arm(client)
+    points = [(0.0, q0.tolist()), (1.5, (q0 + 0.15).tolist()), (3.0, (q0 + 0.25).tolist())]
+    message = goal(PANDA_ARM, points, goal_tolerance=0.01, goal_time_s=1.0)
+    status, result, sent = action.run(message)
+    assert (status, result.error_code) == (GoalStatus.STATUS_SUCCEEDED, Result.SUCCESSFUL)
+    reached = _arm(client)
+    print(f"reached - goal: {np.round(reached - q0 - 0.25, 4).tolist()} rad")
+    assert np.abs(reached - (q0 + 0.25)).max() < 0.01
+    stamps = np.array([stamp_s(f) for _, f in sent.feedback])
+    wall = np.diff([t for t, _ in sent.feedback])
+    print(f"{len(stamps)} feedback messages, wall interval median {np.median(wall):.4f} s")
+    assert len(stamps) >= 3.0 / PERIOD_S - 2  # one per tick over the 3 s
+    np.testing.assert_allclose(np.diff(stamps), PERIOD_S, atol=1e-6)  # every tick, none twice
+    last = sent.feedback[-1][1]
+    assert list(last.joint_names) == list(PANDA_ARM)
+    np.testing.assert_allclose(
+        np.array(last.error.positions),
+        np.array(last.desired.positions) - np.array(last.actual.positions),
+    )
+    status, _, _ = action.run(_move(reached, -0.25, seconds=2.0))  # back where it started
+    assert status == GoalStatus.STATUS_SUCCEEDED
+
+
+@pytest.mark.parametrize(
+    ("case", "code", "words"),
+    [
+        ("unknown joint", Result.INVALID_JOINTS, "'panda_joint8' is not a joint of this robot"),
+        ("old stamp", Result.OLD_HEADER_TIMESTAMP, "before now"),
+        ("NaN", Result.INVALID_GOAL, "panda_joint3 is nan"),
+        ("bad tolerance", Result.INVALID_GOAL, "goal_tolerance[0].position is -2.0"),
+    ],
+)
+def test_a_bad_goal_ends_aborted_with_its_code_and_reason(
+    client: Client, action: TrajectoryActionClient, case: str, code: int, words: str
+) -> None:
+    q = _arm(client)
+    message = _move(q, 0.1)
+    trajectory = message.trajectory  # type: ignore[attr-defined]
+    if case == "unknown joint":
+        trajectory.joint_names[-1] = "panda_joint8"
+    elif case == "old stamp":  # started 5 s ago, ended 3 s ago
+        client.probe.wait(lambda: client.now_s() > 6.0, 30.0, "6 s of simulated time")
+        trajectory.header.stamp.sec = int(client.now_s()) - 5
+    elif case == "NaN":
+        trajectory.points[1].positions[2] = float("nan")
+    else:
+        message = _move(q, 0.1, goal_tolerance=-2.0)
+    status, result, _ = action.run(message)
+    assert (status, result.error_code) == (GoalStatus.STATUS_ABORTED, code)
+    assert words in result.error_string
+    assert np.abs(_arm(client) - q).max() < 0.005  # nothing moved
+
+
+def test_path_and_goal_tolerance_violations_abort_with_their_codes(
+    client: Client, action: TrajectoryActionClient
+) -> None:
+    q = _arm(client)
+    status, result, _ = action.run(_move(q, 0.2, path_tolerance=1e-4))
+    assert (status, result.error_code) == (
+        GoalStatus.STATUS_ABORTED,
+        Result.PATH_TOLERANCE_VIOLATED,
+    )
+    assert "(path_tolerance)" in result.error_string
+    q = _arm(client)
+    started = client.now_s()
+    message = _move(q, 0.05, seconds=1.0, goal_tolerance=1e-6, goal_time_s=0.3)
+    status, result, _ = action.run(message)
+    assert (status, result.error_code) == (
+        GoalStatus.STATUS_ABORTED,
+        Result.GOAL_TOLERANCE_VIOLATED,
+    )
+    assert "0.3 s after the trajectory's last point" in result.error_string
+    assert client.now_s() - started >= 1.3 - PERIOD_S  # it waited out goal_time_tolerance
+
+
+def test_the_estop_aborts_a_running_goal_and_refuses_the_next(
+    client: Client, action: TrajectoryActionClient
+) -> None:
+    q = _arm(client)
+    sent = action.send(_move(q, -0.2, seconds=3.0))
+    client.probe.wait(lambda: len(sent.feedback) >= 10, 10.0, "10 feedback messages")
+    response = client.call(ESTOP)
+    assert response.success and "aborted" in response.message
+    status, result = action.result(sent)
+    assert status == GoalStatus.STATUS_ABORTED
+    assert result.error_string == "the trajectory stopped: the E-stop latched"
+    status, result, _ = action.run(_move(_arm(client), 0.1))
+    assert (status, result.error_string) == (GoalStatus.STATUS_ABORTED, "the E-stop is latched")
+    assert client.call(RELEASE_ESTOP).success
+
+
+def test_a_newer_goal_preempts_the_running_one(
+    client: Client, action: TrajectoryActionClient
+) -> None:
+    q = _arm(client)
+    first = action.send(_move(q, 0.3, seconds=3.0))
+    client.probe.wait(lambda: len(first.feedback) >= 10, 10.0, "10 feedback messages")
+    second = action.send(_move(q, 0.0, seconds=1.0))  # back to q at rest: from where it is
+    status, result = action.result(first)
+    assert (status, result.error_code) == (GoalStatus.STATUS_ABORTED, Result.INVALID_GOAL)
+    assert result.error_string == "pre-empted by a newer goal"
+    assert action.result(second)[0] == GoalStatus.STATUS_SUCCEEDED
+
+
+def test_a_cancelled_goal_stops_its_path_within_one_control_tick(
+    client: Client, action: TrajectoryActionClient
+) -> None:
+    q = _arm(client)
+    sent = action.send(_move(q, 0.3, seconds=3.0))
+    client.probe.wait(lambda: len(sent.feedback) >= 20, 10.0, "20 feedback messages")
+    cancel_wall, cancel_sim = time.monotonic(), client.now_s()
+    assert len(action.cancel(sent).goals_canceling) == 1
+    status, _ = action.result(sent)
+    assert status == GoalStatus.STATUS_CANCELED
+    time.sleep(0.5)
+    later = [
+        stamp_s(r.msg)
+        for r in client.probe.since(JOINT_TRAJECTORY_STATE, cancel_wall)
+        if stamp_s(r.msg) > cancel_sim + 2 * PERIOD_S + 1e-6  # the /clock seen lags a tick
+    ]
+    assert not later, f"desired points after the cancel: {later}"
+    moved = _arm(client) - q
+    assert 0.0 < moved.max() < 0.3  # stopped part-way
