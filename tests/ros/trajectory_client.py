@@ -20,6 +20,7 @@ from openral_bridge.topics import (
     ESTOP,
     JOINT_STATES,
     JOINT_TRAJECTORY,
+    JOINT_TRAJECTORY_REFUSED,
     JOINT_TRAJECTORY_STATE,
     RELEASE_ESTOP,
     RESET,
@@ -29,7 +30,7 @@ from openral_bridge.topics import (
 from openral_nodes.runtime import Spinner, claim_domain_id, ros_session
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import Image, JointState
-from std_msgs.msg import Float64MultiArray
+from std_msgs.msg import Float64MultiArray, String
 from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory
 
@@ -99,7 +100,12 @@ class Client:
 def franka_graph(logs: Path) -> Iterator[Client]:
     """The franka tabletop as a live graph and a client of it (a fixture's body)."""
     domain = claim_domain_id()
-    topics = {JOINT_STATES: JointState, CLOCK: Clock, JOINT_TRAJECTORY_STATE: JointState}
+    topics = {
+        JOINT_STATES: JointState,
+        CLOCK: Clock,
+        JOINT_TRAJECTORY_STATE: JointState,
+        JOINT_TRAJECTORY_REFUSED: String,
+    }
     with ros_session(domain_id=domain) as context:
         probe = Probe(context, {**topics, WRIST: Image}, name="trajectory_client")
         with Spinner(context) as spinner, deploy_sim(FRANKA_SCENE, domain, logs) as process:

@@ -17,7 +17,9 @@ Example::
 from __future__ import annotations
 
 import fcntl
+import math
 import os
+import sys
 import tempfile
 import threading
 import time
@@ -42,6 +44,8 @@ LATCHED = QoSProfile(  # type: ignore[no-untyped-call]
 
 T = TypeVar("T")
 
+REPORT_EVERY_S = 2.0
+"""At most one line per this many seconds about callbacks that raise [s]."""
 SPIN_PERIOD_S = 0.5
 """Longest wait of one ``spin_once`` [s]; bounds how late a stop request (Ctrl-C, a
 signal) is noticed. Each timeout is an executor wake that rebuilds its wait set, so a
@@ -211,16 +215,28 @@ def spin_until(
 ) -> bool:
     """Spin ``executor`` on the calling thread until ``stop`` is set or ``timeout_s`` passes.
 
+    A callback that raises does not end the spinning (rclpy re-raises it from
+    ``spin_once``): it is reported in one line on stderr, at most once per
+    :data:`REPORT_EVERY_S`, and the executor goes on serving everything else.
+
     Returns:
         True when ``stop`` was set, False when the timeout elapsed or the context ended.
     """
     deadline = None if timeout_s is None else time.monotonic() + timeout_s
-    try:
-        while not stop.is_set() and executor.context.ok():
-            left = SPIN_PERIOD_S if deadline is None else deadline - time.monotonic()
-            if left <= 0:
-                return False
+    reported = -math.inf
+    while not stop.is_set() and executor.context.ok():
+        left = SPIN_PERIOD_S if deadline is None else deadline - time.monotonic()
+        if left <= 0:
+            return False
+        try:
             executor.spin_once(timeout_sec=min(SPIN_PERIOD_S, left))
-    except ExternalShutdownException:  # the context was shut down under us
-        return False
+        except ExternalShutdownException:  # the context was shut down under us
+            return False
+        except Exception as error:  # a callback's bug: said, never the end of the executor
+            if time.monotonic() - reported >= REPORT_EVERY_S:
+                reported = time.monotonic()
+                sys.stderr.write(
+                    f"openral: a ROS callback failed ({type(error).__name__}: {error}); "
+                    "the executor goes on\n"
+                )
     return stop.is_set()

@@ -32,7 +32,7 @@ its result code.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from enum import StrEnum
 
 import numpy as np
@@ -117,9 +117,10 @@ class PathStart:
     [rad or m] (0: never)."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class JointPath:
-    """A planned trajectory over some action slots, in simulated time."""
+    """A planned trajectory over some action slots, in simulated time (compared by identity:
+    each path is one plan)."""
 
     names: tuple[str, ...]
     slots: npt.NDArray[np.intp]
@@ -129,7 +130,7 @@ class JointPath:
     """Knot positions, one row per knot, one column per slot of :attr:`slots`."""
     velocities: FloatArray
     """Knot velocities (NaN rows: the knot has none)."""
-    source: str = field(default="a joint trajectory", compare=False)
+    source: str = "a joint trajectory"
     """Who sent it (:attr:`TrajectoryRequest.source`)."""
 
     @property

@@ -150,9 +150,9 @@ class TrajectoryFollower:
             ended = [p for p in (self._running, self._waiting) if p is not None]
             if path is not None:
                 ended = [p for p in ended if p is path]
-            if self._running in ended:
+            if any(p is self._running for p in ended):
                 self._running = None
-            if self._waiting in ended:
+            if any(p is self._waiting for p in ended):
                 self._waiting = None
             self.cancelled += len(ended)
         for gone in ended:

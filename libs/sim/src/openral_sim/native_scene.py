@@ -229,6 +229,8 @@ class NativeScene:
         if self.base is not None:
             self.base.reset()
         self._advance(self.wiring.settle_steps_default)
+        if self.base is not None:  # the odometry frame: where the base settled, exactly
+            self.base.reset()
         self._steps = 0
         return self._observe()
 
@@ -331,16 +333,21 @@ class NativeScene:
         """``steps`` physics steps; a mobile base's drive is updated before every
         :data:`BASE_UPDATE_STEPS` of them (the joint driver slews in chunks of that size
         too, so chunking changes nothing of the arm's motion)."""
-        base = self.base
+        base, model, data = self.base, self.model, self.data
         if base is None:
-            self.driver.advance(self.model, self.data, steps)
-            return
-        timestep = float(self.model.opt.timestep)
-        while steps > 0:
+            self.driver.advance(model, data, steps)
+        timestep = float(model.opt.timestep)
+        while base is not None and steps > 0:
             chunk = min(steps, BASE_UPDATE_STEPS)
             base.update(chunk * timestep)
-            self.driver.advance(self.model, self.data, chunk)
+            self.driver.advance(model, data, chunk)
             steps -= chunk
+        # mj_step leaves the poses (bodies, sites, cameras) of the state *before* its last
+        # step: bring them to the state the data now holds, so that /tf, cameras and lidars
+        # show the instant they are stamped with (the physics is not changed by this).
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_comPos(model, data)
+        mujoco.mj_camlight(model, data)
 
     def _hold_base_where_it_is(self) -> None:
         """Aim the base weld (if any) at the root body's pose now: relpose is the world's
