@@ -1,10 +1,11 @@
-"""What the ROS graph holds: topic names, types and publishers, and their message classes.
+"""What the ROS graph holds: topic names, types and publishers, and their interface classes.
 
 Graph queries read rmw's discovery cache, which DDS threads fill in the background, so
 they need no executor; waiting is polling that cache every ``POLL_S`` seconds.
 
-A topic's type name comes from whichever peer advertises it, so it never names a module
-to import: only the packages in ``DECODABLE_PACKAGES`` are decoded.
+A topic's (or service's) type name comes from whichever peer advertises it, so it never
+names a module to import: only the packages in ``DECODABLE_PACKAGES`` are decoded and only
+those in ``SERVICE_PACKAGES`` are called.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ POLL_S = 0.05
 """Interval between discovery-cache reads while waiting (s)."""
 DECODABLE_PACKAGES = (
     "builtin_interfaces",
+    "control_msgs",
     "geometry_msgs",
     "lifecycle_msgs",
     "nav_msgs",
@@ -33,11 +35,29 @@ DECODABLE_PACKAGES = (
     "rosgraph_msgs",
     "sensor_msgs",
     "std_msgs",
+    "tf2_msgs",
     "trajectory_msgs",
 )
-"""ROS message packages whose types are decoded (the ``ros`` extra and rclpy's own)."""
+"""ROS message packages whose types are decoded (the ``ros`` extra, rclpy's own and the
+interface packages built at setup: tf2_msgs, control_msgs)."""
+SERVICE_PACKAGES = (
+    "lifecycle_msgs",
+    "nav_msgs",
+    "rcl_interfaces",
+    "sensor_msgs",
+    "std_srvs",
+    "type_description_interfaces",
+)
+"""ROS packages whose service types ``openral ros call`` builds (installed with rclpy or
+the ``ros`` extra)."""
 MESSAGE_NAME = re.compile(r"[A-Z][A-Za-z0-9]*")
-"""A ROS message name: CamelCase, letters and digits."""
+"""A ROS message or service name: CamelCase, letters and digits."""
+_KINDS = {
+    "msg": ("message", "decode", "decodable", DECODABLE_PACKAGES),
+    "srv": ("service", "call", "callable", SERVICE_PACKAGES),
+}
+"""Per interface kind: its noun, what openral does with it (verb, adjective) and the
+packages allowed."""
 
 
 @dataclass(frozen=True)
@@ -63,15 +83,17 @@ class TopicNotFound(OpenralError):
 
 
 class MessageTypeError(OpenralError):
-    """A topic type this process does not decode: not a message, not allowed or not installed."""
+    """A topic or service type this process does not decode: not a message (service), not
+    allowed or not installed."""
 
 
 class TopicNameError(OpenralError):
-    """A topic name that ROS would reject."""
+    """A topic or service name that ROS would reject."""
 
 
-def topic_name(name: str) -> str:
-    """Absolute form of a valid topic name (``joint_states`` → ``/joint_states``).
+def topic_name(name: str, *, service: bool = False) -> str:
+    """Absolute form of a valid topic (or ``service``) name (``joint_states`` →
+    ``/joint_states``).
 
     Raises:
         TopicNameError: ROS does not accept the name (e.g. ``/a[b]``, ``/1x``, ``/a//b``).
@@ -81,7 +103,10 @@ def topic_name(name: str) -> str:
         validate_full_topic_name(full)
     except InvalidTopicNameException as error:
         reason = str(error).splitlines()[0].removeprefix("Invalid topic name: ").rstrip(":")
-        raise TopicNameError(f"{escaped(name)} is not a valid ROS topic name: {reason}") from None
+        if service:
+            reason = reason.replace("topic name", "service name", 1)
+        what = "service" if service else "topic"
+        raise TopicNameError(f"{escaped(name)} is not a valid ROS {what} name: {reason}") from None
     return full
 
 
@@ -119,28 +144,45 @@ def message_class(type_name: str, topic: str) -> type[Any]:
         MessageTypeError: not ``pkg/msg/Name``, a package outside the allow-list, or a
             name that package does not define as a message.
     """
+    return _interface_class(type_name, "msg", f"topic {topic}")
+
+
+def service_class(type_name: str, service: str) -> type[Any]:
+    """The class of ``service``'s type, e.g. ``std_srvs/srv/Trigger``, from one of
+    ``SERVICE_PACKAGES`` (checked, like :func:`message_class`, before anything is imported).
+
+    Raises:
+        MessageTypeError: not ``pkg/srv/Name``, a package outside the allow-list, or a
+            name that package does not define as a service.
+    """
+    return _interface_class(type_name, "srv", f"service {service}")
+
+
+def _interface_class(type_name: str, kind: str, subject: str) -> type[Any]:
+    noun, verb, adjective, packages = _KINDS[kind]
     shown = escaped(type_name)
     parts = type_name.split("/")
-    if len(parts) != 3 or parts[1] != "msg":
+    if len(parts) != 3 or parts[1] != kind:
         raise MessageTypeError(
-            f"topic {topic} has type {shown}, which is not a message type (expected pkg/msg/Name)"
+            f"{subject} has type {shown}, which is not a {noun} type (expected pkg/{kind}/Name)"
         )
     package, _, name = parts
-    if package not in DECODABLE_PACKAGES:
+    if package not in packages:
         raise MessageTypeError(
-            f"topic {topic} has type {shown}, which openral does not decode; "
-            f"decodable packages: {', '.join(DECODABLE_PACKAGES)}"
+            f"{subject} has type {shown}, which openral does not {verb}; "
+            f"{adjective} packages: {', '.join(packages)}"
         )
     if not MESSAGE_NAME.fullmatch(name):
-        raise MessageTypeError(f"topic {topic} has type {shown}: {name!r} is not a message name")
+        raise MessageTypeError(f"{subject} has type {shown}: {name!r} is not a {noun} name")
     try:
-        module = importlib.import_module(f"{package}.msg")
+        module = importlib.import_module(f"{package}.{kind}")
     except ImportError as error:
         raise MessageTypeError(
-            f"topic {topic} has type {shown}, but {package} is not installed ({error}); "
+            f"{subject} has type {shown}, but {package} is not installed ({error}); "
             f"install the ros-{package.replace('_', '-')} wheel"
         ) from None
     cls = getattr(module, name, None)
-    if not isinstance(cls, type) or not hasattr(cls, "get_fields_and_field_types"):
-        raise MessageTypeError(f"topic {topic} has type {shown}, which {package} does not define")
+    member = "get_fields_and_field_types" if kind == "msg" else "Request"
+    if not isinstance(cls, type) or not hasattr(cls, member):
+        raise MessageTypeError(f"{subject} has type {shown}, which {package} does not define")
     return cls

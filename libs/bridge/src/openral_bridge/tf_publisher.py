@@ -61,6 +61,7 @@ class TfPublisher:
         self._sent: FrameSample | None = None
         self._publishers: tuple[Any, Any] | None = None
         self._job: tuple[Pacer, PacedJob] | None = None
+        self._tick_hz = self.rate_hz
         self._dynamic = _message(tree, tree.dynamic)
         self._static = _message(tree, tree.static)
 
@@ -78,6 +79,7 @@ class TfPublisher:
             node.create_publisher(TFMessage, TF_STATIC, TF_STATIC_QOS),
         )
         loop.add_reader(self.capture)
+        self._tick_hz = 1.0 / loop.period_s
         self.publish_static()
         self.publish()
         self._job = (pacer, pacer.every(1.0 / self.rate_hz, self.publish, "tf"))

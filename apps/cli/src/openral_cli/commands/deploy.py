@@ -171,6 +171,7 @@ def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
     from openral_bridge.topics import (
         CMD_VEL,
         ESTOP,
+        FOLLOW_JOINT_TRAJECTORY,
         JOINT_TRAJECTORY,
         RELEASE_ESTOP,
         RESET,
@@ -189,8 +190,8 @@ def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
     for column in ("published topic", "type", "rate"):
         table.add_column(column, overflow="fold")
     for topic in node.topics():
-        rate = "latched" if topic.rate_hz is None else f"{topic.rate_hz:g} Hz"
-        table.add_row(topic.name, topic.type, f"{rate} {topic.when}".strip())
+        rate = f"{topic.rate_hz:g} Hz {topic.when}" if topic.rate_hz else topic.when or "latched"
+        table.add_row(topic.name, topic.type, rate.strip())
     out.print(table, soft_wrap=False)
     out.print(
         f"actions:  {SAFE_ACTION} (std_msgs/msg/Float64MultiArray, {len(names)} values: "
@@ -200,6 +201,8 @@ def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
     if node.commands is not None and node.commands.follows_trajectories:
         kind = "trajectory_msgs/msg/JointTrajectory, joints by manifest name"
         out.print(f"          {JOINT_TRAJECTORY} ({kind})", soft_wrap=False)
+        kind = "control_msgs/action/FollowJointTrajectory"
+        out.print(f"          {FOLLOW_JOINT_TRAJECTORY} ({kind})", soft_wrap=False)
     if node.bridge is not None and node.bridge.base is not None:
         out.print(f"base:     {CMD_VEL} (geometry_msgs/msg/Twist, base frame)", soft_wrap=False)
     out.print(f"E-stop:   {ESTOP}, {RELEASE_ESTOP} (std_srvs/srv/Trigger)", soft_wrap=False)

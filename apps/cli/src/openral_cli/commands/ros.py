@@ -6,6 +6,12 @@ Examples::
     openral ros echo /joint_states --once
     openral ros snapshot /openral/cameras/agentview/image --out agentview.png
     openral ros pub /cmd_vel geometry_msgs/msg/Twist "{linear: {x: 0.3}}" --count 40 --rate 20
+    openral ros call /openral/estop
+    openral ros call /openral/release_estop std_srvs/srv/Trigger
+    openral ros call /openral/reset
+    openral ros call /some/switch std_srvs/srv/SetBool "{data: true}"
+    openral ros tf
+    openral ros tf hand --target link0
     openral ros reset
 
 rclpy is imported only when a command runs, so the rest of the CLI works without the
@@ -31,7 +37,10 @@ if TYPE_CHECKING:
     from openral_nodes.topic_probe import Inbox
     from rclpy.node import Node
 
-app = command_group("Inspect the ROS 2 graph: topics, messages, camera frames; publish a message.")
+app = command_group(
+    "Inspect the ROS 2 graph: topics, messages, camera frames, TF; publish a message, call a "
+    "service."
+)
 
 DomainId = Annotated[
     int | None,
@@ -247,6 +256,108 @@ def pub(
             publisher.publish(msg)
         time.sleep(0.2)  # let the last message leave before the node goes
     out.print(f"published {count} {type_name} on {name} at {rate:g} Hz", markup=False)
+
+
+@app.command("call")
+def call(
+    service: Annotated[str, typer.Argument(help="Service name, e.g. /openral/estop.")],
+    type_name: Annotated[
+        str | None,
+        typer.Argument(
+            metavar="TYPE",
+            help="Service type, e.g. std_srvs/srv/SetBool.",
+            show_default="the graph's",
+        ),
+    ] = None,
+    values: Annotated[
+        str, typer.Argument(help="Request fields as YAML, e.g. '{data: true}'.")
+    ] = "{}",
+    timeout: Annotated[
+        float,
+        typer.Option(
+            "--timeout", min=0.0, help="Seconds to wait for the service, then its answer."
+        ),
+    ] = 5.0,
+    domain_id: DomainId = None,
+) -> None:
+    """Call SERVICE with a request of VALUES and print the response; exit 1 when it answers
+    `success: false`.
+
+    TYPE is found in the graph when left out (VALUES may then come second). Only types of
+    the packages openral installs are built; VALUES is read like `ros pub` reads them.
+
+    Examples:
+
+        openral ros call /openral/estop
+        openral ros call /openral/release_estop std_srvs/srv/Trigger
+        openral ros call /openral/reset
+        openral ros call /some/switch std_srvs/srv/SetBool "{data: true}"
+    """
+    require_ros()
+    from openral_core.errors import OpenralError, escaped
+    from openral_nodes.message_fill import parse_values
+    from openral_nodes.service_call import call_service, checked_request
+    from openral_nodes.topic_format import format_message
+
+    if type_name is not None and values == "{}" and _looks_like_values(type_name):
+        values, type_name = type_name, None  # `call SERVICE VALUES`: the type is the graph's
+    request = parse_values(values)
+    checked_request(service, type_name, request)  # a bad argument fails before any ROS setup
+    with _probe_node(domain_id) as node:
+        answer = call_service(node, service, type_name, request, timeout)
+    out.print(f"# {answer.service}: {escaped(answer.type_name)}")
+    out.print(format_message(answer.response) or "(empty response)")
+    if answer.failed:
+        raise OpenralError(f"{answer.service} answered success: false")
+
+
+def _looks_like_values(text: str) -> bool:
+    """True for request text given where the type goes: a type has no ``{``, ``:`` or space."""
+    return not text.strip() or any(mark in text for mark in "{: ")
+
+
+@app.command("tf")
+def tf(
+    frame: Annotated[
+        str | None,
+        typer.Argument(help="Frame to locate; the whole tree when left out.", show_default=False),
+    ] = None,
+    target: Annotated[
+        str | None,
+        typer.Option("--target", help="Frame to express FRAME in.", show_default="the root"),
+    ] = None,
+    timeout: Annotated[
+        float,
+        typer.Option(
+            "--timeout",
+            min=0.0,
+            help="Seconds to listen to /tf and /tf_static once the first transform arrives "
+            "(awaited 3 s longer).",
+        ),
+    ] = 3.0,
+    domain_id: DomainId = None,
+) -> None:
+    """Print the TF tree, or where FRAME is.
+
+    Without FRAME: every frame below the root, indented under its parent, with `static` or
+    the rate it was seen at [Hz]. With FRAME: its pose in the root frame (or TARGET), composed
+    from the latest transform of each link: translation [m], quaternion (x y z w),
+    roll/pitch/yaw [rad] and stamp [s]. An unknown frame names the closest known ones.
+
+    Examples:
+
+        openral ros tf
+        openral ros tf hand
+        openral ros tf hand --target link0
+    """
+    require_ros()
+    from openral_cli.commands.ros_tf import gather, report
+
+    with _probe_node(domain_id) as node:
+        buffer = gather(node, timeout, frame, target)
+        domain = node.context.get_domain_id()
+    for text in report(buffer, frame, target, timeout, domain):
+        out.print(text)
 
 
 @app.command("reset")
