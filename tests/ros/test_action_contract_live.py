@@ -31,7 +31,7 @@ from typing import Any
 import mujoco
 import numpy as np
 import pytest
-from openral_bridge.topics import ACTION_SPEC, JOINT_STATES, SAFE_ACTION
+from openral_bridge.topics import ACTION_SPEC, MANIFEST_JOINT_STATES, SAFE_ACTION
 from openral_core.loaded import open_robot_by_id
 from openral_core.loader import load_scene
 from openral_core.models import LimitedJoint
@@ -99,7 +99,7 @@ class Graph:
     control_period_s: float
 
     def position(self, joint: str) -> float:
-        msg = self.probe.latest(JOINT_STATES)
+        msg = self.probe.latest(MANIFEST_JOINT_STATES)
         return float(msg.position[list(msg.name).index(joint)])
 
     def send(self, **values: float) -> float:
@@ -115,7 +115,7 @@ class Graph:
     def samples(self, joint: str, start: float) -> list[Sample]:
         """Readings of ``joint`` since ``start``, one per scene step (distinct stamps)."""
         out: list[Sample] = []
-        for r in self.probe.since(JOINT_STATES, start):
+        for r in self.probe.since(MANIFEST_JOINT_STATES, start):
             i = list(r.msg.name).index(joint)
             stamp = r.msg.header.stamp.sec + r.msg.header.stamp.nanosec * 1e-9
             if not out or stamp != out[-1].stamp_s:
@@ -151,7 +151,7 @@ def finite_difference_speeds(samples: list[Sample]) -> list[float]:
 def live_graph(scene: Path, logs: Path) -> Iterator[Graph]:
     """deploy sim on ``scene`` in a domain of its own, with a probe and an action publisher."""
     domain = claim_domain_id()
-    topics = {JOINT_STATES: JointState, ACTION_SPEC: JointState}
+    topics = {MANIFEST_JOINT_STATES: JointState, ACTION_SPEC: JointState}
     with (
         deploy_sim(scene, domain, logs) as process,
         ros_session(domain_id=domain) as context,
@@ -162,7 +162,7 @@ def live_graph(scene: Path, logs: Path) -> Iterator[Graph]:
         publisher = probe.node.create_publisher(Float64MultiArray, SAFE_ACTION, 10)
         try:
             probe.wait_count(ACTION_SPEC, 1, timeout_s=START_WAIT_S)
-            probe.wait_count(JOINT_STATES, 1, timeout_s=START_WAIT_S)
+            probe.wait_count(MANIFEST_JOINT_STATES, 1, timeout_s=START_WAIT_S)
             wait_until(lambda: publisher.get_subscription_count() > 0, what="safe_action match")
             spec = probe.latest(ACTION_SPEC)
             options = load_scene(scene).scene.options

@@ -7,7 +7,7 @@ import pytest
 from openral_bridge.ros_messages import image_msg, stamp
 from openral_nodes.topic_codec import ImageEncodingError, image_to_rgb
 from openral_nodes.topic_format import format_message
-from openral_nodes.topic_graph import MessageTypeError, message_class
+from openral_nodes.topic_graph import MessageTypeError, is_hidden, message_class
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float64MultiArray, MultiArrayDimension
 
@@ -81,3 +81,19 @@ def test_a_peers_control_characters_are_shown_escaped_never_sent_to_the_terminal
     hostile = "ok\x1b[2J\x07"  # clear screen and bell
     assert format_value(hostile) == "ok\\x1b[2J\\x07"
     assert format_value("sensor_msgs/msg/Image") == "sensor_msgs/msg/Image"
+
+
+@pytest.mark.parametrize(
+    ("name", "hidden"),
+    [
+        ("/rosout", True),
+        ("/parameter_events", True),
+        ("/openral/joint_trajectory_controller/follow_joint_trajectory/_action/feedback", True),
+        ("/a/_b", True),
+        ("/joint_states", False),
+        ("/openral/joint_trajectory/state", False),
+        ("/rosout_agg", False),
+    ],
+)
+def test_hidden_topics_are_the_ones_ros2_topic_list_hides(name: str, hidden: bool) -> None:
+    assert is_hidden(name) is hidden

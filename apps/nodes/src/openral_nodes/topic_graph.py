@@ -23,6 +23,15 @@ from rclpy.validate_full_topic_name import validate_full_topic_name
 
 HIDDEN_TOPICS = frozenset({"/rosout", "/parameter_events"})
 """Topics every node creates; listed only on request."""
+
+
+def is_hidden(name: str) -> bool:
+    """Whether a topic is listed only on request: one every node creates, or one with a
+    token starting with ``_`` (an action's ``/_action/feedback`` and ``/_action/status``),
+    which ``ros2 topic list`` hides too."""
+    return name in HIDDEN_TOPICS or any(token.startswith("_") for token in name.split("/"))
+
+
 POLL_S = 0.05
 """Interval between discovery-cache reads while waiting (s)."""
 DECODABLE_PACKAGES = (
@@ -115,7 +124,7 @@ def graph_topics(node: Node, *, include_hidden: bool = False) -> list[TopicInfo]
     return [
         TopicInfo(name, tuple(types), node.count_publishers(name))
         for name, types in sorted(node.get_topic_names_and_types())
-        if include_hidden or name not in HIDDEN_TOPICS
+        if include_hidden or not is_hidden(name)
     ]
 
 

@@ -25,6 +25,10 @@ LATCHED = QoSProfile(  # type: ignore[no-untyped-call]
 )
 
 
+STOP_WAIT_S = 10.0
+"""Longest a stop waits for a URDF still being made [s] (the first run exports meshes)."""
+
+
 class DescriptionPublisher:
     """Makes the URDF on a thread and publishes it once, latched."""
 
@@ -58,11 +62,15 @@ class DescriptionPublisher:
         return self.text is not None
 
     def stop(self) -> None:
-        """Destroy the publisher (the thread finishes on its own and publishes nothing)."""
+        """Destroy the publisher, then wait up to ``STOP_WAIT_S`` for the thread to end (it
+        publishes nothing once the publisher is gone), so a stopped graph leaves no thread."""
         with self._lock:
             publisher, self._publisher = self._publisher, None
         if publisher is not None:
             self.node.destroy_publisher(publisher)
+        thread, self._thread = self._thread, None
+        if thread is not None and thread is not threading.current_thread():
+            thread.join(STOP_WAIT_S)
 
     def topics(self) -> list[TopicInfo]:
         """``/robot_description`` (latched)."""

@@ -119,10 +119,11 @@ class TfPublisher:
             publishers[1].publish(self._static)
 
     def topics(self) -> list[TopicInfo]:
-        """``/tf`` (at most the rate, once per tick) and ``/tf_static`` (latched)."""
+        """``/tf`` (a new pose at most once per control tick, so at the joint-state rate or the
+        control rate, whichever is lower) and ``/tf_static`` (latched)."""
         kind = "tf2_msgs/msg/TFMessage"
         return [
-            TopicInfo(TF, kind, self.rate_hz, "once per tick"),
+            TopicInfo(TF, kind, min(self.rate_hz, self._tick_hz)),
             TopicInfo(TF_STATIC, kind, None),
         ]
 

@@ -100,7 +100,10 @@ def topics(
         float, typer.Option("--window", min=0.1, help="Seconds to measure rates over.")
     ] = 2.0,
     all_topics: Annotated[
-        bool, typer.Option("--all", help="Include /rosout and /parameter_events.")
+        bool,
+        typer.Option(
+            "--all", help="Include hidden topics: /rosout, /parameter_events, /_action/ ones."
+        ),
     ] = False,
     domain_id: DomainId = None,
 ) -> None:
