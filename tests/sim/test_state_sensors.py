@@ -130,7 +130,10 @@ def test_reading_changes_nothing_in_the_simulation() -> None:
 
 
 def test_a_pose_sensor_reads_its_site_in_the_world(write_manifest: ManifestWriter) -> None:
-    line = "  - {name: tool_pose, kind: pose, site: attachment_site, rate_hz: 50.0, frame_id: tool_pose_frame}"
+    line = (
+        "  - {name: tool_pose, kind: pose, site: attachment_site, rate_hz: 50.0,"
+        " frame_id: tool_pose_frame}"
+    )
     manifest = write_manifest(
         ("sensors:\n", f"sensors:\n{line}\n"), base=ROBOTS / "ur5e" / "robot.yaml", folder="ur5e"
     )
