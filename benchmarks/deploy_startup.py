@@ -44,9 +44,10 @@ from benchmarks.deploy_launch import (
 from benchmarks.results_file import write_results
 from benchmarks.sensor_streams import Stream, sensor_streams
 
-TARGETS = {"first_state_s": 1.0, "first_frames_s": 1.5, "rate_error": 0.05}
+TARGETS = {"first_state_s": 1.0, "first_frames_s": 1.5, "rate_error": 0.05, "tf_cpu_points": 3.0}
 """Median launch → first /joint_states [s], median launch → first frame of every camera [s],
-and the largest relative rate error of a sensor stream over the window."""
+the largest relative rate error of a sensor stream over the window, and the deploy CPU that
+publishing /tf and /tf_static adds (median with them less median without, % of one core)."""
 ROOM_SCENE = REPO / "robots" / "panda_mobile" / "scenes" / "room.yaml"
 """The mobile manipulator's room: depth, cloud, scan and odometry streams."""
 BOOT_TIMEOUT_S = 60.0
@@ -55,12 +56,19 @@ Run = dict[str, Any]
 
 
 def one_run(
-    scene: Path, streams: list[Stream], window_s: float, rate_hz: float, model_cache: str = ""
+    scene: Path,
+    streams: list[Stream],
+    window_s: float,
+    rate_hz: float,
+    model_cache: str = "",
+    *,
+    tf: bool = True,
 ) -> Run:
     """Launch, wait for every first message, measure a window, stop with SIGINT; with
-    ``model_cache``, the launch's compiled-model cache is that folder."""
+    ``model_cache``, the launch's compiled-model cache is that folder; ``tf=False`` launches
+    with ``--no-tf``."""
     env = {"OPENRAL_MODEL_CACHE": model_cache} if model_cache else None
-    options = ("--camera-rate", str(rate_hz))
+    options = ("--camera-rate", str(rate_hz), *(() if tf else ("--no-tf",)))
     extra = {stream.topic: stream.kind for stream in streams}
     with watched_deploy(scene, [], *options, env=env, extra=extra) as (launch, watcher):
         booted = watcher.wait(lambda: all(watcher.arrivals.values()), BOOT_TIMEOUT_S)
@@ -103,24 +111,34 @@ def parse_args() -> argparse.Namespace:
     parser.add_argument(
         "--cold-runs", type=int, default=3, help="launches with an empty model cache"
     )
+    parser.add_argument(
+        "--no-tf-runs",
+        type=int,
+        default=5,
+        help="launches with --no-tf, each after a timed one (the CPU /tf costs)",
+    )
     return parser.parse_args()
 
 
 def time_runs(
     args: argparse.Namespace, streams: list[Stream], console: Console
-) -> tuple[list[Run], list[Run]]:
-    """One untimed warm-up launch, ``args.runs`` measured ones, then ``args.cold_runs`` each
-    with an empty model cache, announcing each."""
+) -> tuple[list[Run], list[Run], list[Run]]:
+    """One untimed warm-up launch, ``args.runs`` measured ones (each of the first
+    ``args.no_tf_runs`` followed by one with ``--no-tf``), then ``args.cold_runs`` each with
+    an empty model cache, announcing each."""
     console.print(f"warm-up launch (not timed): {warm_up(args.scene):.1f} s")
-    runs, cold = [], []
+    runs, no_tf, cold = [], [], []
     for index in range(args.runs):
         console.print(f"run {index + 1}/{args.runs} …")
         runs.append(one_run(args.scene, streams, args.window, args.camera_rate))
+        if index < args.no_tf_runs:
+            console.print(f"run {index + 1}/{args.runs} with --no-tf …")
+            no_tf.append(one_run(args.scene, streams, args.window, args.camera_rate, tf=False))
     for index in range(args.cold_runs):
         console.print(f"run {index + 1}/{args.cold_runs} with an empty model cache …")
         with tempfile.TemporaryDirectory(prefix="openral-bench-cold-") as folder:
             cold.append(one_run(args.scene, streams, args.window, args.camera_rate, folder))
-    return runs, cold
+    return runs, cold, no_tf
 
 
 def _target_row(table: Table, label: str, values: list[float], target: float, unit: str) -> None:
@@ -176,10 +194,37 @@ def _streaming_rows(
     table.add_row("deploy process CPU", f"{statistics.median(cpu):.0f} %", f"{max(cpu):.0f} %", "")
 
 
+def _tf_rows(table: Table, runs: list[Run], no_tf: list[Run]) -> None:
+    """The deploy CPU without /tf and what /tf adds (medians, in points of one core)."""
+    if not no_tf:
+        return
+    without = [r["cpu_percent"] for r in no_tf]
+    table.add_row(
+        f"deploy process CPU with --no-tf ({len(no_tf)} runs)",
+        f"{statistics.median(without):.1f} %",
+        f"{max(without):.1f} %",
+        "",
+    )
+    added = tf_cpu_points(runs, no_tf)
+    colour = "green" if added <= TARGETS["tf_cpu_points"] else "red"
+    table.add_row(
+        "  CPU added by /tf and /tf_static",
+        f"[{colour}]{added:+.1f} points[/]",
+        "",
+        f"≤ {TARGETS['tf_cpu_points']:g} points",
+    )
+
+
+def tf_cpu_points(runs: list[Run], no_tf: list[Run]) -> float:
+    """Median deploy CPU with /tf less the median without [% of one core]."""
+    with_tf = statistics.median(r["cpu_percent"] for r in runs)
+    return with_tf - statistics.median(r["cpu_percent"] for r in no_tf)
+
+
 def results_table(
     args: argparse.Namespace,
     streams: list[Stream],
-    runs: tuple[list[Run], list[Run]],
+    runs: tuple[list[Run], list[Run], list[Run]],
     load: tuple[float, ...],
 ) -> Table:
     """The printed summary: start-up rows, then streaming rows, median and worst of the runs."""
@@ -192,6 +237,7 @@ def results_table(
         table.add_column(column, justify="left" if column == "measure" else "right")
     _startup_rows(table, runs[0], runs[1], streams)
     _streaming_rows(table, runs[0], streams, args)
+    _tf_rows(table, runs[0], runs[2])
     return table
 
 
@@ -202,7 +248,7 @@ def bytecode_note() -> str:
 
 
 def save_results(
-    args: argparse.Namespace, runs: tuple[list[Run], list[Run]], load: tuple[float, ...]
+    args: argparse.Namespace, runs: tuple[list[Run], list[Run], list[Run]], load: tuple[float, ...]
 ) -> Path:
     """Write the settings, targets and every run to ``benchmarks/results/deploy_startup.json``
     (``deploy_startup_<scene>.json`` for another scene than the default)."""
@@ -224,6 +270,8 @@ def save_results(
             "cold_medians": _medians(runs[1]) if runs[1] else None,
             "runs": runs[0],
             "cold_runs": runs[1],
+            "no_tf_runs": runs[2],
+            "tf_cpu_points": tf_cpu_points(runs[0], runs[2]) if runs[2] else None,
         },
     )
 
@@ -250,7 +298,7 @@ def main() -> int:
             "Times from Popen (includes interpreter start-up); rates from arrival times at a "
             f"subscriber in this process; CPU: 100 % = one core. Written to {path}."
         )
-        clean &= all(r["exit_code"] == 0 for r in runs[0] + runs[1])
+        clean &= all(r["exit_code"] == 0 for r in runs[0] + runs[1] + runs[2])
     return 0 if clean else 1
 
 

@@ -17,7 +17,7 @@ from functools import partial
 from typing import Any
 
 import pytest
-from openral_bridge.topics import ACTION_SPEC
+from openral_bridge.topics import ACTION_SPEC, ROBOT_DESCRIPTION
 from openral_core.models import RobotDescription
 from openral_nodes.manifest_node import ManifestLifecycleNode
 from openral_nodes.runtime import LATCHED, Spinner, claim_domain_id
@@ -63,7 +63,7 @@ class Probe:
         self.messages: dict[str, list[Received]] = {topic: [] for topic in topics}
         self._condition = threading.Condition()
         for topic, kind in topics.items():
-            qos = LATCHED if topic == ACTION_SPEC else 50
+            qos = LATCHED if topic in (ACTION_SPEC, ROBOT_DESCRIPTION) else 50
             self.node.create_subscription(kind, topic, partial(self._record, topic), qos)
 
     def _record(self, topic: str, msg: Any) -> None:

@@ -108,3 +108,27 @@ def test_twenty_lifecycle_cycles_leak_no_threads_fds_or_ros_entities(
     finally:
         spinner.remove_node(node)
         node.destroy_node()
+
+
+@pytest.mark.parametrize("publish_tf", [True, False])
+def test_publish_tf_false_leaves_tf_to_another_node_and_keeps_the_description(
+    ros_context: Context, spinner: Spinner, publish_tf: bool
+) -> None:
+    node = make_node(ros_context, publish_tf=publish_tf)
+    spinner.add_node(node)
+    try:
+        assert spinner.call(node.trigger_configure) == SUCCESS
+        assert spinner.call(node.trigger_activate) == SUCCESS
+
+        def topics() -> set[str]:
+            return {p.topic_name for p in node.publishers}
+
+        published = spinner.call(topics)
+        assert ({"/tf", "/tf_static"} <= published) is publish_tf
+        assert not ({"/tf", "/tf_static"} & published) or publish_tf
+        assert {"/joint_states", "/robot_description"} <= published
+        assert spinner.call(node.trigger_deactivate) == SUCCESS
+        assert spinner.call(node.trigger_cleanup) == SUCCESS
+    finally:
+        spinner.remove_node(node)
+        node.destroy_node()

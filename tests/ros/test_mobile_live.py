@@ -19,10 +19,19 @@ import numpy as np
 import pytest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
-from openral_bridge.topics import CMD_VEL, ESTOP, JOINT_STATES, ODOM, SCAN, depth_points
+from openral_bridge.topics import (
+    CMD_VEL,
+    ESTOP,
+    JOINT_STATES,
+    ODOM,
+    ROBOT_DESCRIPTION,
+    SCAN,
+    depth_points,
+)
 from openral_nodes.runtime import Spinner, claim_domain_id, ros_session
 from openral_nodes.topic_codec import cloud_points
 from sensor_msgs.msg import JointState, LaserScan, PointCloud2
+from std_msgs.msg import String
 from std_srvs.srv import Trigger
 
 from tests.conftest import ROBOTS
@@ -57,7 +66,13 @@ class Client:
 def client(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Client]:
     logs = tmp_path_factory.mktemp("mobile_live")
     domain = claim_domain_id()
-    topics = {SCAN: LaserScan, POINTS: PointCloud2, ODOM: Odometry, JOINT_STATES: JointState}
+    topics = {
+        SCAN: LaserScan,
+        POINTS: PointCloud2,
+        ODOM: Odometry,
+        JOINT_STATES: JointState,
+        ROBOT_DESCRIPTION: String,  # out once the start-up work beside the loop is done
+    }
     with ros_session(domain_id=domain) as context, deploy_sim(ROOM, domain, logs) as process:
         probe = Probe(context, topics, name="mobile_client")
         with Spinner(context) as spinner:

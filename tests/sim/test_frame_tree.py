@@ -26,6 +26,7 @@ from openral_mujoco.errors import HalError
 from openral_mujoco.robot_tree import BaseKind
 from openral_sim.frame_tree import Frame, FrameTree
 from openral_sim.native_scene import NativeScene
+from openral_sim.robot_description import robot_description, scene_robot_description
 from openral_sim.scene import build_scene, build_sim_env_from_yaml
 from openral_sim.scene_cameras import camera_sensors
 
@@ -271,3 +272,14 @@ def test_a_base_frame_named_after_a_body_of_the_model_is_refused(
     with pytest.raises(HalError, match="'base_link'") as refused:
         _ = scene.frame_tree
     assert "base frame" in str(refused.value)
+
+
+# -- the URDF a running scene publishes --------------------------------------------------------
+
+
+@pytest.mark.parametrize("robot_id", sorted(SCENES))
+def test_a_scene_publishes_the_urdf_of_the_robot_alone(robot_id: str) -> None:
+    """What the graph reads from its scene's model is what ``openral robot urdf`` writes."""
+    scene = _scene(robot_id)
+    published = scene_robot_description(scene.frame_tree, scene.robot.name)
+    assert published == robot_description(scene.robot)

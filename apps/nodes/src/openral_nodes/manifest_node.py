@@ -321,7 +321,15 @@ class ManifestLifecycleNode(LifecycleNode):
         spec_msg.header.stamp = sim_stamp(self, sim_time_s)
         spec.publish(spec_msg)
         rate_hz = float(self._param("joint_state_rate_hz"))
-        self.states = RobotStateStreams(self, hal, self.hal_lock, self.loop, rate_hz, self._loaded)
+        self.states = RobotStateStreams(
+            self,
+            hal,
+            self.hal_lock,
+            self.loop,
+            rate_hz,
+            self._loaded,
+            bool(self._param("publish_tf")),
+        )
         self.states.start(pacer)
         rules = self.description.trajectory if self.description is not None else None
         self.commands = CommandInterfaces(

@@ -20,6 +20,7 @@ PARAMETERS: dict[str, Any] = {
     "viewer_enabled": True,
     "camera_publish_rate_hz": 0.0,
     "joint_state_rate_hz": 50.0,
+    "publish_tf": True,
 }
 """Every parameter and its default."""
 

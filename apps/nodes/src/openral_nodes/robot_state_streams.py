@@ -2,9 +2,10 @@
 
 - ``/joint_states`` and ``/openral/manifest_joint_states``
   (:class:`~openral_bridge.joint_state_publisher.JointStatePublisher`);
-- ``/tf`` and ``/tf_static`` (:class:`~openral_bridge.tf_publisher.TfPublisher`) and the
-  URDF on ``/robot_description`` (:class:`~openral_bridge.description_publisher.
-  DescriptionPublisher`), for a simulated HAL with a frame tree (a native scene).
+- ``/tf`` and ``/tf_static`` (:class:`~openral_bridge.tf_publisher.TfPublisher`; off with
+  the ``publish_tf`` parameter) and the URDF on ``/robot_description``
+  (:class:`~openral_bridge.description_publisher.DescriptionPublisher`), for a simulated HAL
+  with a frame tree (a native scene).
 
 A model whose frames cannot be laid out as a tree is said once in the log; the graph then
 runs without ``/tf`` and ``/robot_description`` and ``/joint_states`` carries the manifest's
@@ -31,7 +32,7 @@ from openral_core.loaded import LoadedRobot
 from openral_hal.errors import HalError
 from openral_hal.protocol import FramesHal, MobileBaseHal, RobotHal
 from openral_sim.frame_tree import FrameTree
-from openral_sim.robot_description import robot_description
+from openral_sim.robot_description import scene_robot_description
 
 if TYPE_CHECKING:
     from rclpy.node import Node
@@ -48,6 +49,7 @@ class RobotStateStreams:
         loop: ControlLoop | None,
         rate_hz: float,
         robot: LoadedRobot | None,
+        publish_tf: bool = True,
     ) -> None:
         """Lay out the frames (nothing is published until :meth:`start`).
 
@@ -58,6 +60,8 @@ class RobotStateStreams:
             loop: The control loop of a simulated HAL (None for a real one).
             rate_hz: The joint-state rate, also the highest ``/tf`` rate [Hz].
             robot: The loaded robot (for its URDF).
+            publish_tf: False leaves ``/tf`` and ``/tf_static`` to another node (a
+                robot_state_publisher fed by our ``/joint_states`` and ``/robot_description``).
         """
         self.node, self.loop = node, loop
         tree = self._frame_tree(hal) if loop is not None else None
@@ -67,10 +71,15 @@ class RobotStateStreams:
         if loop is not None:
             source = TickStates(loop, tree.tree if tree else None, data, base)
         self.states = JointStatePublisher(node, rate_hz, source)
-        self.tf = TfPublisher(node, tree, data, rate_hz) if tree and data is not None else None
+        self.tf = None
+        if publish_tf and tree is not None and data is not None:
+            self.tf = TfPublisher(node, tree, data, rate_hz)
         self.description = None
-        if self.tf is not None and robot is not None:
-            self.description = DescriptionPublisher(node, lambda: robot_description(robot))
+        if tree is not None and robot is not None:
+            name = robot.name
+            self.description = DescriptionPublisher(
+                node, lambda: scene_robot_description(tree, name)
+            )
 
     def start(self, pacer: Pacer) -> None:
         """Publish the joint states and transforms once now, then on ``pacer``; start

@@ -39,6 +39,8 @@ GIMBAL_LOCK = 1e-8
 SKIPPED = (mujoco.mjtGeom.mjGEOM_PLANE, mujoco.mjtGeom.mjGEOM_HFIELD, mujoco.mjtGeom.mjGEOM_SDF)
 """Geom types a URDF leaves out."""
 IDENTITY: Quaternion = (1.0, 0.0, 0.0, 0.0)
+ORIGIN_DECIMALS = 12
+"""Decimals of an origin's numbers [m, rad]."""
 
 
 def urdf_text(
@@ -211,7 +213,12 @@ def _place(element: ET.Element, model: mujoco.MjModel, geom: int, meshes: MeshEx
 
 
 def _origin(element: ET.Element, position: Vector, quat: Quaternion) -> None:
-    ET.SubElement(element, "origin", xyz=_numbers(position), rpy=_numbers(rpy(quat)))
+    """An ``<origin>`` at 1e-12 m and rad: poses composed from the model's world poses carry
+    rounding noise (0.33299999999999996 for 0.333) that would make two readings of one
+    robot differ."""
+    xyz = " ".join(_number(round(v, ORIGIN_DECIMALS)) for v in position)
+    angles = " ".join(_number(round(v, ORIGIN_DECIMALS)) for v in rpy(quat))
+    ET.SubElement(element, "origin", xyz=xyz, rpy=angles)
 
 
 def rpy(quat: Quaternion) -> Vector:

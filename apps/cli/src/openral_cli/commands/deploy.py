@@ -58,6 +58,13 @@ def sim(
         float,
         typer.Option("--joint-state-rate", min=0.1, max=1000.0, help="/joint_states rate [Hz]."),
     ] = 50.0,
+    no_tf: Annotated[
+        bool,
+        typer.Option(
+            "--no-tf",
+            help="Publish no /tf or /tf_static (another node, e.g. robot_state_publisher, does).",
+        ),
+    ] = False,
     duration: Annotated[
         float | None,
         typer.Option(
@@ -71,6 +78,7 @@ def sim(
 ) -> None:
     """Bring SCENE's robot up as a ROS 2 graph: joint states, cameras, actions, E-stop."""
     parameters = _node_parameters(config, manifest, not no_viewer, camera_rate, joint_state_rate)
+    parameters["publish_tf"] = not no_tf
     require_ros()
     from openral_nodes.runtime import ros_session, spin_until
     from rclpy.executors import SingleThreadedExecutor
