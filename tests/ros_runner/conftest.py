@@ -10,6 +10,7 @@ joint states and a latched action spec; it records what arrives on ``/openral/sa
 from __future__ import annotations
 
 import os
+import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -19,6 +20,7 @@ import numpy as np
 import pytest
 from openral_bridge.ros_messages import image_msg, joint_state_msg, stamp
 from openral_bridge.topics import ACTION_SPEC
+from openral_cli import main
 from openral_nodes.runtime import LATCHED, Spinner, claim_domain_id, ros_session
 from rclpy.context import Context
 from rclpy.node import Node
@@ -119,3 +121,18 @@ def ros() -> Iterator[RosHarness]:
             spinner.stop()
             for node in harness.nodes:
                 node.destroy_node()
+
+
+def run_cli(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], *args: str
+) -> tuple[int, str, str]:
+    """``openral ARGS`` through the entry point on this process's ROS domain: exit code,
+    stdout, stderr."""
+    monkeypatch.setenv("ROS_DOMAIN_ID", str(DOMAIN_ID))
+    monkeypatch.setenv("COLUMNS", "300")
+    monkeypatch.setattr(sys, "argv", ["openral", *args])
+    with pytest.raises(SystemExit) as exit_:
+        main.run()
+    captured = capsys.readouterr()
+    assert isinstance(exit_.value.code, int)
+    return exit_.value.code, captured.out, captured.err

@@ -13,7 +13,6 @@ from types import ModuleType
 
 import pytest
 from action_msgs.msg import GoalStatusArray
-from openral_cli import main
 from openral_nodes.topic_graph import (
     DECODABLE_PACKAGES,
     MessageTypeError,
@@ -24,7 +23,8 @@ from openral_nodes.topic_graph import (
 from rclpy.node import Node
 from sensor_msgs.msg import Image
 
-from tests.ros_runner.conftest import DOMAIN_ID, RosHarness
+from tests.ros_runner.conftest import RosHarness
+from tests.ros_runner.conftest import run_cli as run_entry_point
 
 HOSTILE_TYPES = {
     "os/msg/system": "which openral does not decode; decodable packages: builtin_interfaces,",
@@ -99,15 +99,9 @@ def test_invalid_topic_names_are_one_line_errors(name: str, reason: str) -> None
 def run_cli(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], *args: str
 ) -> tuple[int, str]:
-    """``openral ARGS`` through the entry point, on this test process's ROS domain."""
-    monkeypatch.setenv("ROS_DOMAIN_ID", str(DOMAIN_ID))
-    monkeypatch.setenv("COLUMNS", "300")
-    monkeypatch.setattr(sys, "argv", ["openral", *args])
-    with pytest.raises(SystemExit) as exit_:
-        main.run()
-    captured = capsys.readouterr()
-    assert isinstance(exit_.value.code, int)
-    return exit_.value.code, captured.out + captured.err
+    """``openral ARGS`` through the entry point: exit code and all it printed."""
+    code, out, err = run_entry_point(monkeypatch, capsys, *args)
+    return code, out + err
 
 
 def test_echo_of_a_peer_type_outside_the_allow_list_is_one_line_and_exit_1(

@@ -4,7 +4,6 @@ buffer's composition against numpy (no graph needed)."""
 from __future__ import annotations
 
 import math
-import sys
 import time
 from collections.abc import Iterator
 from typing import Any
@@ -12,7 +11,6 @@ from typing import Any
 import numpy as np
 import pytest
 from geometry_msgs.msg import TransformStamped
-from openral_cli import main
 from openral_cli.main import app
 from openral_core.errors import OpenralError
 from openral_nodes.runtime import LATCHED, Spinner, ros_session
@@ -23,7 +21,7 @@ from std_srvs.srv import SetBool, Trigger
 from tf2_msgs.msg import TFMessage
 from typer.testing import CliRunner
 
-from tests.ros_runner.conftest import DOMAIN_ID
+from tests.ros_runner.conftest import DOMAIN_ID, run_cli
 
 runner = CliRunner()
 ENV = {"COLUMNS": "200", "ROS_DOMAIN_ID": str(DOMAIN_ID)}
@@ -247,20 +245,6 @@ def test_tf_frame_in_a_target_frame_returns_once_it_resolves(peer: Peer) -> None
     assert result.output.splitlines()[0] == "camera -> hand"
     pose, _, _ = printed_pose(result.output)
     assert np.allclose(pose, np.linalg.inv(matrix(CAMERA)) @ matrix(HAND), atol=1e-8)
-
-
-def run_cli(
-    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], *args: str
-) -> tuple[int, str, str]:
-    """``openral ARGS`` through the entry point: exit code, stdout, stderr."""
-    monkeypatch.setenv("ROS_DOMAIN_ID", str(DOMAIN_ID))
-    monkeypatch.setenv("COLUMNS", "300")
-    monkeypatch.setattr(sys, "argv", ["openral", *args])
-    with pytest.raises(SystemExit) as exit_:
-        main.run()
-    captured = capsys.readouterr()
-    assert isinstance(exit_.value.code, int)
-    return exit_.value.code, captured.out, captured.err
 
 
 def test_tf_of_an_unknown_frame_is_one_line_naming_the_closest(

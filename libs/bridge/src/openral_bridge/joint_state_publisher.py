@@ -40,7 +40,8 @@ from openral_sim.base_drive import BaseDrive
 from sensor_msgs.msg import JointState
 
 from openral_bridge import ros_messages
-from openral_bridge.pacer import PacedJob, Pacer
+from openral_bridge.paced_publishers import PacedPublishers
+from openral_bridge.pacer import Pacer
 from openral_bridge.topics import JOINT_STATES, MANIFEST_JOINT_STATES
 
 if TYPE_CHECKING:
@@ -152,38 +153,30 @@ class JointStatePublisher:
         self.source = source
         self.published = 0
         """Readings published since :meth:`start`."""
-        self._publishers: tuple[Any, Any] | None = None
-        self._job: tuple[Pacer, PacedJob] | None = None
+        self._out = PacedPublishers(node)
         self._messages: tuple[StateReading, Any, Any] | None = None
 
     def start(self, pacer: Pacer) -> None:
         """Create the publishers, publish once, then once per period on ``pacer``."""
         self.stop()
         node = self.node
-        self._publishers = (
+        self._out.open(
             node.create_publisher(JointState, JOINT_STATES, QUEUE_DEPTH),
             node.create_publisher(JointState, MANIFEST_JOINT_STATES, QUEUE_DEPTH),
         )
         self.published = 0
         self.publish()
-        self._job = (pacer, pacer.every(1.0 / self.rate_hz, self.publish, "joint_states"))
+        self._out.schedule(pacer, 1.0 / self.rate_hz, self.publish, "joint_states")
 
     def stop(self) -> None:
         """Unschedule the job and destroy the publishers (idempotent)."""
-        if self._job is not None:
-            pacer, job = self._job
-            self._job = None
-            pacer.cancel(job)
-        if self._publishers is not None:
-            publishers, self._publishers = self._publishers, None
-            for publisher in publishers:
-                self.node.destroy_publisher(publisher)
+        self._out.close()
         self._messages = None
 
     def publish(self) -> None:
         """Publish the newest reading."""
-        publishers = self._publishers
-        if publishers is None:
+        publishers = self._out.publishers
+        if not publishers:
             return
         joints, manifest = self._messages_of(self.source.reading())
         publishers[0].publish(joints)

@@ -26,7 +26,8 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from tf2_msgs.msg import TFMessage
 
 from openral_bridge import ros_messages
-from openral_bridge.pacer import PacedJob, Pacer
+from openral_bridge.paced_publishers import PacedPublishers
+from openral_bridge.pacer import Pacer
 from openral_bridge.topics import TF, TF_STATIC, TopicInfo
 
 if TYPE_CHECKING:
@@ -59,8 +60,7 @@ class TfPublisher:
         """``/tf`` messages sent since :meth:`start`."""
         self._latest: FrameSample | None = None
         self._sent: FrameSample | None = None
-        self._publishers: tuple[Any, Any] | None = None
-        self._job: tuple[Pacer, PacedJob] | None = None
+        self._out = PacedPublishers(node)
         self._tick_hz = self.rate_hz
         self._dynamic = _message(tree, tree.dynamic)
         self._static = _message(tree, tree.static)
@@ -74,7 +74,7 @@ class TfPublisher:
         dynamic ones once now, then ``/tf`` at :attr:`rate_hz` on ``pacer``."""
         self.stop()
         node = self.node
-        self._publishers = (
+        self._out.open(
             node.create_publisher(TFMessage, TF, TF_QOS),
             node.create_publisher(TFMessage, TF_STATIC, TF_STATIC_QOS),
         )
@@ -82,29 +82,17 @@ class TfPublisher:
         self._tick_hz = 1.0 / loop.period_s
         self.publish_static()
         self.publish()
-        self._job = (pacer, pacer.every(1.0 / self.rate_hz, self.publish, "tf"))
+        self._out.schedule(pacer, 1.0 / self.rate_hz, self.publish, "tf")
 
     def stop(self) -> None:
         """Unschedule the job and destroy the publishers (idempotent)."""
-        if self._job is not None:
-            pacer, job = self._job
-            self._job = None
-            pacer.cancel(job)
-        if self._publishers is not None:
-            publishers, self._publishers = self._publishers, None
-            for publisher in publishers:
-                self.node.destroy_publisher(publisher)
+        self._out.close()
         self._sent = None
 
     def publish(self) -> None:
         """Send the dynamic transforms of the newest capture, unless already sent."""
-        sample, publishers = self._latest, self._publishers
-        if (
-            sample is None
-            or publishers is None
-            or sample is self._sent
-            or not len(self.tree.dynamic)
-        ):
+        sample, publishers = self._latest, self._out.publishers
+        if sample is None or not publishers or sample is self._sent or not len(self.tree.dynamic):
             return
         _fill(self._dynamic, sample, self.tree, self.tree.dynamic)
         publishers[0].publish(self._dynamic)
@@ -113,8 +101,8 @@ class TfPublisher:
 
     def publish_static(self) -> None:
         """Send every static transform of the newest capture (after start and each reset)."""
-        sample, publishers = self._latest, self._publishers
-        if sample is not None and publishers is not None:
+        sample, publishers = self._latest, self._out.publishers
+        if sample is not None and publishers:
             _fill(self._static, sample, self.tree, self.tree.static)
             publishers[1].publish(self._static)
 
