@@ -13,6 +13,7 @@
 
 from __future__ import annotations
 
+import gc
 import subprocess
 import sys
 import threading
@@ -224,6 +225,10 @@ def test_a_flood_of_goals_never_delays_the_estop_or_joint_states(
     flood = threading.Thread(target=_flood, args=(client, stop, sent), daemon=True)
     with outside_client(client.domain, DEPLOY_NODE, "estop_during_flood") as peer:
         peer.trigger(RELEASE_ESTOP)  # discovery and a first call, not measured
+        # What is measured is the graph: a garbage collection in this process (which holds
+        # the objects of every test run before) would read as a late E-stop or a gap.
+        gc.collect()
+        gc.disable()
         flood.start()
         started = time.monotonic()
         round_trips = []
@@ -238,11 +243,14 @@ def test_a_flood_of_goals_never_delays_the_estop_or_joint_states(
         finally:
             stop.set()
             flood.join(10.0)
-    arrivals = [r.at for r in client.probe.since(JOINT_STATES, started)]
-    gaps = np.diff(arrivals)
+            gc.enable()
+    received = client.probe.since(JOINT_STATES, started)
+    gaps = np.diff([r.at for r in received])
+    stamps = [r.msg.header.stamp.sec + 1e-9 * r.msg.header.stamp.nanosec for r in received]
     print(
-        f"{sent[0]} goals in {arrivals[-1] - started:.1f} s; E-stop round trips "
-        f"{np.round(round_trips, 4).tolist()} s; largest /joint_states gap {gaps.max():.3f} s"
+        f"{sent[0]} goals in {received[-1].at - started:.1f} s; E-stop round trips "
+        f"{np.round(round_trips, 4).tolist()} s; largest /joint_states gap {gaps.max():.3f} s "
+        f"(arrivals), {np.diff(stamps).max():.3f} s (stamps)"
     )
     assert max(round_trips) < ESTOP_LIMIT_S
     assert gaps.max() < 0.25  # 50 Hz, never stopped by the flood

@@ -134,8 +134,9 @@ def _fill(message: Any, sample: FrameSample, tree: FrameTree, rows: Any) -> None
         return
     positions, quats = sample.relative(tree, np.asarray(rows, dtype=np.intp))
     stamp = ros_messages.stamp(sample.sim_time_s)
-    for transform, position, quat in zip(message.transforms, positions, quats, strict=True):
+    rows_of = zip(message.transforms, positions.tolist(), quats.tolist(), strict=True)
+    for transform, position, quat in rows_of:
         transform.header.stamp = stamp
         translation, rotation = transform.transform.translation, transform.transform.rotation
-        translation.x, translation.y, translation.z = (float(v) for v in position)
-        rotation.w, rotation.x, rotation.y, rotation.z = (float(v) for v in quat)
+        translation.x, translation.y, translation.z = position
+        rotation.w, rotation.x, rotation.y, rotation.z = quat

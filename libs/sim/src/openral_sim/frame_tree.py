@@ -166,10 +166,12 @@ class FrameTree:
 
     def _base_pose(self, data: mujoco.MjData) -> tuple[FloatArray, FloatArray]:
         """The base frame's world pose: the root body's, less its origin in the base frame."""
-        position, quat = self._origin
+        position, inverse = self._origin
         root = self.tree.root
-        world = _multiply(np.array(data.xquat[root])[None], _conjugate(quat[None]))[0]
-        return np.array(data.xpos[root]) - _rotate(world[None], position[None])[0], world
+        world, offset = np.empty(4), np.empty(3)
+        mujoco.mju_mulQuat(world, data.xquat[root], inverse)
+        mujoco.mju_rotVecQuat(offset, position, world)
+        return data.xpos[root] - offset, world
 
     def _sensor_frame(self, sensor: SensorFrame, link_of: dict[int, str]) -> Frame:
         model = self.model
@@ -228,10 +230,11 @@ def scene_frame_tree(
 
 
 def _root_origin(tree: RobotTree) -> tuple[FloatArray, FloatArray]:
-    """The root body's pose in the base frame (identity when the root is the base)."""
+    """The root body's position in the base frame and the inverse of its orientation there
+    (identity when the root is the base)."""
     for link in tree.links:
         if link.body == tree.root:
-            return np.array(link.position), np.array(link.quat)
+            return np.array(link.position, dtype=np.float64), _conjugate(np.array(link.quat))
     raise FrameTreeError("the robot's tree has no root body")
 
 
@@ -240,7 +243,9 @@ def _sensor_pose(data: mujoco.MjData, sensor: SensorFrame) -> tuple[FloatArray, 
     quat = np.empty(4)
     if sensor.camera >= 0:
         mujoco.mju_mat2Quat(quat, data.cam_xmat[sensor.camera])
-        return np.array(data.cam_xpos[sensor.camera]), _multiply(quat[None], OPTICAL[None])[0]
+        optical = np.empty(4)
+        mujoco.mju_mulQuat(optical, quat, OPTICAL)
+        return np.array(data.cam_xpos[sensor.camera]), optical
     mujoco.mju_mat2Quat(quat, data.site_xmat[sensor.site])
     return np.array(data.site_xpos[sensor.site]), quat
 
@@ -269,9 +274,19 @@ def _multiply(a: FloatArray, b: FloatArray) -> FloatArray:
 
 
 def _rotate(q: FloatArray, v: FloatArray) -> FloatArray:
-    """Each row of ``v`` turned by the unit quaternion in the same row of ``q``."""
+    """Each row of ``v`` turned by the unit quaternion in the same row of ``q``
+    (``v + w t + u x t`` with ``t = 2 u x v``; cross products written out, a tenth of
+    ``np.cross``'s time on a few rows)."""
     w = q[:, :1]
     u = q[:, 1:]
-    t = 2.0 * np.cross(u, v)
-    out: FloatArray = v + w * t + np.cross(u, t)
+    t = 2.0 * _cross(u, v)
+    out: FloatArray = v + w * t + _cross(u, t)
+    return out
+
+
+def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Row-wise cross product of two (n, 3) arrays."""
+    ax, ay, az = a.T
+    bx, by, bz = b.T
+    out: FloatArray = np.stack([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx], axis=1)
     return out

@@ -34,6 +34,22 @@ if TYPE_CHECKING:
 
 app = command_group("Run robots as ROS 2 graphs.")
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+CameraRate = Annotated[
+    float | None,
+    typer.Option(
+        "--camera-rate",
+        min=0.1,
+        max=1000.0,
+        help="Publish every camera at this rate [Hz] (default: each sensor's rate_hz).",
+    ),
+]
+NoTf = Annotated[
+    bool,
+    typer.Option(
+        "--no-tf",
+        help="Publish no /tf or /tf_static (another node, e.g. robot_state_publisher, does).",
+    ),
+]
 
 
 @app.command("sim")
@@ -42,15 +58,7 @@ def sim(
     no_viewer: Annotated[
         bool, typer.Option("--no-viewer", help="Never open the MuJoCo viewer.")
     ] = False,
-    camera_rate: Annotated[
-        float | None,
-        typer.Option(
-            "--camera-rate",
-            min=0.1,
-            max=1000.0,
-            help="Publish every camera at this rate [Hz] (default: each sensor's rate_hz).",
-        ),
-    ] = None,
+    camera_rate: CameraRate = None,
     manifest: Annotated[
         Path | None, typer.Option("--manifest", help="Manifest file (default: the scene's robot).")
     ] = None,
@@ -58,13 +66,7 @@ def sim(
         float,
         typer.Option("--joint-state-rate", min=0.1, max=1000.0, help="/joint_states rate [Hz]."),
     ] = 50.0,
-    no_tf: Annotated[
-        bool,
-        typer.Option(
-            "--no-tf",
-            help="Publish no /tf or /tf_static (another node, e.g. robot_state_publisher, does).",
-        ),
-    ] = False,
+    no_tf: NoTf = False,
     duration: Annotated[
         float | None,
         typer.Option(
