@@ -3,6 +3,7 @@ franka default scene running as a live node (see ``ros_helpers`` for the isolati
 
 from __future__ import annotations
 
+import gc
 import time
 from collections.abc import Iterator
 
@@ -26,7 +27,14 @@ def ros_context() -> Iterator[Context]:
 
 @pytest.fixture(scope="module")
 def deployed(ros_context: Context) -> Iterator[Deployed]:
-    """``deploy sim`` on the franka default scene, in-process, headless, probed from the start."""
+    """``deploy sim`` on the franka default scene, in-process, headless, probed from the start.
+
+    The graph shares this process with every object the suite made before it, which a
+    ``deploy sim`` process would not: they are frozen out of garbage collection while it
+    runs (``gc.freeze``), so a collection of the suite's garbage never stalls its threads.
+    """
+    gc.collect()
+    gc.freeze()
     spinner = Spinner(ros_context).start()
     probe = Probe(ros_context, PROBE_TOPICS)
     spinner.add_node(probe.node)
@@ -49,6 +57,7 @@ def deployed(ros_context: Context) -> Iterator[Deployed]:
         spinner.stop()
         node.destroy_node()
         probe.node.destroy_node()
+        gc.unfreeze()
 
 
 @pytest.fixture
