@@ -261,6 +261,13 @@ def pub(
     out.print(f"published {count} {type_name} on {name} at {rate:g} Hz", markup=False)
 
 
+ServiceTimeout = Annotated[
+    float,
+    typer.Option("--timeout", min=0.0, help="Seconds to wait for the service, then its answer."),
+]
+"""``--timeout`` of the commands that call a service (each sets its own default)."""
+
+
 @app.command("call")
 def call(
     service: Annotated[str, typer.Argument(help="Service name, e.g. /openral/estop.")],
@@ -275,12 +282,7 @@ def call(
     values: Annotated[
         str, typer.Argument(help="Request fields as YAML, e.g. '{data: true}'.")
     ] = "{}",
-    timeout: Annotated[
-        float,
-        typer.Option(
-            "--timeout", min=0.0, help="Seconds to wait for the service, then its answer."
-        ),
-    ] = 5.0,
+    timeout: ServiceTimeout = 5.0,
     domain_id: DomainId = None,
 ) -> None:
     """Call SERVICE with a request of VALUES and print the response; exit 1 when it answers
@@ -365,12 +367,7 @@ def tf(
 
 @app.command("reset")
 def reset(
-    timeout: Annotated[
-        float,
-        typer.Option(
-            "--timeout", min=0.0, help="Seconds to wait for the service, then its answer."
-        ),
-    ] = 10.0,
+    timeout: ServiceTimeout = 10.0,
     domain_id: DomainId = None,
 ) -> None:
     """Reset the simulated scene through ``/openral/reset``: its seed, the start pose and
