@@ -17,10 +17,11 @@ from functools import partial
 from typing import Any
 
 import pytest
+from openral_bridge.ros_messages import LATCHED
 from openral_bridge.topics import ACTION_SPEC, ROBOT_DESCRIPTION
 from openral_core.models import RobotDescription
 from openral_nodes.manifest_node import ManifestLifecycleNode
-from openral_nodes.runtime import LATCHED, Spinner, claim_domain_id
+from openral_nodes.runtime import Spinner, claim_domain_id
 from rclpy.context import Context
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock

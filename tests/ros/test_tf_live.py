@@ -35,10 +35,11 @@ import numpy as np
 import pytest
 import yourdfpy
 from geometry_msgs.msg import Twist
+from openral_bridge.ros_messages import LATCHED
 from openral_bridge.topics import CMD_VEL, JOINT_STATES, ODOM, ROBOT_DESCRIPTION, TF, TF_STATIC
 from openral_core import open_robot_by_id
 from openral_core.loaded import LoadedRobot
-from openral_nodes.runtime import LATCHED, Spinner, claim_domain_id, ros_session
+from openral_nodes.runtime import Spinner, claim_domain_id, ros_session
 from openral_nodes.topic_graph import message_class
 from rclpy.context import Context
 from rclpy.qos import QoSProfile

@@ -18,10 +18,10 @@ from typing import Any
 
 import numpy as np
 import pytest
-from openral_bridge.ros_messages import image_msg, joint_state_msg, stamp
+from openral_bridge.ros_messages import LATCHED, image_msg, joint_state_msg, stamp
 from openral_bridge.topics import ACTION_SPEC
 from openral_cli import main
-from openral_nodes.runtime import LATCHED, Spinner, claim_domain_id, ros_session
+from openral_nodes.runtime import Spinner, claim_domain_id, ros_session
 from rclpy.context import Context
 from rclpy.node import Node
 from sensor_msgs.msg import Image, JointState

@@ -11,9 +11,10 @@ from typing import Any
 import numpy as np
 import pytest
 from geometry_msgs.msg import TransformStamped
+from openral_bridge.ros_messages import LATCHED
 from openral_cli.main import app
 from openral_core.errors import OpenralError
-from openral_nodes.runtime import LATCHED, Spinner, ros_session
+from openral_nodes.runtime import Spinner, ros_session
 from openral_nodes.tf_listener import FrameNotFound, TfBuffer, Transform
 from rclpy.context import Context
 from rclpy.node import Node

@@ -26,7 +26,8 @@ from action_msgs.msg import GoalStatus
 from builtin_interfaces.msg import Duration
 from control_msgs.action import FollowJointTrajectory
 from control_msgs.msg import JointComponentTolerance, JointTolerance
-from openral_nodes.runtime import LATCHED, Spinner, claim_domain_id, ros_session
+from openral_bridge.ros_messages import LATCHED
+from openral_nodes.runtime import Spinner, claim_domain_id, ros_session
 from rclpy.action import ActionClient, ActionServer
 from rclpy.action.server import ServerGoalHandle
 from rclpy.context import Context

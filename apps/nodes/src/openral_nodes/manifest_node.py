@@ -53,6 +53,7 @@ from openral_bridge import ros_messages
 from openral_bridge.control_loop import ControlLoop
 from openral_bridge.joint_state_publisher import sim_stamp
 from openral_bridge.pacer import PacedJob, Pacer
+from openral_bridge.ros_messages import LATCHED
 from openral_bridge.topics import ACTION_SPEC, CLOCK, TopicInfo
 from openral_bridge.trajectory_follower import follower_for
 from openral_core import LoadedRobot
@@ -72,7 +73,6 @@ from openral_nodes.command_interfaces import CommandInterfaces
 from openral_nodes.lifecycle_guard import guard_change_state
 from openral_nodes.node_parameters import BOUNDS, PARAMETERS, check_rates, robot_and_scene
 from openral_nodes.robot_state_streams import RobotStateStreams
-from openral_nodes.runtime import LATCHED
 from openral_nodes.scene_bridges import SceneBridges
 
 NODE_NAME = "openral_manifest_node"

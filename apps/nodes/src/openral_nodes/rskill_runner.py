@@ -24,6 +24,7 @@ from typing import Any, TypeVar
 import numpy as np
 import numpy.typing as npt
 from openral_bridge import topics
+from openral_bridge.ros_messages import LATCHED
 from openral_core import VlaSlot, open_robot_by_id
 from openral_core.errors import OpenralError
 from openral_eval.policies import Observation, PolicyAdapter, make_policy, parse_params
@@ -36,7 +37,6 @@ from rclpy.qos import (
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float64MultiArray
 
-from openral_nodes.runtime import LATCHED
 from openral_nodes.topic_codec import image_to_rgb
 
 T = TypeVar("T")

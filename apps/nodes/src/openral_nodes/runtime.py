@@ -34,13 +34,7 @@ from openral_core.errors import OpenralError
 from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
-
-LATCHED = QoSProfile(  # type: ignore[no-untyped-call]
-    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
-)
-"""Latched QoS (``/openral/action_spec``): a late subscriber still gets the last message."""
 
 T = TypeVar("T")
 

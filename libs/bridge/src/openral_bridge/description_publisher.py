@@ -12,17 +12,13 @@ import threading
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import String
 
+from openral_bridge.ros_messages import LATCHED
 from openral_bridge.topics import ROBOT_DESCRIPTION, TopicInfo
 
 if TYPE_CHECKING:
     from rclpy.node import Node
-
-LATCHED = QoSProfile(  # type: ignore[no-untyped-call]
-    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
-)
 
 
 STOP_WAIT_S = 10.0

@@ -13,6 +13,7 @@ import numpy as np
 import numpy.typing as npt
 from builtin_interfaces.msg import Time
 from openral_sim.depth_cloud import focal_length_px
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import (
     CameraInfo,
     Image,
@@ -21,6 +22,13 @@ from sensor_msgs.msg import (
     PointCloud2,
     PointField,
 )
+
+LATCHED = QoSProfile(  # type: ignore[no-untyped-call]
+    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
+)
+"""Latched QoS (transient local, reliable, depth 1), as a latched ROS publisher offers it:
+a late subscriber still gets the last message (``/openral/action_spec``,
+``/robot_description``, ``/tf_static``)."""
 
 FloatArray = npt.NDArray[np.floating[Any]]
 

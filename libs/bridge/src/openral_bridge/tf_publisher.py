@@ -22,7 +22,7 @@ import mujoco
 import numpy as np
 from geometry_msgs.msg import TransformStamped
 from openral_sim.frame_tree import FrameSample, FrameTree
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from tf2_msgs.msg import TFMessage
 
 from openral_bridge import ros_messages
@@ -37,9 +37,7 @@ if TYPE_CHECKING:
 
 TF_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)  # type: ignore[no-untyped-call]
 """``/tf`` as tf2's broadcaster offers it."""
-TF_STATIC_QOS = QoSProfile(  # type: ignore[no-untyped-call]
-    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
-)
+TF_STATIC_QOS = ros_messages.LATCHED
 """``/tf_static`` as tf2's static broadcaster offers it (a late listener gets it)."""
 
 
