@@ -5,13 +5,18 @@ Markdown in docstrings and ``help=`` strings (``code`` spans in backticks; a bla
 separates paragraphs, single line breaks are reflowed). Option and argument hints follow
 click's convention: a flag shows none, a value its kind (``TEXT``, ``INTEGER``,
 ``FLOAT``, ``PATH``) or its choices, a repeated argument its element's kind; the usage
-line names arguments in capitals (``TOPIC``, ``[VALUES]...``), not ``{topic}``.
+line names arguments in capitals (``TOPIC``, ``[VALUES]...``), not ``{topic}``. A
+placeholder in angle brackets (``robots/<id>/robot.yaml``) prints as written: help is
+rendered by :class:`~openral_cli.help_markdown.PlainAngleMarkdown`, which reads no HTML.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import typer
-from typer.core import TyperArgument, TyperOption
+from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
 __all__ = ["command_group"]
 
@@ -34,7 +39,26 @@ def _usage_name(param: TyperArgument) -> str:
     return name + ("..." if param.nargs != 1 else "")
 
 
+def _angle_brackets_kept() -> None:
+    """Render help with :class:`PlainAngleMarkdown` (imports rich: only when help prints)."""
+    from typer import rich_utils
+
+    from openral_cli.help_markdown import PlainAngleMarkdown
+
+    rich_utils.Markdown = PlainAngleMarkdown  # type: ignore[attr-defined]
+
+
+def _keeping_angle_brackets(format_help: Callable[..., None]) -> Callable[..., None]:
+    def format_help_kept(self: Any, ctx: Any, formatter: Any) -> None:
+        _angle_brackets_kept()
+        format_help(self, ctx, formatter)
+
+    return format_help_kept
+
+
 def _install() -> None:
+    TyperCommand.format_help = _keeping_angle_brackets(TyperCommand.format_help)  # type: ignore[method-assign]
+    TyperGroup.format_help = _keeping_angle_brackets(TyperGroup.format_help)  # type: ignore[method-assign]
     TyperOption.display_type_rich = _hint  # type: ignore[assignment,method-assign]
     TyperArgument.display_type_rich = _hint  # type: ignore[assignment,method-assign]
     TyperArgument._usage_display_name = _usage_name  # type: ignore[assignment,method-assign]
