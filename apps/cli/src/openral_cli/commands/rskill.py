@@ -83,11 +83,21 @@ def run(
             node.destroy_node()  # type: ignore[no-untyped-call]
     if node.abort_error is not None:
         raise node.abort_error
-    routes = ", ".join(f"{e.slot} <- {e.sensor}" for e in node.slot_table)
     out.print(
         f"{policy} on {node.robot}: {node.status.actions} action(s) on /openral/safe_action "
-        f"in {elapsed:.1f} s ({routes or 'no cameras'})"
+        f"in {elapsed:.1f} s ({_fed_routes(node) or 'no cameras'})"
     )
+
+
+def _fed_routes(node: RskillRunnerNode) -> str:
+    """``slot <- sensor`` for the slots that had frames at the runner's last tick.
+
+    The manifest's slot table names every camera the robot has; a scene renders only those
+    in its ``cameras`` list, so a slot whose camera the scene leaves out never gets a frame
+    and is not listed.
+    """
+    fed = set(node.status.seen_slots)
+    return ", ".join(f"{e.slot} <- {e.sensor}" for e in node.slot_table if e.slot in fed)
 
 
 def _watch(node: RskillRunnerNode, policy: str, duration: float | None) -> float:
