@@ -8,8 +8,11 @@ from pathlib import Path
 
 import pytest
 from openral_core.errors import ManifestError
+from openral_core.loader import load_robot
+from openral_core.registry import manifest_path
 from openral_core.yaml_guard import (
     ALIAS_FACTOR,
+    MAX_ALIAS_CHARS,
     MAX_ALIAS_NODES,
     MAX_DEPTH,
     MAX_FILE_BYTES,
@@ -151,3 +154,74 @@ def test_utf8_bom_is_accepted(tmp_path: Path) -> None:
     file = tmp_path / "doc.yaml"
     file.write_bytes("\ufeffa: 1\n".encode())
     assert load_located(file).data == {"a": 1}
+
+
+LONG = 10 * 1024
+"""Length of the anchored string in the long-string alias tests [characters]."""
+
+
+def long_string_aliases(count: int, written: int = 0) -> str:
+    """A manifest-shaped file: one anchored string of :data:`LONG` characters, ``written``
+    plain numbers, then ``count`` aliases to the string in a block list."""
+    head = f'name: &a "{"x" * LONG}"\nnumbers: [{", ".join(["1"] * written)}]\njoints:\n'
+    return head + "  - *a\n" * count
+
+
+def test_aliases_to_a_long_string_are_refused_at_the_crossing_alias(tmp_path: Path) -> None:
+    file = tmp_path / "robot.yaml"
+    file.write_text(long_string_aliases(140_000))
+    assert 0.9e6 < file.stat().st_size <= MAX_FILE_BYTES
+    tracemalloc.start()
+    with pytest.raises(ManifestError) as info:
+        load_robot(file, check_folder_name=False)
+    _, peak_bytes = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    (issue,) = info.value.issues
+    crossing = MAX_ALIAS_CHARS // LONG  # index of the first alias past the bound
+    assert (issue.line, issue.column, issue.field) == (4 + crossing, 5, f"joints[{crossing}]")
+    assert issue.message == (
+        f"aliases expand this document by more than {MAX_ALIAS_CHARS} characters of text "
+        f"(this alias repeats {LONG}); at most {MAX_ALIAS_CHARS} are accepted"
+    )
+    assert len(str(info.value).splitlines()) == 1
+    assert peak_bytes < 50e6, f"refusing the file allocated {peak_bytes / 1e6:.1f} MB"
+
+
+def test_long_string_aliases_within_the_node_ratio_are_refused_too(tmp_path: Path) -> None:
+    # The fuzzed shape: enough written values that the node ratio allows every alias.
+    (message,) = _refusal(tmp_path, long_string_aliases(3_000, written=1_000))
+    assert f"more than {MAX_ALIAS_CHARS} characters of text" in message
+    assert message.startswith(f"{4 + MAX_ALIAS_CHARS // LONG}:5: joints[")
+
+
+def test_aliases_count_as_values_written(tmp_path: Path) -> None:
+    text = "a: &a x\nb: [" + "*a," * MAX_NODES + "*a]\n"
+    (message,) = _refusal(tmp_path, text)
+    crossing = MAX_NODES - 5  # the mapping, a, x, b and the list are the 5 written values
+    assert message.startswith(f"2:{5 + 3 * crossing}: b[{crossing}]: more than")
+    assert f"more than {MAX_NODES} values in one file" in message
+
+
+def test_aliases_up_to_the_character_bound_load_and_share_one_string(tmp_path: Path) -> None:
+    file = tmp_path / "doc.yaml"
+    count = MAX_ALIAS_CHARS // LONG
+    file.write_text(long_string_aliases(count, written=count // ALIAS_FACTOR))
+    joints = load_located(file).data["joints"]
+    assert len(joints) == count and joints[0] == "x" * LONG
+    assert all(joint is joints[0] for joint in joints)
+
+
+def test_a_manifest_with_a_few_aliases_loads_as_if_written_out(tmp_path: Path) -> None:
+    original = manifest_path("franka_panda")
+    text = original.read_text(encoding="utf-8")
+    limits = "position_limits: [-2.8973, 2.8973]"
+    assert text.count(limits) == 4
+    text = text.replace(limits, "position_limits: &wide [-2.8973, 2.8973]", 1)
+    text = text.replace(limits, "position_limits: *wide")
+    text = text.replace("rate_hz: 10.0", "rate_hz: &camera_hz 10.0", 1)
+    text = text.replace("rate_hz: 10.0", "rate_hz: *camera_hz")
+    assert text.count("*wide") == 3 and text.count("*camera_hz") == 1
+    (tmp_path / "franka_panda").mkdir()
+    file = tmp_path / "franka_panda" / "robot.yaml"
+    file.write_text(text, encoding="utf-8")
+    assert load_robot(file).model_dump() == load_robot(original).model_dump()

@@ -7,14 +7,18 @@ line each, what would otherwise cost unbounded time or memory or end in a traceb
   that are not UTF-8, and control characters YAML does not allow;
 - :func:`scan_events`: one pass over ruamel's event stream (its parser keeps explicit
   stacks, so no input makes it recurse) that refuses nesting deeper than :data:`MAX_DEPTH`,
-  more than :data:`MAX_NODES` values, aliases that would expand the document (a "billion
-  laughs" bomb) or that refer to their own node, tags, directives, merge keys (``<<``),
-  keys that are not plain scalars, repeated keys, more than one document and integers
-  longer than :data:`MAX_INT_DIGITS`.
+  more than :data:`MAX_NODES` values (aliases included), aliases that would expand the
+  document (a "billion laughs" bomb, or many aliases to one long string) or that refer to
+  their own node, tags, directives, merge keys (``<<``), keys that are not plain scalars,
+  repeated keys, more than one document and integers longer than :data:`MAX_INT_DIGITS`.
 
 Only a document that passed both is handed to ruamel's loader. The scan counts an alias as
-the size of the node it names, in constant time, so a bomb is refused after reading its few
-hundred bytes, never by expanding it.
+the size of the node it names, in constant time: its nodes and the characters of every
+scalar (keys included) in it. Aliases may add at most :data:`MAX_ALIAS_NODES` nodes (and
+:data:`ALIAS_FACTOR` times the nodes written) and :data:`MAX_ALIAS_CHARS` characters, so a
+loaded document holds at most ~3 Mi characters of text (the file's own 1 MiB plus 2 Mi from
+aliases) whatever the file; a bomb is refused at the alias that crosses a bound, after
+reading only the text before it, never by expanding it.
 """
 
 from __future__ import annotations
@@ -45,10 +49,13 @@ MAX_FILE_BYTES = 1 << 20
 MAX_DEPTH = 32
 """Deepest nesting of mappings and lists accepted (manifests nest about 5 deep)."""
 MAX_NODES = 20_000
-"""Most nodes written in one file (the largest manifest in robots/ has ~600; ruamel parses
-about 40,000 nodes a second, so this bounds the scan to about half a second)."""
+"""Most values written in one file, aliases included (the largest manifest in robots/ has
+~600; ruamel parses some 15,000-40,000 a second, so this bounds the scan to ~1 s)."""
 MAX_ALIAS_NODES = 100_000
 """Most nodes that aliases may add to a document, whatever its size."""
+MAX_ALIAS_CHARS = 1 << 21
+"""Most characters of scalar text that aliases may add to a document (2 Mi; a manifest's
+aliases repeat a few limits or names, some hundred characters)."""
 ALIAS_FACTOR = 10
 """Aliases may add at most this many times the number of nodes written in the file."""
 MAX_INT_DIGITS = 100
@@ -131,6 +138,8 @@ class _Frame:
     anchor: str | None
     size: int = 1
     """Nodes in this collection so far, aliases expanded (itself included)."""
+    chars: int = 0
+    """Characters of the scalars in this collection so far, aliases expanded."""
     children: int = 0
     key: str | int | None = None
     """The key whose value comes next (mappings)."""
@@ -153,12 +162,16 @@ class _Scan:
 
     file: Path
     frames: list[_Frame] = field(default_factory=list)
-    anchors: dict[str, int] = field(default_factory=dict)
-    """Finished anchored nodes → their expanded size in nodes."""
+    anchors: dict[str, tuple[int, int]] = field(default_factory=dict)
+    """Finished anchored nodes → their expanded size: (nodes, characters of scalars)."""
     open_anchors: set[str] = field(default_factory=set)
     written: int = 0
+    """Nodes written in the file (aliases not included)."""
+    aliases: int = 0
     expanded: int = 0
     """Nodes that aliases add to the document."""
+    expanded_chars: int = 0
+    """Characters of scalar text that aliases add to the document."""
     first_alias: AliasEvent | None = None
     documents: int = 0
     issues: list[Issue] = field(default_factory=list)
@@ -209,8 +222,8 @@ def _visit(scan: _Scan, event: Event) -> None:
         frame = scan.frames.pop()
         if frame.anchor is not None:
             scan.open_anchors.discard(frame.anchor)
-            scan.anchors[frame.anchor] = frame.size
-        _finish_child(scan, frame.size, None)
+            scan.anchors[frame.anchor] = (frame.size, frame.chars)
+        _finish_child(scan, (frame.size, frame.chars), None)
 
 
 def _document_start(scan: _Scan, event: DocumentStartEvent) -> None:
@@ -229,11 +242,13 @@ def _node(scan: _Scan, event: NodeEvent) -> None:
     if tag is not None:
         scan.issue(event, path, f"YAML tags ({tag}) are not allowed; write the plain value")
     if isinstance(event, AliasEvent):
-        _alias(scan, event, path, is_key)
+        scan.aliases += 1
+        _count_value(scan, event, path)
+        if not scan.stopped:
+            _alias(scan, event, path, is_key)
         return
     scan.written += 1
-    if scan.written > MAX_NODES:
-        scan.issue(event, path, f"more than {MAX_NODES} values in one file", fatal=True)
+    _count_value(scan, event, path)
     if event.anchor is not None:
         scan.open_anchors.add(event.anchor)
     if isinstance(event, CollectionStartEvent):
@@ -252,10 +267,18 @@ def _node(scan: _Scan, event: NodeEvent) -> None:
         if digits > MAX_INT_DIGITS:
             message = f"an integer of {digits} digits; at most {MAX_INT_DIGITS} are accepted"
             scan.issue(event, path, message)
+    size = (1, len(event.value))
     if event.anchor is not None:
         scan.open_anchors.discard(event.anchor)
-        scan.anchors[event.anchor] = 1
-    _finish_child(scan, 1, event.value if is_key else None)
+        scan.anchors[event.anchor] = size
+    _finish_child(scan, size, event.value if is_key else None)
+
+
+def _count_value(scan: _Scan, event: NodeEvent, path: PathKey) -> None:
+    """Refuse the value past :data:`MAX_NODES` written in the file (aliases count: each one
+    costs the parser as much as a written value)."""
+    if scan.written + scan.aliases > MAX_NODES:
+        scan.issue(event, path, f"more than {MAX_NODES} values in one file", fatal=True)
 
 
 def _key(scan: _Scan, event: ScalarEvent, frame: _Frame) -> None:
@@ -278,16 +301,23 @@ def _alias(scan: _Scan, event: AliasEvent, path: PathKey, is_key: bool) -> None:
         scan.issue(event, path, "an alias cannot be a key; write the key out")
     if name in scan.open_anchors:
         scan.issue(event, path, f"alias *{name} refers to the node that contains it")
-        _finish_child(scan, 1, None)
+        _finish_child(scan, (1, 0), None)
         return
     size = scan.anchors.get(name) if name is not None else None
     if size is None:
         scan.issue(event, path, f"alias *{name} names no anchor defined before it")
-        size = 1
-    scan.expanded += size
+        size = (1, 0)
+    scan.expanded += size[0]
+    scan.expanded_chars += size[1]
     scan.first_alias = scan.first_alias or event
     if scan.expanded > MAX_ALIAS_NODES:
         message = f"aliases expand this document by more than {MAX_ALIAS_NODES} nodes"
+        scan.issue(event, path, message, fatal=True)
+    elif scan.expanded_chars > MAX_ALIAS_CHARS:
+        message = (
+            f"aliases expand this document by more than {MAX_ALIAS_CHARS} characters of "
+            f"text (this alias repeats {size[1]}); at most {MAX_ALIAS_CHARS} are accepted"
+        )
         scan.issue(event, path, message, fatal=True)
     _finish_child(scan, size, None)
 
@@ -302,12 +332,14 @@ def _check_alias_ratio(scan: _Scan) -> None:
         scan.issue(scan.first_alias, (), message)
 
 
-def _finish_child(scan: _Scan, size: int, key: str | None) -> None:
-    """A node of ``size`` nodes (aliases expanded) is complete: count it in its parent."""
+def _finish_child(scan: _Scan, size: tuple[int, int], key: str | None) -> None:
+    """A node of ``size`` (nodes, characters; aliases expanded) is complete: count it in
+    its parent."""
     if not scan.frames:
         return
     parent = scan.frames[-1]
-    parent.size += size
+    parent.size += size[0]
+    parent.chars += size[1]
     if parent.is_mapping and parent.expects_key:
         parent.key = key
     parent.children += 1

@@ -4,7 +4,8 @@ The text first passes :mod:`openral_core.yaml_guard` (size, encoding, control ch
 nesting, aliases, tags, merge and duplicate keys, long integers). Only then does ruamel's
 round-trip loader (which never builds arbitrary Python objects) parse it; the document is
 turned into plain ``dict``/``list``/scalars with the line and column of every key and item,
-so later checks can point at the exact spot in the file.
+so later checks can point at the exact spot in the file. A string that aliases repeat is
+converted once and shared, not copied for each alias.
 """
 
 from __future__ import annotations
@@ -64,14 +65,20 @@ def load_located(file: Path) -> LocatedDocument:
         raise ManifestError(file, [issue]) from None
     document = LocatedDocument(file, None)
     issues: list[Issue] = []
-    document.data = _plain(raw, (), document, issues)
+    document.data = _plain(raw, (), document, issues, {})
     if issues:
         raise ManifestError(file, issues)
     return document
 
 
-def _plain(node: Any, path: PathKey, doc: LocatedDocument, issues: list[Issue]) -> Any:
-    """Convert ruamel nodes to plain Python, recording positions and rejecting oddities."""
+def _plain(
+    node: Any, path: PathKey, doc: LocatedDocument, issues: list[Issue], strings: dict[int, str]
+) -> Any:
+    """Convert ruamel nodes to plain Python, recording positions and rejecting oddities.
+
+    ``strings`` maps the id of each ruamel string converted so far (an anchored one is a
+    ``str`` subclass, shared by its aliases) to its plain ``str``, so none is copied twice.
+    """
     if isinstance(node, CommentedMap):
         result: dict[str, Any] = {}
         for key, (line, col) in _key_positions(node):
@@ -79,14 +86,14 @@ def _plain(node: Any, path: PathKey, doc: LocatedDocument, issues: list[Issue]) 
             doc.positions[child] = (line, col)
             if not isinstance(key, str):
                 issues.append(doc.issue(child, f"keys must be strings, got {key!r}"))
-            result[str(key)] = _plain(node[key], child, doc, issues)
+            result[str(key)] = _plain(node[key], child, doc, issues, strings)
         return result
     if isinstance(node, CommentedSeq):
         items: list[Any] = []
         for index, item in enumerate(node):
             line, col = node.lc.item(index)
             doc.positions[(*path, index)] = (line + 1, col + 1)
-            items.append(_plain(item, (*path, index), doc, issues))
+            items.append(_plain(item, (*path, index), doc, issues, strings))
         return items
     if isinstance(node, bool) or node is None:
         return node
@@ -97,7 +104,12 @@ def _plain(node: Any, path: PathKey, doc: LocatedDocument, issues: list[Issue]) 
             issues.append(doc.issue(path, f"expected a finite number, got {node}"))
         return float(node)
     if isinstance(node, str):
-        return str(node)
+        if type(node) is str:
+            return node
+        plain = strings.get(id(node))
+        if plain is None:
+            plain = strings[id(node)] = str(node)
+        return plain
     issues.append(doc.issue(path, f"unsupported YAML value {node!r} ({type(node).__name__})"))
     return None
 
