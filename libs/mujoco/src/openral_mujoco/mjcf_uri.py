@@ -10,6 +10,10 @@ Schemes:
   ``share/openarm_mujoco/v2/openarm_bimanual.xml``).
 - ``robosuite:<path>``: ``robosuite/models/assets/<path>`` of the installed robosuite.
 
+``<distribution>`` must be a distribution name (PEP 508: letters, digits, ``.``, ``_``, ``-``,
+starting and ending with a letter or digit) and a ``pkg:``/``robosuite:`` ``<path>`` must
+have no empty, ``.`` or ``..`` part; anything else is refused before any look-up.
+
 Each resolution has a confinement root (:class:`~openral_mujoco.mjcf_confinement.Confinement`):
 the robot's folder for ``file:``, the folder holding the distribution's files next to the
 model for the others. The model, and every file it includes or loads, must lie inside it
@@ -44,6 +48,11 @@ SCHEMES = ("file", "pkg", "robosuite")
 
 DISTRIBUTION = "openral"
 """Our own distribution, whose extras name the robot model packages."""
+
+PKG_FORM = "'pkg:<distribution>/<path inside it>'"
+"""How a ``pkg:`` URI is written, for messages."""
+_DISTRIBUTION_NAME = re.compile(r"[A-Za-z0-9](?:[A-Za-z0-9._-]*[A-Za-z0-9])?")
+"""A distribution name as PEP 508 spells it."""
 
 
 class MjcfUriError(OpenralError):
@@ -129,22 +138,44 @@ def locate_mjcf_uri(uri: str, manifest_dir: Path | None = None) -> tuple[Path, C
     """The file ``uri`` names and the root it must stay in, unchecked (None: no root known)."""
     scheme, sep, rest = uri.partition(":")
     if not sep or not rest:
-        raise MjcfUriError(uri, f"expected '<scheme>:<path>' with scheme one of {SCHEMES}")
+        message = f"expected '<scheme>:<path>' with scheme one of {SCHEMES}"
+        raise MjcfUriError(uri, message, manifest_dir)
     if scheme == "file":
         return _file_path(rest, uri, manifest_dir)
     if scheme == "pkg":
-        distribution, slash, inner = rest.partition("/")
-        if not slash or not inner:
-            raise MjcfUriError(uri, "expected 'pkg:<distribution>/<path inside it>'", manifest_dir)
+        distribution, inner = _package_parts(rest, uri, manifest_dir)
     elif scheme == "robosuite":
+        _check_inner(rest, "'robosuite:<path inside models/assets>'", uri, manifest_dir)
         distribution, inner = "robosuite", f"robosuite/models/assets/{rest}"
     else:
         message = (
             f"unknown scheme {scheme!r}; expected one of {SCHEMES} (a file installed by a "
-            "Python distribution is 'pkg:<distribution>/<path inside it>')"
+            f"Python distribution is {PKG_FORM})"
         )
         raise MjcfUriError(uri, message, manifest_dir)
     return distribution_file(distribution, inner, uri, manifest_dir)
+
+
+def _package_parts(rest: str, uri: str, manifest_dir: Path | None) -> tuple[str, str]:
+    """``(distribution, path inside it)`` of a ``pkg:`` URI whose ``rest`` follows ``pkg:``."""
+    distribution, slash, inner = rest.partition("/")
+    if not slash or not inner:
+        raise MjcfUriError(uri, f"expected {PKG_FORM}", manifest_dir)
+    if not _DISTRIBUTION_NAME.fullmatch(distribution):
+        message = (
+            f"expected {PKG_FORM}, and {distribution!r} is not a distribution name "
+            "(letters, digits, '.', '_' and '-', starting and ending with a letter or digit)"
+        )
+        raise MjcfUriError(uri, message, manifest_dir)
+    _check_inner(inner, PKG_FORM, uri, manifest_dir)
+    return distribution, inner
+
+
+def _check_inner(inner: str, form: str, uri: str, manifest_dir: Path | None) -> None:
+    """Refuse a path inside a distribution with an empty, ``.`` or ``..`` part."""
+    if any(part in ("", ".", "..") for part in inner.split("/")):
+        message = f"expected {form}, and the path {inner!r} has an empty, '.' or '..' part"
+        raise MjcfUriError(uri, message, manifest_dir)
 
 
 def distribution_file(
