@@ -16,6 +16,7 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 from openral_bridge.frame_renderer import FrameRenderer
+from openral_sim.mujoco_capture import MujocoCapture
 from openral_sim.native_scene import NativeScene
 from openral_sim.scene import build_sim_env_from_yaml
 
@@ -81,7 +82,7 @@ def make(
     size: tuple[int, int] = (16, 16),
 ) -> tuple[FrameRenderer, Published]:
     published = Published()
-    frames = FrameRenderer(*handles, sensors, size, render, published)
+    frames = FrameRenderer(MujocoCapture(*handles, sensors, size, render), published)
     frames.start()
     return frames, published
 
@@ -188,7 +189,7 @@ def test_a_failing_render_stops_the_thread_and_is_reported(
 
 
 def test_unknown_sensors_are_refused(tiny: tuple[mujoco.MjModel, mujoco.MjData]) -> None:
-    frames = FrameRenderer(*tiny, ("a",), (16, 16), Gate(), Published())
+    frames = FrameRenderer(MujocoCapture(*tiny, ("a",), (16, 16), Gate()), Published())
     with pytest.raises(KeyError):
         frames.request("z")
     assert frames.stop()  # never started: nothing to stop
@@ -243,16 +244,16 @@ def test_a_snapshot_frame_is_the_frame_of_the_state_it_was_taken_at(
 
 def test_without_observation_rendering_step_renders_nothing(franka: NativeScene) -> None:
     calls: list[object] = []
-    original = franka.render_cameras
-    franka.render_cameras = lambda *a, **k: calls.append(a) or original(*a, **k)  # type: ignore[method-assign]
+    original = franka.sensors.render
+    franka.sensors.render = lambda *a, **k: calls.append(a) or original(*a, **k)  # type: ignore[method-assign]
     try:
         obs = franka.step(franka.hold_action()).obs
-        assert obs["images"] == {} and obs["time"] > 0 and not calls
+        assert obs.images == {} and obs.time_s > 0 and not calls
         franka.render_observations = True
         obs = franka.step(franka.hold_action()).obs
-        assert set(obs["images"]) == {"agentview", "wrist"} and len(calls) == 1
+        assert set(obs.images) == {"agentview", "wrist"} and len(calls) == 1
     finally:
-        franka.render_cameras = original  # type: ignore[method-assign]
+        franka.sensors.render = original  # type: ignore[method-assign]
         franka.render_observations = False
     assert franka.image_size == (128, 128)
     with pytest.raises(KeyError, match="belly"):

@@ -24,6 +24,17 @@ class Config(WaveConfig):
 
 ENTRY = PolicyEntry(Config, WavePolicy)
 NOT_AN_ENTRY = 42
+
+
+class Undeclared:  # acts, but says nothing of what it needs
+    def __init__(self, config):
+        self.config = config
+
+    def act(self, obs):
+        return obs["action_spec"][1]
+
+
+UNDECLARED = PolicyEntry(WaveConfig, Undeclared)
 """
 
 
@@ -38,6 +49,7 @@ def plugin(tmp_path: Path) -> Iterator[None]:
         "big_wave = my_policies:ENTRY\n"
         "broken = my_missing_module:ENTRY\n"
         "not_entry = my_policies:NOT_AN_ENTRY\n"
+        "undeclared = my_policies:UNDECLARED\n"
     )
     sys.path.insert(0, str(tmp_path))
     try:
@@ -65,3 +77,11 @@ def test_broken_registrations_are_one_line_each(plugin: None) -> None:
         make_policy("dance")
     assert str(unknown.value).startswith("unknown policy 'dance'; available: wave, scripted_lift")
     assert "big_wave" in str(unknown.value)
+
+
+def test_a_policy_that_does_not_declare_its_needs_is_refused(plugin: None) -> None:
+    with pytest.raises(PolicyConfigError) as refused:
+        make_policy("undeclared")
+    assert str(refused.value).startswith(
+        "policy 'undeclared' (Undeclared) lacks required_slots, needs_privileged;"
+    )

@@ -133,6 +133,7 @@ def test_an_episode_that_raises_is_recorded_and_the_sweep_goes_on(
 ) -> None:
     class Broken:
         required_slots: tuple[str, ...] = ()
+        needs_privileged = False
 
         def act(self, obs: policies.Observation) -> object:
             raise RuntimeError("the policy fell over")

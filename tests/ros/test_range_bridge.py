@@ -25,7 +25,8 @@ def bridge(ros_context: Context) -> Iterator[tuple[RangeBridge, Pacer]]:
     scene = NativeScene(load_scene(FRANKA_SCENE), open_robot_by_id("franka_panda"))
     scene.reset(0)
     node = Node("range_bridge_test", context=ros_context)
-    bridge, pacer = RangeBridge(node, scene, threading.Lock()), Pacer()
+    sensors = scene.sensors
+    bridge, pacer = RangeBridge(node, sensors, sensors, threading.Lock(), {}), Pacer()
     with Spinner(ros_context) as spinner:
         spinner.add_node(node)
         spinner.call(bridge.start, pacer)

@@ -18,6 +18,7 @@ from openral_core.registry import load_robot_by_id
 from openral_hal.protocol import CameraHal, EStopLatch, MujocoBacked
 from openral_mujoco.state import FloatArray, JointStateSample
 from openral_nodes.runtime import Spinner
+from openral_sim.sensor_schedule import sensor_rates
 from rclpy.context import Context
 from rclpy.node import Node
 from sensor_msgs.msg import CameraInfo, Image
@@ -123,8 +124,9 @@ def test_each_camera_publishes_at_its_own_manifest_rate(
 def test_camera_rate_overrides_every_sensor(node: Node) -> None:
     description = with_rates(FRANKA, agentview=20.0, wrist=4.0)
     pacer = Pacer()  # never started: the jobs are only looked at
+    rates = sensor_rates(description, None, frame_rate_hz=15.0)
     bridge = SimSensorBridge(
-        node, FakeSimHal(), description, pacer, viewer_enabled=False, camera_rate_hz=15.0
+        node, FakeSimHal(), description, pacer, viewer_enabled=False, camera_rates_hz=rates
     )
     bridge.setup()
     try:
@@ -176,7 +178,8 @@ def test_frames_carry_manifest_frame_ids_sim_time_and_manifest_fovy(
     hal = FakeSimHal()
     hal.sim_time_s = 12.5
     probe = Probe(ros_context, {image_topic("wrist"): Image, info_topic("wrist"): CameraInfo})
-    bridge = SimSensorBridge(node, hal, FRANKA, pacer, viewer_enabled=False, camera_rate_hz=20.0)
+    rates = sensor_rates(FRANKA, None, frame_rate_hz=20.0)
+    bridge = SimSensorBridge(node, hal, FRANKA, pacer, viewer_enabled=False, camera_rates_hz=rates)
     with Spinner(ros_context) as spinner:
         spinner.add_node(probe.node)
         spinner.add_node(node)
@@ -196,11 +199,11 @@ def test_frames_carry_manifest_frame_ids_sim_time_and_manifest_fovy(
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"camera_rate_hz": 0.0}, "camera_rate_hz"),
-        ({"camera_rate_hz": -2.0}, "camera_rate_hz"),
+        ({"camera_rates_hz": {"wrist": 0.0}}, r"camera_rates_hz\['wrist'\]"),
+        ({"camera_rates_hz": {"agentview": -2.0}}, r"camera_rates_hz\['agentview'\]"),
         ({"viewer_sync_rate_hz": -1.0}, "viewer_sync_rate_hz"),
     ],
 )
-def test_bad_rates_are_rejected(node: Node, kwargs: dict[str, float], message: str) -> None:
+def test_bad_rates_are_rejected(node: Node, kwargs: dict[str, object], message: str) -> None:
     with pytest.raises(ValueError, match=message):
         SimSensorBridge(node, FakeSimHal(), FRANKA, Pacer(), **kwargs)  # type: ignore[arg-type]

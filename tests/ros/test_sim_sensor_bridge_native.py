@@ -17,12 +17,18 @@ from openral_hal.factory import build_hal
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_nodes.runtime import Spinner
 from openral_sim.native_scene import NativeScene
+from openral_sim.sensor_schedule import sensor_rates
 from rclpy.context import Context
 from rclpy.node import Node
 from sensor_msgs.msg import Image
 
 from tests.ros.ros_helpers import FRANKA_SCENE, Probe, image_topic, wait_until
 from tests.ros.test_sim_sensor_bridge import CAMERAS, FRANKA, entity_counts
+
+
+def every_camera(rate_hz: float) -> dict[str, float]:
+    """Every camera of the Panda at ``rate_hz`` (the deploy override's rule)."""
+    return sensor_rates(FRANKA, None, frame_rate_hz=rate_hz)
 
 
 @pytest.fixture
@@ -86,7 +92,12 @@ def test_a_native_scene_renders_a_frame_only_when_one_is_due(
     probe = Probe(ros_context, {image_topic(c): Image for c in CAMERAS})
     # 0.1 Hz: after the one frame per camera at setup, nothing is due for 10 s
     bridge = SimSensorBridge(
-        node, native_hal, FRANKA, pacer, viewer_enabled=False, camera_rate_hz=0.1
+        node,
+        native_hal,
+        FRANKA,
+        pacer,
+        viewer_enabled=False,
+        camera_rates_hz=every_camera(0.1),
     )
     with Spinner(ros_context) as spinner:
         spinner.add_node(probe.node)
@@ -135,7 +146,13 @@ def test_a_busy_render_thread_skips_frames_and_never_holds_up_the_control_tick(
         ticks[0] += 1
 
     bridge = SimSensorBridge(
-        node, native_hal, FRANKA, pacer, lock=lock, viewer_enabled=False, camera_rate_hz=50.0
+        node,
+        native_hal,
+        FRANKA,
+        pacer,
+        lock=lock,
+        viewer_enabled=False,
+        camera_rates_hz=every_camera(50.0),
     )
     try:
         with Spinner(ros_context) as spinner:
@@ -207,7 +224,12 @@ def test_a_failing_renderer_stops_the_cameras_not_the_node(
     assert isinstance(scene, NativeScene)
     before = entity_counts(node, pacer)
     bridge = SimSensorBridge(
-        node, native_hal, FRANKA, pacer, viewer_enabled=False, camera_rate_hz=50.0
+        node,
+        native_hal,
+        FRANKA,
+        pacer,
+        viewer_enabled=False,
+        camera_rates_hz=every_camera(50.0),
     )
     with Spinner(ros_context) as spinner:
         spinner.add_node(node)

@@ -29,6 +29,7 @@ class RecordingPolicy:
     """Keeps every observation and answers with the hold action."""
 
     required_slots = ("camera1", "camera2")
+    needs_privileged = False
 
     def __init__(self) -> None:
         self.observations: list[Observation] = []

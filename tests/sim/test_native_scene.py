@@ -28,13 +28,13 @@ def test_every_default_scene_renders_its_cameras_and_moves(scene: Path) -> None:
     env = build_sim_env_from_yaml(scene)
     try:
         assert isinstance(env, SimRollout)
-        first = env.reset(0)["images"]
+        first = env.reset(0).images
         assert set(first) == set(env.camera_names) and first
         handles = env.mujoco_handles()
         assert handles is not None and env.action_dim == len(env.action_names)  # type: ignore[attr-defined]
         hold = env.hold_action()  # type: ignore[attr-defined]
         for step in range(6):
-            last = env.step(hold + 0.2 * (step + 1) / 6).obs["images"]
+            last = env.step(hold + 0.2 * (step + 1) / 6).obs.images
         for name, image in first.items():
             assert image.dtype == np.uint8 and image.shape == (128, 128, 3)
             assert image.std() > 5, f"{name} is blank"

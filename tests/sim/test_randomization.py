@@ -54,7 +54,7 @@ def test_a_seed_gives_the_same_episode_in_any_scene_and_order(franka: NativeScen
     for env, order in ((franka, (3, 7)), (other, (7, 3))):
         for seed in order:
             obs = env.reset(seed=seed)
-            frames[(id(env), seed)] = (env.data.qpos.copy(), obs["images"]["agentview"])
+            frames[(id(env), seed)] = (env.data.qpos.copy(), obs.images["agentview"])
     for seed in (3, 7):
         (qa, fa), (qb, fb) = frames[(id(franka), seed)], frames[(id(other), seed)]
         assert np.array_equal(qa, qb) and np.array_equal(fa, fb)
@@ -65,10 +65,10 @@ def test_a_seed_gives_the_same_episode_in_any_scene_and_order(franka: NativeScen
 
 def test_a_scene_without_ranges_is_the_same_for_every_seed() -> None:
     env = scene(ROBOTS / "ur5e" / "scenes" / "tabletop.yaml", "ur5e")
-    first = env.reset(seed=0)["images"]
+    first = env.reset(seed=0).images
     qpos = env.data.qpos.copy()
     for seed in (1, 99):
-        images = env.reset(seed=seed)["images"]
+        images = env.reset(seed=seed).images
         assert np.array_equal(env.data.qpos, qpos)
         assert all(np.array_equal(images[k], first[k]) for k in first)
 

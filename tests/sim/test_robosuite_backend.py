@@ -40,6 +40,10 @@ SCENES = {
 }
 
 
+CAMERAS = {"agentview", "wrist"}
+"""The scene files' cameras (10 Hz sensors of both manifests)."""
+
+
 def scene_text(robot_id: str, scene: str, options: str = f"horizon: {HORIZON}") -> str:
     return f"""schema_version: "0.1"
 robot_id: {robot_id}
@@ -84,7 +88,7 @@ def rollout(request: pytest.FixtureRequest, rollouts: dict[str, RobosuiteRollout
 
 
 def test_reset_renders_both_cameras(rollout: RobosuiteRollout) -> None:
-    images = rollout.reset(0)["images"]
+    images = rollout.reset(0).images
     assert rollout.camera_names == ("agentview", "wrist")
     assert set(images) == {"agentview", "wrist"}
     for name, image in images.items():
@@ -105,22 +109,24 @@ def test_random_steps_move_the_arm_and_the_picture(rollout: RobosuiteRollout) ->
     model, data = rollout.mujoco_handles()
     qpos = data.qpos.copy()
     rng = np.random.default_rng(0)
-    for _ in range(3):
-        result = rollout.step(rng.uniform(-1.0, 1.0, rollout.action_dim))
-        assert not (result.terminated or result.truncated)
-    frame = result.obs["images"]["agentview"]
-    assert not np.array_equal(frame, first["images"]["agentview"])
+    results = [rollout.step(rng.uniform(-1.0, 1.0, rollout.action_dim)) for _ in range(4)]
+    assert not any(result.outcome.done for result in results)
+    # the cameras are 10 Hz sensors on a 20 Hz loop: a frame every other step
+    assert [set(result.obs.images) for result in results] == [set(), CAMERAS, set(), CAMERAS]
+    result = results[-1]
+    frame = result.obs.images["agentview"]
+    assert not np.array_equal(frame, first.images["agentview"])
     assert not np.allclose(data.qpos, qpos)
-    assert result.obs["time"] == pytest.approx(3 / 20.0)
-    assert result.info["steps"] == 3
+    assert result.obs.time_s == pytest.approx(4 / 20.0)
+    assert result.outcome.steps == 4
     assert model.nq == data.qpos.size
 
 
 def test_same_seed_same_first_frame_and_handles_survive_reset(rollout: RobosuiteRollout) -> None:
-    first = rollout.reset(7)["images"]["agentview"]
+    first = rollout.reset(7).images["agentview"]
     handles = rollout.mujoco_handles()
     rollout.step(np.ones(rollout.action_dim))
-    again = rollout.reset(7)["images"]["agentview"]
+    again = rollout.reset(7).images["agentview"]
     assert np.array_equal(first, again)
     model, data = rollout.mujoco_handles()
     assert model is handles[0] and data is handles[1]
@@ -129,8 +135,8 @@ def test_same_seed_same_first_frame_and_handles_survive_reset(rollout: Robosuite
 def test_horizon_truncates(rollout: RobosuiteRollout) -> None:
     rollout.reset(0)
     results = [rollout.step(np.zeros(rollout.action_dim)) for _ in range(HORIZON)]
-    assert [r.truncated for r in results] == [False] * (HORIZON - 1) + [True]
-    assert not any(r.terminated for r in results)
+    assert [r.outcome.truncated for r in results] == [False] * (HORIZON - 1) + [True]
+    assert not any(r.outcome.terminated for r in results)
 
 
 def test_panda_handles_are_raw_mujoco(rollouts: dict[str, RobosuiteRollout]) -> None:
@@ -140,7 +146,7 @@ def test_panda_handles_are_raw_mujoco(rollouts: dict[str, RobosuiteRollout]) -> 
     assert joints[:7] == [f"robot0_joint{i}" for i in range(1, 8)]
     obs = rollouts["franka_panda"].reset(0)
     qpos = [data.qpos[model.joint(f"robot0_joint{i}").qposadr[0]] for i in range(1, 8)]
-    np.testing.assert_allclose(obs["joint_positions"], qpos)
+    np.testing.assert_allclose(obs.task_state["robot0_joint_pos"], qpos)
 
 
 def test_frames_match_a_plain_mujoco_render(rollout: RobosuiteRollout) -> None:
@@ -148,7 +154,7 @@ def test_frames_match_a_plain_mujoco_render(rollout: RobosuiteRollout) -> None:
     also while another rollout and a foreign GL context are alive: robosuite draws into
     whichever context is current, so the rollout must make its own current."""
     model, data = rollout.mujoco_handles()
-    frames = rollout.reset(0)["images"]
+    frames = rollout.reset(0).images
     cameras = rollout.camera_models  # from the manifests' robosuite_camera
     assert cameras == {"agentview": "agentview", "wrist": "robot0_eye_in_hand"}
     with mujoco.Renderer(model, SIZE, SIZE) as renderer:
@@ -157,7 +163,7 @@ def test_frames_match_a_plain_mujoco_render(rollout: RobosuiteRollout) -> None:
             reference = renderer.render().astype(float)
             # multisampling differs; an upside-down or foreign-context frame is off by > 60
             assert np.abs(frames[name] - reference).mean() < 30, name
-        again = rollout.reset(0)["images"]  # the renderer's context is current now
+        again = rollout.reset(0).images  # the renderer's context is current now
     for name in cameras:
         assert np.array_equal(again[name], frames[name]), name
 

@@ -25,7 +25,9 @@ from openral_hal.mujoco_arm import MujocoArmHAL
 from openral_hal.protocol import EStopLatch, RobotHal, Tickable
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_mujoco.state import FloatArray, JointStateSample
-from openral_sim.rollout import Observation, SimRollout, StepResult
+from openral_mujoco.state import JointStateSample
+from openral_sim.observation import Observation, StepResult
+from openral_sim.rollout import SimRollout
 
 from tests.sim_attach.fake_arm import NO_SENSORS, write_fake_arm
 
@@ -125,7 +127,8 @@ class StillRollout:
     control_period_s = 0.05
 
     def reset(self, seed: int | None = None) -> Observation:
-        return {"images": {}, "joint_positions": np.array([0.1, 0.2])}
+        positions, zeros = np.array([0.1, 0.2]), np.zeros(2)
+        return Observation(0.0, JointStateSample(("a", "b"), positions, zeros, zeros, 0))
 
     def step(self, action: npt.NDArray[np.floating[Any]]) -> StepResult:
         return StepResult(self.reset())

@@ -3,7 +3,7 @@
 
 Two honest fakes stand in for scene backends: a tiny MuJoCo arm whose joints carry
 robosuite's ``robot0_`` prefix and whose fixed camera really renders, and a non-MuJoCo
-backend that only reports ``obs["joint_positions"]``.
+backend that only reports ``obs.joints``.
 """
 
 from __future__ import annotations
@@ -27,7 +27,9 @@ from openral_core.loader import load_robot
 from openral_core.models import RobotDescription
 from openral_hal.errors import ActionRejected, ConfigurationError, EStopLatched
 from openral_hal.sim_attached import SimAttachedHAL
-from openral_sim.rollout import Observation, SimRollout, StepResult
+from openral_mujoco.state import JointStateSample
+from openral_sim.observation import Observation, Outcome, StepResult
+from openral_sim.rollout import SimRollout
 
 from tests.sim_attach.fake_arm import write_fake_arm
 
@@ -99,7 +101,7 @@ class MujocoArmRollout:
         mujoco.mj_step(self.model, self.data, nstep=self.substeps)
         self._steps += 1
         done = self.horizon is not None and self._steps >= self.horizon
-        return StepResult(self._observe(), terminated=done)
+        return StepResult(self._observe(), Outcome(terminated=done))
 
     def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
         return self.model, self.data
@@ -110,7 +112,8 @@ class MujocoArmRollout:
 
     def _observe(self) -> Observation:
         self.renderer.update_scene(self.data, camera="agentview")
-        return {"images": {"agentview": self.renderer.render().copy()}}
+        image = self.renderer.render().copy()
+        return Observation(time_s=float(self.data.time), images={"agentview": image})
 
 
 class NonMujocoRollout:
@@ -154,10 +157,14 @@ class NonMujocoRollout:
 
     def _observe(self) -> Observation:
         tick = len(self.actions)
-        obs: Observation = {"images": {"agentview": np.full((4, 4, 3), tick, dtype=np.uint8)}}
+        images = {"agentview": np.full((4, 4, 3), tick, dtype=np.uint8)}
+        joints = None
         if self.n_positions is not None:
-            obs["joint_positions"] = np.arange(1, self.n_positions + 1, dtype=np.float64) + tick
-        return obs
+            positions = np.arange(1, self.n_positions + 1, dtype=np.float64) + tick
+            names = tuple(f"j{i}" for i in range(self.n_positions))
+            zeros = np.zeros(self.n_positions)
+            joints = JointStateSample(names, positions, zeros, zeros, stamp_ns=0)
+        return Observation(time_s=0.05 * tick, joints=joints, images=images)
 
 
 @pytest.fixture

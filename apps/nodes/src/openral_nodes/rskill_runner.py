@@ -141,7 +141,7 @@ class RskillRunnerNode(Node):
         self.slot_table = robot.tables.vla_slots
         self.policy = policy or make_policy(policy_name, parse_params(params or []))
         self.policy_name = policy_name if policy is None else type(policy).__name__
-        if getattr(self.policy, "needs_privileged", False):
+        if self.policy.needs_privileged:
             raise RunnerAborted(
                 f"policy {self.policy_name} reads the simulation itself (privileged state); "
                 "it runs in `openral sim sweep`, not on a ROS graph"

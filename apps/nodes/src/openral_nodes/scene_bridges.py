@@ -1,14 +1,18 @@
 """SceneBridges: everything a simulated robot publishes and takes beyond its joints.
 
 - cameras and the viewer (:class:`~openral_bridge.sim_sensor_bridge.SimSensorBridge`);
-- on a native scene, its depth cameras (image, camera info, cloud) and lidars (scans)
+- depth cameras (image, camera info, cloud) and lidars (scans) of a HAL that serves them
   (:class:`~openral_bridge.range_bridge.RangeBridge`), and its IMU, force-torque and pose
-  sensors (:class:`~openral_bridge.state_sensor_bridge.StateSensorBridge`);
+  sensors (:class:`~openral_bridge.state_sensor_bridge.StateSensorBridge`): whatever HAL
+  implements the sensor Protocols (:mod:`openral_sim.sensor_sources`), simulated or real;
 - for a robot with a mobile base, ``/cmd_vel`` in and ``/odom`` out
   (:class:`~openral_bridge.base_bridge.BaseBridge`, at the joint-state rate).
 
-All their periodic work runs on the node's pacer and every call into the HAL or the live
-scene holds the node's HAL lock. A sensor none of them serves is reported once at setup.
+Every sensor's rate comes from one rule (:func:`~openral_sim.sensor_schedule.sensor_rates`):
+its manifest rate, the ``camera_rate_hz`` override applied to RGB, depth and lidar alike,
+capped at the control rate of a ticked HAL. All their periodic work runs on the node's
+pacer and every call into the HAL or the live scene holds the node's HAL lock. A sensor
+none of them serves is reported once at setup.
 """
 
 from __future__ import annotations
@@ -22,8 +26,10 @@ from openral_bridge.range_bridge import RangeBridge
 from openral_bridge.sim_sensor_bridge import SimSensorBridge
 from openral_bridge.state_sensor_bridge import StateSensorBridge
 from openral_bridge.topics import TopicInfo
+from openral_hal.factory import can_tick
 from openral_hal.protocol import MobileBaseHal, RobotHal
-from openral_hal.sim_attached import native_scene
+from openral_sim.sensor_schedule import sensor_rates
+from openral_sim.sensor_sources import DepthSource, LidarSource, StateSensorSource
 
 if TYPE_CHECKING:
     from rclpy.node import Node
@@ -44,13 +50,15 @@ class SceneBridges:
         odom_rate_hz: float,
     ) -> None:
         """Nothing is created until :meth:`setup` (see the bridges for the arguments)."""
-        scene = native_scene(hal)
-        self.range = RangeBridge(node, scene, lock) if scene is not None else None
+        control_hz = 1.0 / hal.control_period_s if can_tick(hal) else None
+        rates = sensor_rates(hal.description, control_hz, frame_rate_hz=camera_rate_hz)
+        depth = hal if isinstance(hal, DepthSource) else None
+        lidar = hal if isinstance(hal, LidarSource) else None
+        self.range = RangeBridge(node, depth, lidar, lock, rates)
+        served = frozenset(self.range.depth) | frozenset(self.range.lidars)
         self.state = None
-        served: frozenset[str] = frozenset()
-        if scene is not None:
-            served = frozenset(scene.range_sensors.depth) | frozenset(scene.range_sensors.lidars)
-            self.state = StateSensorBridge(node, scene, lock, 1.0 / scene.control_period_s)
+        if isinstance(hal, StateSensorSource):
+            self.state = StateSensorBridge(node, hal, lock, rates)
             served |= self.state.served
         self.base = None
         if isinstance(hal, MobileBaseHal) and hal.base is not None:
@@ -62,7 +70,7 @@ class SceneBridges:
             pacer,
             lock=lock,
             viewer_enabled=viewer_enabled,
-            camera_rate_hz=camera_rate_hz,
+            camera_rates_hz=rates,
             served_elsewhere=served,
         )
         self.pacer = pacer

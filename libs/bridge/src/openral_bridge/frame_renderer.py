@@ -1,20 +1,15 @@
-"""FrameRenderer: camera frames of a live MuJoCo scene, rendered off the control path.
+"""FrameRenderer: frames of costly sensors (cameras, depth), developed off the control path.
 
-The control loop steps the live ``MjData`` on the node's pacer thread; a camera frame
-takes milliseconds to tens of milliseconds to render (llvmpipe, software EGL), so a frame
-is never rendered there. When a camera is due, :meth:`FrameRenderer.request` (called on the
+The control loop steps the live state on the node's pacer thread; a camera frame takes
+milliseconds to tens of milliseconds to render (llvmpipe, software EGL), so a frame is
+never rendered there. When a sensor is due, :meth:`FrameRenderer.request` (called on the
 pacer thread holding the HAL's lock, between two control ticks, so the state is consistent)
-copies the live data into that camera's own preallocated ``MjData`` with ``mj_copyData``
-and returns (Panda tabletop: 6 µs in a hot loop, 30-55 µs median at a 20 Hz control pace
-with cold caches). One render thread owns the ``mujoco.Renderer`` (created on that thread: an EGL
-context is current on one thread only); it renders the copy and hands the frame and the
-copy's ``data.time`` to the publish callback. The render thread never reads the live data.
-
-Copying the whole data (not only ``qpos`` followed by ``mj_kinematics``) keeps the poses the
-step computed, so a frame is pixel for pixel the frame ``openral sim run`` writes for the
-same step. (``mj_step`` computes positions before it integrates, so those poses are one
-physics step older than ``data.time``; recomputing them would make deploy and sim run
-frames differ.)
+takes the sensor's snapshot (:meth:`FrameCapture.snapshot
+<openral_sim.sensor_sources.FrameCapture.snapshot>`: a MuJoCo scene copies its data, see
+:mod:`openral_sim.mujoco_capture`) and returns. One render thread opens the capture's
+developer (on that thread: an EGL context is current on one thread only), develops each
+snapshot and hands the frame and the snapshot's time to the publish callback. The render
+thread never reads the live state.
 
 Each camera has one slot. A camera that is due while its previous frame is still waiting
 or rendering is skipped and counted (:attr:`FrameRenderer.skipped`); nothing queues beyond
@@ -37,21 +32,18 @@ from __future__ import annotations
 
 import queue
 import threading
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from typing import Generic, TypeVar
 
-import mujoco
-import numpy as np
-import numpy.typing as npt
+from openral_sim.observation import ImageArray
+from openral_sim.sensor_sources import FrameCapture, FrameDeveloper
 
 from openral_bridge.os_thread import name_os_thread
 
-ImageArray = npt.NDArray[np.uint8]
+__all__ = ["FrameRenderer", "ImageArray"]
+
 FrameT = TypeVar("FrameT")
 """What one render makes: an RGB image, a depth frame with its cloud."""
-RenderFn = Callable[[mujoco.Renderer, mujoco.MjData, str], FrameT]
-"""Render one sensor's frame of the snapshot data with the render thread's renderer (the
-frame may live in a buffer the next render of that sensor reuses: it is published first)."""
 PublishFn = Callable[[str, FrameT, float], None]
 """Publish one sensor's frame with the snapshot's simulated time [s] (render thread)."""
 
@@ -60,11 +52,12 @@ STOP_TIMEOUT_S = 5.0
 
 
 class _Slot:
-    """One camera's snapshot: a copy of the live data at one instant."""
+    """One sensor's frame in flight."""
 
-    def __init__(self, sensor: str, model: mujoco.MjModel) -> None:
+    def __init__(self, sensor: str) -> None:
         self.sensor = sensor
-        self.data = mujoco.MjData(model)
+        self.time_s = 0.0
+        """Time of its snapshot [s]."""
         self.busy = False
         """True from the request until its frame is published (or failed)."""
         self.rendered = 0
@@ -73,16 +66,12 @@ class _Slot:
 
 class FrameRenderer(Generic[FrameT]):
     """Snapshots taken on the caller's thread, rendered and published on one thread of
-    its own; at most one frame per camera in flight. Frames are RGB images for cameras
-    (``FrameRenderer[ImageArray]``) or whatever ``render`` makes (a depth frame)."""
+    its own; at most one frame per sensor in flight. Frames are RGB images for cameras
+    (``FrameRenderer[ImageArray]``) or whatever the capture develops (a depth frame)."""
 
     def __init__(
         self,
-        model: mujoco.MjModel,
-        live: mujoco.MjData,
-        sensors: Iterable[str],
-        size: tuple[int, int],
-        render: RenderFn[FrameT],
+        capture: FrameCapture[FrameT],
         publish: PublishFn[FrameT],
         *,
         name: str = "openral-render",
@@ -90,20 +79,13 @@ class FrameRenderer(Generic[FrameT]):
         """Nothing runs until :meth:`start`.
 
         Args:
-            model: The scene's model (shared, only read while the thread runs).
-            live: The scene's live data; only :meth:`request` reads it.
-            sensors: The cameras, by sensor name.
-            size: (height, width) of the render thread's renderer [px].
-            render: Renders one sensor of the snapshot data.
-            publish: Receives each frame and its simulated time [s], on the render thread.
+            capture: Snapshots of the live source and their developer.
+            publish: Receives each frame and its snapshot's time [s], on the render thread.
             name: The render thread's name (also in the OS, at most 15 bytes there).
         """
-        self._model = model
-        self._live = live
-        self._size = size
-        self._render = render
+        self._capture = capture
         self._publish = publish
-        self._slots = {sensor: _Slot(sensor, model) for sensor in sensors}
+        self._slots = {sensor: _Slot(sensor) for sensor in capture.sensors}
         self._jobs: queue.SimpleQueue[_Slot | None] = queue.SimpleQueue()
         self._lock = threading.Lock()
         self._idle = threading.Condition(self._lock)
@@ -166,7 +148,13 @@ class FrameRenderer(Generic[FrameT]):
                 slot.skipped += 1
                 return False
             slot.busy = True
-        mujoco.mj_copyData(slot.data, self._model, self._live)
+        try:
+            slot.time_s = self._capture.snapshot(sensor)
+        except Exception as error:  # reported by the owner; the control loop goes on
+            self.error = error
+            with self._lock:
+                slot.busy = False
+            return False
         self._jobs.put(slot)
         return True
 
@@ -188,23 +176,23 @@ class FrameRenderer(Generic[FrameT]):
     def _run(self) -> None:
         name_os_thread(self._thread.name)
         try:
-            renderer = mujoco.Renderer(self._model, *self._size)
-        except Exception as error:  # no GL context: the cameras stop, the robot does not
+            developer = self._capture.open()
+        except Exception as error:  # no GL context: the sensors stop, the robot does not
             self.error = error
             return
         try:
             while (slot := self._jobs.get()) is not None and not self._stopping:
-                self._frame(renderer, slot)
+                self._frame(developer, slot)
                 if self.error is not None:
                     break
         finally:
-            renderer.close()
+            developer.close()
 
-    def _frame(self, renderer: mujoco.Renderer, slot: _Slot) -> None:
-        """Render ``slot``'s copy and publish it with the copy's simulated time."""
+    def _frame(self, developer: FrameDeveloper[FrameT], slot: _Slot) -> None:
+        """Develop ``slot``'s snapshot and publish it with the snapshot's time."""
         try:
-            image = self._render(renderer, slot.data, slot.sensor)
-            self._publish(slot.sensor, image, float(slot.data.time))
+            image = developer.develop(slot.sensor)
+            self._publish(slot.sensor, image, slot.time_s)
             slot.rendered += 1
         except Exception as error:  # reported by the owner; the control loop goes on
             self.error = error

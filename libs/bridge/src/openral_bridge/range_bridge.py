@@ -1,38 +1,36 @@
-"""RangeBridge: the depth cameras and lidars of a native scene on ROS.
+"""RangeBridge: depth cameras and lidars on ROS, from any HAL that serves them.
 
-For each depth sensor the scene serves (:mod:`openral_sim.range_sensors`), at the sensor's
-manifest ``rate_hz``:
+The bridge depends only on :class:`~openral_sim.sensor_sources.DepthSource` and
+:class:`~openral_sim.sensor_sources.LidarSource` (a native scene's HAL, a real driver's).
+For each depth sensor served, at its rate (:func:`~openral_sim.sensor_schedule.sensor_rates`):
 
 - ``/openral/cameras/<name>/depth``: ``sensor_msgs/Image``, ``32FC1``, metres along the
   optical axis, NaN where nothing is within ``range_m`` (REP 118), frame ``frame_id``;
 - ``/openral/cameras/<name>/camera_info``: the pinhole it was rendered with;
 - ``/openral/cameras/<name>/points``: ``sensor_msgs/PointCloud2`` (float32 x, y, z [m])
-  in the robot's base frame, without the robot (segmentation, and a margin of 1 cm plus a
-  pixel around what the camera sees of it) and without anything out of range.
+  in the frame the source names (``DepthSpec.cloud_frame``: a native scene's clouds are in
+  the robot's base frame, without the robot and without anything out of range).
 
-The base frame is the robot's (``FrameNames.base``: the manifest's ``mobile_base.base_frame``,
-the cloud moved by the static offset of the base's root body,
-``BaseDrive.root_in_base_frame``; else ``frames.base``, at the robot's root body).
-
-A depth frame is rendered, and its cloud built, on a thread of the sensor's own
+A depth frame is developed, and its cloud built, on a thread of the sensor's own
 (:class:`~openral_bridge.frame_renderer.FrameRenderer`, from a snapshot taken between two
 control ticks), never on the control path; a frame due while the previous one is in
-flight is skipped. For each lidar, at its ``rate_hz``, one ray cast of the live state on
-the pacer's thread (0.1 ms for 1024 rays) is published as ``sensor_msgs/LaserScan`` on
-``/scan`` (``/scan/<name>`` when the robot has more than one), frame ``frame_id``,
-REP 117 ranges. Every message is stamped with the simulated time of the state it shows.
+flight is skipped. For each lidar, at its rate, one scan read on the pacer's thread
+holding the HAL's lock (a native scene's ray cast: 0.1 ms for 1024 rays) is published as
+``sensor_msgs/LaserScan`` on ``/scan`` (``/scan/<name>`` when the robot has more than
+one), frame ``frame_id``, REP 117 ranges. Every message is stamped with the time of the
+state it shows.
 """
 
 from __future__ import annotations
 
 import threading
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import partial
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
 from openral_sim.depth_cloud import DepthFrame
-from openral_sim.native_scene import NativeScene
+from openral_sim.sensor_sources import DepthSource, LidarSource
 
 from openral_bridge import ros_messages
 from openral_bridge.frame_renderer import FrameRenderer
@@ -59,21 +57,30 @@ class _Stream:
 
 
 class RangeBridge:
-    """Depth, cloud and scan publishers of one native scene on one node."""
+    """Depth, cloud and scan publishers of one HAL on one node."""
 
-    def __init__(self, node: Node, scene: NativeScene, lock: threading.Lock) -> None:
+    def __init__(
+        self,
+        node: Node,
+        depth: DepthSource | None,
+        lidar: LidarSource | None,
+        lock: threading.Lock,
+        rates_hz: Mapping[str, float],
+    ) -> None:
         """Nothing is created until :meth:`start`.
 
         Args:
             node: The node that owns the publishers.
-            scene: The connected native scene (its live data is read holding ``lock``).
-            lock: The HAL's lock.
+            depth: What serves the depth sensors (None: none).
+            lidar: What serves the lidars (None: none).
+            lock: The HAL's lock (held while a snapshot or a scan is taken).
+            rates_hz: Each sensor's rate [Hz] (a sensor missing here keeps its manifest's).
         """
-        self.node, self.scene, self.lock = node, scene, lock
-        self.base_frame = scene.robot.tables.frames.base
-        self.base_offset = np.zeros(3, dtype=np.float32)
-        if scene.base is not None:
-            self.base_offset = np.asarray(scene.base.root_in_base_frame, dtype=np.float32)
+        self.node, self.lock = node, lock
+        self.depth = dict(depth.depth_sensors()) if depth is not None else {}
+        self.lidars = dict(lidar.lidar_sensors()) if lidar is not None else {}
+        self._depth_source, self._lidar_source = depth, lidar
+        self.rates_hz = dict(rates_hz)
         self._streams: dict[str, _Stream] = {}
         self._pacer: Pacer | None = None
 
@@ -90,11 +97,10 @@ class RangeBridge:
         on ``pacer``; each sensor publishes once now."""
         self.stop()
         self._pacer = pacer
-        sensors = self.scene.range_sensors
-        for name in sensors.depth:
+        for name in self.depth:
             self._streams[name] = self._depth_stream(name)
-        for name in sensors.lidars:
-            self._streams[name] = self._scan_stream(name, only=len(sensors.lidars) == 1)
+        for name in self.lidars:
+            self._streams[name] = self._scan_stream(name, only=len(self.lidars) == 1)
         for name, stream in self._streams.items():
             due = partial(self._due, name)
             stream.job = pacer.every(1.0 / stream.rate_hz, due, f"range {name}")
@@ -122,7 +128,8 @@ class RangeBridge:
     def _depth_stream(self, name: str) -> _Stream:
         from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 
-        camera = self.scene.range_sensors.depth[name]
+        spec = self.depth[name]
+        assert self._depth_source is not None
         topics = {
             "depth": (depth_image(name), Image),
             "info": (camera_info(name), CameraInfo),
@@ -132,38 +139,29 @@ class RangeBridge:
             key: self.node.create_publisher(kind, topic, QUEUE_DEPTH)
             for key, (topic, kind) in topics.items()
         }
-        rate = float(camera.sensor.rate_hz)
+        rate = self._rate(name, spec.sensor.rate_hz)
         stream = _Stream(rate, publishers)
         stream.topics = [
             TopicInfo(t, f"sensor_msgs/msg/{k.__name__}", rate) for t, k in topics.values()
         ]
-        model, live = self.scene.mujoco_handles()
-        stream.frames = FrameRenderer(
-            model,
-            live,
-            (name,),
-            (camera.height, camera.width),
-            lambda renderer, data, sensor: camera.frame(renderer, data),
-            self._publish_depth,
-            name="openral-depth",
-        )
+        capture = self._depth_source.depth_capture(name)
+        stream.frames = FrameRenderer(capture, self._publish_depth, name="openral-depth")
         stream.frames.start()
         return stream
 
     def _publish_depth(self, name: str, frame: DepthFrame, sim_time_s: float) -> None:
         """Publish one depth frame: image, camera info, cloud (render thread)."""
-        stream, camera = self._streams.get(name), self.scene.range_sensors.depth[name]
+        stream, spec = self._streams.get(name), self.depth[name]
         if stream is None:
             return
         stamp = ros_messages.stamp(sim_time_s)
-        frame_id = camera.sensor.frame_id
+        frame_id = spec.sensor.frame_id
         height, width = frame.depth_m.shape
         stream.publishers["depth"].publish(ros_messages.image_msg(frame.depth_m, stamp, frame_id))
-        info = ros_messages.camera_info_msg(width, height, camera.fovy_deg, stamp, frame_id)
+        info = ros_messages.camera_info_msg(width, height, spec.fovy_deg, stamp, frame_id)
         stream.publishers["info"].publish(info)
-        points = frame.points + self.base_offset
         stream.publishers["points"].publish(
-            ros_messages.point_cloud_msg(points, stamp, self.base_frame)
+            ros_messages.point_cloud_msg(frame.points, stamp, spec.cloud_frame)
         )
         stream.published += 1
 
@@ -172,27 +170,25 @@ class RangeBridge:
     def _scan_stream(self, name: str, *, only: bool) -> _Stream:
         from sensor_msgs.msg import LaserScan
 
-        scanner = self.scene.range_sensors.lidars[name]
         topic = scan(name, only)
-        rate = float(scanner.sensor.rate_hz)
+        rate = self._rate(name, self.lidars[name].sensor.rate_hz)
         stream = _Stream(rate, {"scan": self.node.create_publisher(LaserScan, topic, QUEUE_DEPTH)})
         stream.topics = [TopicInfo(topic, "sensor_msgs/msg/LaserScan", rate)]
         return stream
 
     def _publish_scan(self, name: str) -> None:
         """Cast and publish one scan of the live state (pacer thread)."""
-        stream = self._streams[name]
-        scanner = self.scene.range_sensors.lidars[name]
+        stream, spec = self._streams[name], self.lidars[name]
+        assert self._lidar_source is not None
         with self.lock:
-            ranges = self.scene.range_sensors.scan(name, self.scene.data)
-            sim_time_s = float(self.scene.data.time)
+            reading = self._lidar_source.scan(name)
         msg = ros_messages.laser_scan_msg(
-            ranges,
-            angle_range_rad=(scanner.angle_min, scanner.angle_max),
-            range_m=(scanner.range_min, scanner.range_max),
+            reading.ranges,
+            angle_range_rad=(spec.angle_min_rad, spec.angle_max_rad),
+            range_m=(spec.range_min_m, spec.range_max_m),
             scan_time_s=1.0 / stream.rate_hz,
-            stamp_msg=ros_messages.stamp(sim_time_s),
-            frame_id=scanner.sensor.frame_id,
+            stamp_msg=ros_messages.stamp(reading.sim_time_s),
+            frame_id=spec.sensor.frame_id,
         )
         stream.publishers["scan"].publish(msg)
         stream.published += 1
@@ -217,6 +213,9 @@ class RangeBridge:
             return
         with self.lock:
             frames.request(name, wait_s=wait_s)
+
+    def _rate(self, name: str, manifest_hz: float) -> float:
+        return float(self.rates_hz.get(name, manifest_hz))
 
     def _log(self) -> Any:
         """The node's logger (rclpy's logger is untyped)."""

@@ -5,19 +5,20 @@ can do:
 
 - each manifest RGB sensor the scene renders → ``sensor_msgs/Image`` (rgb8) on
   ``/openral/cameras/<name>/image`` and ``sensor_msgs/CameraInfo`` on
-  ``/openral/cameras/<name>/camera_info``, frame id from the manifest, at the sensor's own
-  ``rate_hz`` (one job per sensor on the node's :class:`~openral_bridge.pacer.Pacer`), or
-  at ``camera_rate_hz`` for every sensor when given;
+  ``/openral/cameras/<name>/camera_info``, frame id from the manifest, at the rate
+  :func:`~openral_sim.sensor_schedule.sensor_rates` gives it (one job per sensor on the
+  node's :class:`~openral_bridge.pacer.Pacer`);
 - the MuJoCo passive viewer when enabled and a display exists (synced by a pacer job).
 
-A native scene renders a camera only when its frame is due, off the control path: the
+A HAL that is a :class:`~openral_sim.sensor_sources.CameraSource` (a native scene's, or
+any driver's) has a camera rendered only when its frame is due, off the control path: the
 sensor's job (on the pacer's thread, holding the HAL's lock, so never during a control
-tick) snapshots the live state and a :class:`~openral_bridge.frame_renderer.FrameRenderer`
-thread renders and publishes it; a camera still busy with its previous frame is skipped and
+tick) takes a snapshot and a :class:`~openral_bridge.frame_renderer.FrameRenderer` thread
+develops and publishes it; a camera still busy with its previous frame is skipped and
 counted (:attr:`SimSensorBridge.frames_skipped`). While the bridge serves its cameras the
-scene's ``reset``/``step`` render nothing. A backend without MuJoCo handles, or one that
-renders inside its own step (robosuite), publishes the last observation's frames
-(``read_images()``) instead, on the pacer's thread.
+scene's ``reset``/``step`` render nothing. A backend that renders inside its own step
+(robosuite) publishes the last observation's frames (``read_images()``) instead, on the
+pacer's thread.
 
 Header stamps are simulation time (MuJoCo ``data.time``; the node publishes ``/clock``):
 a rendered frame carries its snapshot's time, so the stamp says which physics state it
@@ -29,6 +30,7 @@ reported, not published.
 from __future__ import annotations
 
 import threading
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import partial
 from typing import TYPE_CHECKING, Any
@@ -38,9 +40,8 @@ import numpy as np
 import numpy.typing as npt
 from openral_core.models import DepthSensor, RgbSensor, RobotDescription, SiteSensor
 from openral_hal.protocol import CameraHal, MujocoBacked, RobotHal
-from openral_hal.sim_attached import native_scene
 from openral_mujoco.display import has_display
-from openral_sim.native_scene import NativeScene
+from openral_sim.sensor_sources import CameraSource, ObservationFrames
 
 from openral_bridge import ros_messages
 from openral_bridge.camera_messages import CameraMessages
@@ -82,7 +83,7 @@ class SimSensorBridge:
         *,
         lock: threading.Lock | None = None,
         viewer_enabled: bool = True,
-        camera_rate_hz: float | None = None,
+        camera_rates_hz: Mapping[str, float] | None = None,
         viewer_sync_rate_hz: float = 30.0,
         served_elsewhere: frozenset[str] = frozenset(),
     ) -> None:
@@ -97,8 +98,9 @@ class SimSensorBridge:
             lock: The HAL's lock, held while a job reads the HAL or the live scene
                 (default: a lock of the bridge's own).
             viewer_enabled: Open the MuJoCo passive viewer when a display exists.
-            camera_rate_hz: Publish rate of every camera [Hz]; None: each sensor's
-                ``rate_hz``.
+            camera_rates_hz: Publish rate of each camera [Hz] by sensor name (as
+                :func:`~openral_sim.sensor_schedule.sensor_rates` gives them); None, or a
+                camera missing here: the sensor's ``rate_hz``.
             viewer_sync_rate_hz: How often the viewer is synchronised [Hz].
             served_elsewhere: Depth and lidar sensors another bridge publishes (the rest
                 are reported as not published).
@@ -106,9 +108,9 @@ class SimSensorBridge:
         Raises:
             ValueError: A rate that is not positive.
         """
-        rates = {"camera_rate_hz": camera_rate_hz, "viewer_sync_rate_hz": viewer_sync_rate_hz}
-        for label, rate in rates.items():
-            if rate is not None and not rate > 0:
+        rates = {f"camera_rates_hz[{k!r}]": v for k, v in (camera_rates_hz or {}).items()}
+        for label, rate in {**rates, "viewer_sync_rate_hz": viewer_sync_rate_hz}.items():
+            if not rate > 0:
                 raise ValueError(f"{label} must be > 0 Hz, got {rate}")
         self.node = node
         self.hal = hal
@@ -116,14 +118,14 @@ class SimSensorBridge:
         self.pacer = pacer
         self.lock = lock if lock is not None else threading.Lock()
         self.viewer_enabled = viewer_enabled
-        self.camera_rate_hz = camera_rate_hz
+        self.camera_rates_hz = dict(camera_rates_hz or {})
         self.viewer_sync_rate_hz = viewer_sync_rate_hz
         self.served_elsewhere = served_elsewhere
         self._cameras: dict[str, _Camera] = {}
         self._count_lock = threading.Lock()
         self._camera_hal: CameraHal | None = None
-        self._scene: NativeScene | None = None
-        self._scene_rendered_observations = True
+        self._observing: ObservationFrames | None = None
+        self._observed_before = True
         self._frames: FrameRenderer[ImageArray] | None = None
         self._viewer: Any = None
         self._viewer_job: PacedJob | None = None
@@ -171,9 +173,9 @@ class SimSensorBridge:
             frames, self._frames = self._frames, None
             if not frames.stop():
                 self._log().warning("the camera render thread did not stop within its timeout")
-        if self._scene is not None:
-            self._scene.render_observations = self._scene_rendered_observations
-            self._scene = None
+        if self._observing is not None:
+            self._observing.render_in_observations(self._observed_before)
+            self._observing = None
         for camera in self._cameras.values():
             for publisher in (camera.image_pub, camera.info_pub):
                 if publisher is not None:
@@ -203,16 +205,16 @@ class SimSensorBridge:
         hal = self.hal
         if not isinstance(hal, CameraHal):
             return
-        scene = native_scene(hal)
-        rendered = set(scene.camera_names) if scene else set(hal.read_images())
+        source = hal if isinstance(hal, CameraSource) and hal.camera_sensors() else None
+        rendered = set(source.camera_sensors()) if source else set(hal.read_images())
         for sensor in self.description.sensors:
             if isinstance(sensor, RgbSensor) and sensor.name in rendered:
                 self._add_camera(hal, sensor)
         if not self._cameras:
             return
         self._camera_hal = hal
-        if scene is not None:
-            self._start_renderer(scene)
+        if source is not None:
+            self._start_renderer(source)
         for name, camera in self._cameras.items():
             period = 1.0 / camera.rate_hz
             camera.job = self.pacer.every(period, partial(self._due, name), f"camera {name}")
@@ -234,32 +236,23 @@ class SimSensorBridge:
         if fovy is not None:
             topic = camera_info(sensor.name)
             info = self.node.create_publisher(CameraInfo, topic, IMAGE_QUEUE_DEPTH)
-        rate = self.camera_rate_hz if self.camera_rate_hz is not None else sensor.rate_hz
+        rate = self.camera_rates_hz.get(sensor.name, sensor.rate_hz)
         messages = CameraMessages(sensor.frame_id, fovy)
         self._cameras[sensor.name] = _Camera(sensor, float(rate), messages, image, info)
 
-    def _start_renderer(self, scene: NativeScene) -> None:
-        """Render this scene's cameras on a thread of their own; the scene stops rendering
-        into its observations until :meth:`teardown`. A frame is drawn straight into its
-        camera's reused ``Image`` (what :meth:`NativeScene.render_cameras` draws, without its
-        copy)."""
-        cameras, (height, width) = scene.camera_models, scene.image_size
-        messages = {name: camera.messages for name, camera in self._cameras.items()}
-
-        def render(
-            renderer: mujoco.Renderer, data: mujoco.MjData, sensor: str
-        ) -> npt.NDArray[np.uint8]:
-            renderer.update_scene(data, camera=cameras[sensor])
-            return renderer.render(out=messages[sensor].pixels(height, width))
-
-        model, live = scene.mujoco_handles()
-        self._frames = FrameRenderer(
-            model, live, tuple(self._cameras), scene.image_size, render, self._publish
-        )
+    def _start_renderer(self, source: CameraSource) -> None:
+        """Render the cameras on a thread of their own, each frame drawn straight into its
+        camera's reused ``Image``; a scene's observations carry no frames until
+        :meth:`teardown`."""
+        height, width = source.camera_size()
+        out = {
+            name: camera.messages.pixels(height, width) for name, camera in self._cameras.items()
+        }
+        self._frames = FrameRenderer(source.camera_capture(out), self._publish)
         self._frames.start()
-        self._scene = scene
-        self._scene_rendered_observations = scene.render_observations
-        scene.render_observations = False
+        if isinstance(source, ObservationFrames):
+            self._observing = source
+            self._observed_before = source.render_in_observations(False)
 
     def _due(self, name: str, wait_s: float = 0.0) -> None:
         """A camera's job: request a rendered frame, or publish the last observed one."""

@@ -1,6 +1,8 @@
-"""StateSensorBridge: the IMU, force-torque and pose sensors of a native scene on ROS.
+"""StateSensorBridge: IMU, force-torque and pose sensors on ROS, from any HAL that serves them.
 
-For each such sensor of the manifest (:mod:`openral_sim.state_sensors`):
+The bridge depends only on :class:`~openral_sim.sensor_sources.StateSensorSource` (a native
+scene's HAL reads them from MuJoCo's ``sensordata``; a real driver from its hardware). For
+each sensor served:
 
 - ``imu`` → ``sensor_msgs/Imu`` on ``/openral/imu/<name>``: orientation (world frame),
   angular velocity and linear acceleration (gravity included) in the site's frame, header
@@ -11,21 +13,21 @@ For each such sensor of the manifest (:mod:`openral_sim.state_sensors`):
 - ``pose`` → ``geometry_msgs/PoseStamped`` on ``/openral/pose/<name>``, in the world frame
   (header frame: the robot's world frame, ``frames.world``).
 
-A reading changes only when the control loop steps the scene, so each sensor publishes at
-its ``rate_hz`` or the control rate, whichever is lower (publishing faster would repeat
-samples); :meth:`StateSensorBridge.topics` reports that rate. Each message is read on the
-pacer's thread holding the HAL's lock (a copy of a few values of ``sensordata``; nothing is
-computed on the live data) and stamped with the simulated time of the state it shows.
+Each sensor publishes at its rate from :func:`~openral_sim.sensor_schedule.sensor_rates`
+(its ``rate_hz``, capped at the control rate: a reading changes only when the scene steps);
+:meth:`StateSensorBridge.topics` reports that rate. Each message is read on the pacer's
+thread holding the HAL's lock and stamped with the time of the state it shows.
 """
 
 from __future__ import annotations
 
 import threading
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import partial
 from typing import TYPE_CHECKING, Any
 
-from openral_sim.native_scene import NativeScene
+from openral_sim.sensor_sources import StateSensorSource
 from openral_sim.state_sensors import ImuReading, PoseReading, Reading, WrenchReading
 
 from openral_bridge import ros_messages
@@ -48,28 +50,33 @@ class _Stream:
 
 
 class StateSensorBridge:
-    """Imu, WrenchStamped and PoseStamped publishers of one native scene on one node."""
+    """Imu, WrenchStamped and PoseStamped publishers of one HAL on one node."""
 
     def __init__(
-        self, node: Node, scene: NativeScene, lock: threading.Lock, control_rate_hz: float
+        self,
+        node: Node,
+        source: StateSensorSource,
+        lock: threading.Lock,
+        rates_hz: Mapping[str, float],
     ) -> None:
         """Nothing is created until :meth:`start`.
 
         Args:
             node: The node that owns the publishers.
-            scene: The connected native scene (read holding ``lock``).
+            source: What serves the sensors (read holding ``lock``).
             lock: The HAL's lock.
-            control_rate_hz: How often the scene is stepped [Hz] (the highest useful rate).
+            rates_hz: Each sensor's rate [Hz] (a sensor missing here keeps its manifest's).
         """
-        self.node, self.scene, self.lock = node, scene, lock
-        self.control_rate_hz = control_rate_hz
+        self.node, self.source, self.lock = node, source, lock
+        self.specs = dict(source.state_sensors())
+        self.rates_hz = dict(rates_hz)
         self._streams: dict[str, _Stream] = {}
         self._pacer: Pacer | None = None
 
     @property
     def served(self) -> frozenset[str]:
         """The sensors this bridge publishes."""
-        return frozenset(self.scene.state_sensors.sensors)
+        return frozenset(self.specs)
 
     def topics(self) -> list[TopicInfo]:
         """What the bridge publishes now, at the rates it publishes at."""
@@ -83,8 +90,9 @@ class StateSensorBridge:
         """Create the publishers and schedule each sensor's job; each publishes once now."""
         self.stop()
         self._pacer = pacer
-        for name, sensor in self.scene.state_sensors.sensors.items():
-            self._streams[name] = self._stream(name, sensor.kind, sensor.frame_id, sensor.rate_hz)
+        for name, spec in self.specs.items():
+            rate = float(self.rates_hz.get(name, spec.sensor.rate_hz))
+            self._streams[name] = self._stream(name, spec.sensor.kind, spec.frame_id, rate)
         for name, stream in self._streams.items():
             assert stream.topic.rate_hz is not None
             job = partial(self._publish, name)
@@ -109,21 +117,20 @@ class StateSensorBridge:
         from geometry_msgs.msg import PoseStamped, WrenchStamped
         from sensor_msgs.msg import Imu
 
-        topic, msg_type, frame = {
-            "imu": (imu(name), Imu, frame_id),
-            "force_torque": (wrench(name), WrenchStamped, frame_id),
-            "pose": (pose(name), PoseStamped, self.scene.robot.tables.frames.world),
+        topic, msg_type = {
+            "imu": (imu(name), Imu),
+            "force_torque": (wrench(name), WrenchStamped),
+            "pose": (pose(name), PoseStamped),
         }[kind]
-        rate = min(float(rate_hz), self.control_rate_hz)
         package = msg_type.__module__.split(".")[0]
-        info = TopicInfo(topic, f"{package}/msg/{msg_type.__name__}", rate)
-        return _Stream(info, self.node.create_publisher(msg_type, topic, QUEUE_DEPTH), frame)
+        info = TopicInfo(topic, f"{package}/msg/{msg_type.__name__}", rate_hz)
+        return _Stream(info, self.node.create_publisher(msg_type, topic, QUEUE_DEPTH), frame_id)
 
     def _publish(self, name: str) -> None:
         """Read one sensor under the lock and publish its message (pacer thread)."""
         stream = self._streams[name]
         with self.lock:
-            reading = self.scene.state_sensors.read(name, self.scene.data)
+            reading = self.source.read_sensor(name)
         stream.publisher.publish(_message(reading, stream.frame_id))
         stream.published += 1
 

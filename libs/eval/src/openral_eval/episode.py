@@ -3,15 +3,20 @@
 An episode is a pure function of its :class:`EpisodeSpec` (scene file, seed, policy and its
 parameters, step limit): :func:`run_episode` resets the scene with the seed (its declared
 randomisation), then, once per control step, builds the policy's observation, takes its
-action and hands it to :class:`~openral_hal.sim_attached.SimAttachedHAL`, exactly the
-contract ``deploy sim`` drives (manifest units, limits, the E-stop). It ends when the
-scene reports success (``info["success"]`` of a native scene with ``success`` predicates),
-when the scene ends the episode (its horizon), or after ``steps`` steps.
+action and hands it to the HAL :func:`~openral_hal.factory.build_hal` attached to the
+scene, exactly the contract ``deploy sim`` drives (manifest units, limits, the E-stop).
+It ends when the scene reports success (the step's :class:`~openral_sim.observation.Outcome`:
+a native scene's ``success`` predicates, robosuite's own check), when the scene ends the
+episode (its horizon), or after ``steps`` steps.
+
+Cameras are rendered at their own rates (:mod:`openral_sim.sensor_schedule`), and only
+those the policy's slots and the video need: a policy sees each camera's latest frame, and
+the video has one frame per frame of its camera.
 
 Nothing in it depends on the process or on earlier episodes: the same spec gives the same
 joint trajectory serially, in a process pool and on Ray (``trajectory_sha256`` hashes
-every joint position the policy saw). A scene is built once per process and reused
-(:func:`scene_for`); an episode that raises (a diverged simulation, a policy error) is a
+every joint position the policy saw). A scene and its HAL are built once per process and
+reused (:func:`scene_for`); an episode that raises (a diverged simulation, a policy error) is a
 result with its ``error``, never an exception.
 """
 
@@ -27,12 +32,15 @@ import mujoco
 import numpy as np
 from openral_core.loaded import LoadedRobot
 from openral_core.loader import load_scene
+from openral_hal.factory import HalMode, build_hal
 from openral_hal.sim_attached import SimAttachedHAL
-from openral_sim.native_scene import NativeScene
-from openral_sim.rollout import SimRollout
-from openral_sim.scene import build_scene, scene_robot
+from openral_sim.observation import Observation as SceneObservation
+from openral_sim.rollout import SceneRollout
+from openral_sim.scene import scene_robot
+from openral_sim.sensor_schedule import sensor_rates
 
-from openral_eval.policies import Observation, PolicyAdapter, make_policy
+from openral_eval.policies import make_policy
+from openral_eval.policy import Observation, PolicyAdapter
 from openral_eval.privileged import Pose, Privileged
 from openral_eval.video import VideoWriter
 
@@ -85,18 +93,21 @@ class EpisodeResult:
         )
 
 
-_SCENES: dict[str, tuple[SimRollout, LoadedRobot]] = {}
-"""This process's scenes by file, built on first use."""
+_HALS: dict[str, tuple[SimAttachedHAL, LoadedRobot]] = {}
+"""This process's scenes (attached HALs) by file, built on first use."""
 
 
-def scene_for(path: str) -> tuple[SimRollout, LoadedRobot]:
-    """The scene of ``path`` and its robot, built once per process (cameras render on
-    demand, not into every observation)."""
-    if path not in _SCENES:
+def scene_for(path: str) -> tuple[SimAttachedHAL, LoadedRobot]:
+    """The HAL of the scene of ``path`` and its robot, built once per process by
+    :func:`~openral_hal.factory.build_hal`."""
+    if path not in _HALS:
         scene = load_scene(Path(path))
         robot = scene_robot(scene)
-        _SCENES[path] = (build_scene(scene, robot, render_observations=False), robot)
-    return _SCENES[path]
+        hal = build_hal(robot, mode=HalMode.SIM, scene=scene)
+        if not isinstance(hal, SimAttachedHAL):  # build_hal attaches every scene
+            raise TypeError(f"build_hal gave a {type(hal).__name__} for scene {path}")
+        _HALS[path] = (hal, robot)
+    return _HALS[path]
 
 
 def run_episode(spec: EpisodeSpec) -> EpisodeResult:
@@ -126,41 +137,53 @@ def run_episode(spec: EpisodeSpec) -> EpisodeResult:
 
 def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> tuple[int, bool, float]:
     """(steps, success, simulated time [s]) of one episode; may raise."""
-    env, robot = scene_for(spec.scene)
+    hal, robot = scene_for(spec.scene)
     policy = make_policy(spec.policy, dict(spec.params))
-    hal = SimAttachedHAL(env, robot, env_reset_seed=spec.seed)
-    hal.connect()
-    limit = spec.steps or _horizon(env) or DEFAULT_STEPS
-    video = VideoWriter.for_scene(spec.video, env)
-    inputs = _Inputs(env, robot, policy)
+    inputs = _Inputs(hal, robot, policy)
+    camera = inputs.video_camera(spec.video)
+    video = VideoWriter.for_camera(spec.video, camera, _frame_rate_hz(hal, robot, camera))
+    inputs.observe(camera)
+    hal.env_reset_seed = spec.seed
+    hal.release_estop()
+    hal.connect()  # a new episode: the scene reset with the seed
+    limit = spec.steps or _horizon(hal) or DEFAULT_STEPS
     steps, success, started = 0, False, hal.read_state().sim_time_s or 0.0
     try:
         while steps < limit and not success:
             state = hal.read_state()
             digest.update(state.positions.tobytes())
-            video.add(env)
-            hal.send_action(policy.act(inputs.observation(hal, state.positions, steps)))
+            video.add(hal.last_observation())
+            hal.send_action(policy.act(inputs.observation(state.positions, steps)))
             steps += 1
-            success = bool(hal.last_step_info.get("success", False))
+            success = hal.last_outcome.success
             if hal.episode_done and not success:
                 break
-        video.add(env)
+        video.add(hal.last_observation())
     finally:
         video.close()
     digest.update(hal.read_state().positions.tobytes())
     return steps, success, float(hal.read_state().sim_time_s or 0.0) - started
 
 
-def _horizon(env: SimRollout) -> int | None:
-    return env.horizon if isinstance(env, NativeScene) else None
+def _frame_rate_hz(hal: SimAttachedHAL, robot: LoadedRobot, camera: str | None) -> float:
+    """The rate ``camera``'s frames come at in the scene's observations [Hz]."""
+    if camera is None:
+        return 1.0
+    control_hz = 1.0 / hal.control_period_s
+    return sensor_rates(robot.description, control_hz, sensors=[camera])[camera]
+
+
+def _horizon(hal: SimAttachedHAL) -> int | None:
+    return hal.env.horizon if isinstance(hal.env, SceneRollout) else None
 
 
 class _Inputs:
-    """Builds a policy's observation each step: frames by VLA slot when it needs cameras,
-    privileged state when it asks for it."""
+    """Builds a policy's observation each step: the latest frame of each camera by VLA slot
+    when it needs cameras, the task state and the simulation when it asks for them."""
 
-    def __init__(self, env: SimRollout, robot: LoadedRobot, policy: PolicyAdapter) -> None:
-        self.env, self.policy = env, policy
+    def __init__(self, hal: SimAttachedHAL, robot: LoadedRobot, policy: PolicyAdapter) -> None:
+        self.hal, self.policy = hal, policy
+        self.scene = hal.env if isinstance(hal.env, SceneRollout) else None
         slots = {slot.slot: slot.sensor for slot in robot.tables.vla_slots}
         self.slots = {slot: slots[slot] for slot in policy.required_slots if slot in slots}
         missing = [slot for slot in policy.required_slots if slot not in slots]
@@ -171,47 +194,57 @@ class _Inputs:
             )
         self.scratch: mujoco.MjData | None = None
 
-    def observation(self, hal: SimAttachedHAL, positions: np.ndarray, step: int) -> Observation:
-        images = {}
-        if self.slots:
-            if not isinstance(self.env, NativeScene):
-                frames = hal.read_images()
-                images = {slot: frames[sensor] for slot, sensor in self.slots.items()}
-            else:
-                rendered = self.env.render_cameras(self.env.data, list(self.slots.values()))
-                images = {slot: rendered[sensor] for slot, sensor in self.slots.items()}
+    def video_camera(self, path: str | None) -> str | None:
+        """The camera a video shows: the scene's first (None: no video or no camera)."""
+        names = self.hal.env.camera_names
+        return names[0] if path is not None and names else None
+
+    def observe(self, video_camera: str | None) -> None:
+        """Render only the cameras the policy and the video read (a native scene)."""
+        if self.scene is not None:
+            wanted = {*self.slots.values(), *([video_camera] if video_camera else [])}
+            self.scene.observed = frozenset(wanted)
+            self.scene.render_observations = True
+
+    def observation(self, positions: np.ndarray, step: int) -> Observation:
+        hal = self.hal
+        frames = hal.read_images() if self.slots else {}
+        missing = [sensor for sensor in self.slots.values() if sensor not in frames]
+        if missing:
+            raise ValueError(f"the scene renders no frame of {missing}")
         obs: Observation = {
-            "images": images,
+            "images": {slot: frames[sensor] for slot, sensor in self.slots.items()},
             "joint_positions": positions,
             "action_spec": (hal.action_names, hal.hold_action()),
             "time_s": step * hal.control_period_s,
         }
-        if getattr(self.policy, "needs_privileged", False):
-            obs["privileged"] = self._privileged()
+        if self.policy.needs_privileged:
+            scene_obs = hal.last_observation()
+            obs["task_state"] = dict(scene_obs.task_state)
+            if self.scene is not None:
+                obs["privileged"] = self._privileged(self.scene, scene_obs)
         return obs
 
-    def _privileged(self) -> Privileged:
-        env = self.env
-        if not isinstance(env, NativeScene):
-            raise ValueError("a policy with privileged state needs a native scene")
+    def _privileged(self, scene: SceneRollout, scene_obs: SceneObservation) -> Privileged:
+        handles = scene.mujoco_handles()
+        if handles is None:  # a native scene always has them
+            raise ValueError("a policy with privileged state needs a MuJoCo scene")
+        model, data = handles
         if self.scratch is None:
-            self.scratch = mujoco.MjData(env.model)
-        mujoco.mj_copyData(self.scratch, env.model, env.data)
-        slots = env.addresses.arm_slots
+            self.scratch = mujoco.MjData(model)
+        mujoco.mj_copyData(self.scratch, model, data)
+        slots = scene.addresses.arm_slots
         return Privileged(
-            model=env.model,
+            model=model,
             data=self.scratch,
-            objects=object_poses(env),
+            objects=object_poses(scene_obs),
             arm_slots=tuple(int(s) for s in slots),
-            arm_dofs=tuple(int(d) for d in env.addresses.qvel[slots]),
+            arm_dofs=tuple(int(d) for d in scene.addresses.qvel[slots]),
         )
 
 
-def object_poses(env: NativeScene) -> dict[str, Pose]:
-    """World pose of every object the scene file lists (its body ``scene_<name>``)."""
-    options = env.scene.scene.options
-    poses: dict[str, Pose] = {}
-    for obj in options.objects if options and options.objects else []:
-        body = mujoco.mj_name2id(env.model, mujoco.mjtObj.mjOBJ_BODY, f"scene_{obj.name}")
-        poses[obj.name] = (env.data.xpos[body].copy(), env.data.xquat[body].copy())
-    return poses
+def object_poses(obs: SceneObservation) -> dict[str, Pose]:
+    """World pose of every object a native scene reports (``<name>_pos``/``<name>_quat``)."""
+    state = obs.task_state
+    names = [key[: -len("_pos")] for key in state if key.endswith("_pos")]
+    return {name: (state[f"{name}_pos"], state[f"{name}_quat"]) for name in names}

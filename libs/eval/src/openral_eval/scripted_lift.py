@@ -25,7 +25,7 @@ import mujoco
 import numpy as np
 from openral_mujoco.state import FloatArray
 
-from openral_eval.policies import Observation, PolicyConfigError
+from openral_eval.policy import Observation, PolicyConfigError
 from openral_eval.privileged import Privileged
 
 PHASES = ("approach", "descend", "close", "lift")
@@ -65,6 +65,7 @@ class ScriptedLift:
     """The four-phase lift of the module doc; one instance per episode."""
 
     needs_privileged = True
+    """It reads the simulation (only an evaluation episode on a native scene gives it)."""
     required_slots: tuple[str, ...] = ()
 
     def __init__(self, config: LiftConfig) -> None:

@@ -11,7 +11,13 @@ spec's slots, and latches an E-stop. Capabilities are separate Protocols, checke
 * :class:`MobileBaseHal` drives a mobile base with velocity commands and reports its
   odometry (when its ``base`` is not None);
 * :class:`FramesHal` knows the TF frames of the robot and its sensors in its MuJoCo model
-  (:class:`~openral_sim.frame_tree.FrameTree`), read from its ``mujoco_handles``.
+  (:class:`~openral_sim.frame_tree.FrameTree`), read from its ``mujoco_handles``;
+* :class:`ObservingHal` keeps the typed observation of its scene's last step;
+* the sensor sources of :mod:`openral_sim.sensor_sources` (re-exported here):
+  :class:`CameraSource`, :class:`DepthSource`, :class:`LidarSource`,
+  :class:`StateSensorSource` and :class:`BaseOdometrySource` — what the ROS sensor
+  bridges depend on, so a real driver that implements them publishes its depth, scans and
+  IMU through the same bridges a simulation does.
 """
 
 from __future__ import annotations
@@ -25,8 +31,16 @@ from openral_core.models import RobotDescription
 from openral_mujoco.state import FloatArray, JointStateSample
 from openral_sim.base_drive import BaseCommand, BaseDrive, BaseOdometry
 from openral_sim.frame_tree import FrameTree
+from openral_sim.observation import Observation
+from openral_sim.sensor_sources import (
+    BaseOdometrySource,
+    CameraSource,
+    DepthSource,
+    LidarSource,
+    StateSensorSource,
+)
 
-from openral_hal.errors import EStopLatched
+from openral_hal.estop import EStopLatch
 
 
 @runtime_checkable
@@ -142,8 +156,38 @@ class MujocoBacked(Protocol):
         ...
 
 
+__all__ = [
+    "BaseOdometrySource",
+    "CameraHal",
+    "CameraSource",
+    "DepthSource",
+    "EStopLatch",
+    "FramesHal",
+    "LidarSource",
+    "MobileBaseHal",
+    "MujocoBacked",
+    "ObservingHal",
+    "RobotHal",
+    "StateSensorSource",
+    "Tickable",
+]
+
+
 @runtime_checkable
-class MobileBaseHal(RobotHal, Protocol):
+class ObservingHal(RobotHal, Protocol):
+    """A HAL that keeps the typed observation of its scene's last step or reset."""
+
+    def last_observation(self) -> Observation:
+        """The latest observation (its sensor frames: those due at that step).
+
+        Raises:
+            NotConnected: Before connect.
+        """
+        ...
+
+
+@runtime_checkable
+class MobileBaseHal(RobotHal, BaseOdometrySource, Protocol):
     """A HAL that may carry a mobile base (``base`` None: this robot has none)."""
 
     @property
@@ -175,35 +219,3 @@ class FramesHal(MujocoBacked, Protocol):
             HalError: The model's layout cannot be stated as a tree.
         """
         ...
-
-
-class EStopLatch:
-    """The E-stop latch, written once for every HAL (a mixin).
-
-    A HAL calls :meth:`_refuse_when_estopped` before applying an action and overrides
-    :meth:`_on_release` to re-aim its targets at the current pose so nothing jumps.
-    """
-
-    _estopped: bool = False
-
-    @property
-    def estopped(self) -> bool:
-        """True while the E-stop is latched."""
-        return self._estopped
-
-    def estop(self) -> None:
-        """Latch the E-stop: actions are refused and the robot is held."""
-        self._estopped = True
-
-    def release_estop(self) -> None:
-        """Unlatch the E-stop; the HAL's targets are the current pose, so nothing jumps."""
-        self._on_release()
-        self._estopped = False
-
-    def _on_release(self) -> None:
-        """Hook run before unlatching (default: nothing)."""
-
-    def _refuse_when_estopped(self) -> None:
-        """Raise EStopLatched while latched."""
-        if self._estopped:
-            raise EStopLatched()

@@ -3,8 +3,8 @@
 A native scene reports its robot's joint state in manifest units itself. Another backend
 (robosuite) does not: its MuJoCo data is read here by joint name, raw (positions,
 velocities, actuator efforts at each joint's addresses), and a backend without MuJoCo
-gives positions in ``obs["joint_positions"]`` (zeros when absent), zero velocities and
-efforts.
+gives positions in ``obs.joints`` (zeros when absent; padded or cut to the manifest's
+width), zero velocities and efforts.
 """
 
 from __future__ import annotations
@@ -99,10 +99,9 @@ class SceneJointReader:
 
     def _positions_from_obs(self, obs: Observation) -> FloatArray:
         count = len(self.joint_names)
-        raw = obs.get("joint_positions")
-        if raw is None:
+        if obs.joints is None:
             return np.zeros(count)
-        values = np.asarray(raw, dtype=np.float64).ravel()
+        values = np.asarray(obs.joints.positions, dtype=np.float64).ravel()
         if values.size != count:
             if not self._warned_width:
                 _log.warning(

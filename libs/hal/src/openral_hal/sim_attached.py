@@ -6,7 +6,7 @@ and camera frames come from the last observation. A native scene drives its robo
 manifest's contract (:class:`~openral_sim.rollout.ManifestRollout`): then the action is one
 value per manifest joint and the joint state is the scene's own, in manifest units. Another
 backend (robosuite) keeps its controller's action; its joint state is read from the MuJoCo
-data by joint name (or from ``obs["joint_positions"]`` for a non-MuJoCo backend).
+data by joint name (or from ``obs.joints`` for a non-MuJoCo backend).
 The deploy control loop advances the scene one step per control period with
 :meth:`SimAttachedHAL.tick`, which exists only on simulated HALs. A robot on a mobile base
 in a native scene also takes base velocity commands (:meth:`SimAttachedHAL.command_base`,
@@ -27,27 +27,24 @@ from openral_mujoco.action import validated_action
 from openral_mujoco.state import FloatArray, JointStateSample
 from openral_sim.base_drive import BaseCommand, BaseDrive, BaseOdometry
 from openral_sim.frame_tree import FrameTree
-from openral_sim.native_scene import NativeScene
-from openral_sim.rollout import (
-    HoldingRollout,
-    ManifestRollout,
-    Observation,
-    SimRollout,
-    StepResult,
-)
+from openral_sim.hold import hold_action
+from openral_sim.observation import ImageArray, Observation, Outcome, StepResult
+from openral_sim.rollout import HoldingRollout, ManifestRollout, SceneRollout, SimRollout
 
+from openral_hal.attached_sensors import AttachedSensors
 from openral_hal.errors import ConfigurationError, HalError, NotConnected
-from openral_hal.protocol import EStopLatch
+from openral_hal.estop import EStopLatch
 from openral_hal.scene_joints import SceneJointReader
 
 _log = logging.getLogger(__name__)
 
 
-class SimAttachedHAL(EStopLatch):
+class SimAttachedHAL(AttachedSensors, EStopLatch):
     """A robot inside a simulated scene; one action is one step of the scene.
 
     The action is the scene's own action (``action_dim`` values): one per manifest joint on
-    a native scene, whatever its controller takes on robosuite.
+    a native scene, whatever its controller takes on robosuite. The sensors a native scene
+    serves off its step are the HAL's sensor sources (:class:`AttachedSensors`).
     """
 
     is_real = False
@@ -72,6 +69,8 @@ class SimAttachedHAL(EStopLatch):
         self.env = env
         # checked once: a runtime Protocol check costs ~17 us, too much for every tick
         self._manifest_env = env if isinstance(env, ManifestRollout) else None
+        self._scene = env if isinstance(env, SceneRollout) else None
+        self._suite = self._scene.sensors if self._scene is not None else None
         self.robot = robot
         description = robot.description
         self.env_reset_seed = env_reset_seed
@@ -82,8 +81,8 @@ class SimAttachedHAL(EStopLatch):
         self._action_names: tuple[str, ...] = ()
         self._obs: Observation | None = None
         self._last_env_action: FloatArray = np.zeros(0)
-        self._episode_done = False
-        self._info: dict[str, Any] = {}
+        self._outcome = Outcome()
+        self._frames: dict[str, ImageArray] = {}
         self._closed = False
         mjcf_names = tuple(robot.tables.joint_name_map[n] for n in self.joint_names)
         self._joints = SceneJointReader(description, mjcf_names, type(env).__name__)
@@ -132,8 +131,8 @@ class SimAttachedHAL(EStopLatch):
         self._action_dim = width
         self._action_names = self._slot_names(width)
         self._last_env_action = np.zeros(width)
-        self._episode_done = False
-        self._obs = obs
+        self._outcome = Outcome()
+        self._observed(obs)
 
     @property
     def action_names(self) -> tuple[str, ...]:
@@ -142,17 +141,9 @@ class SimAttachedHAL(EStopLatch):
         return self._action_names
 
     def hold_action(self) -> FloatArray:
-        """The action that keeps the robot still: the backend's hold, else zeros.
-
-        Zeros hold velocity and delta controllers; a position-controlled backend provides its
-        current targets instead (zeros would send every joint towards 0 rad).
-        """
-        width = self.action_dim
-        if isinstance(self.env, HoldingRollout):
-            hold = np.asarray(self.env.hold_action(), dtype=np.float64).ravel()
-            if hold.size == width:
-                return hold
-        return np.zeros(width)
+        """The action that keeps the robot still (:func:`openral_sim.hold.hold_action`: the
+        backend's hold, else zeros)."""
+        return hold_action(self.env, self.action_dim)
 
     def disconnect(self) -> None:
         """Close the scene (renderers and all); the HAL cannot be connected again."""
@@ -160,6 +151,7 @@ class SimAttachedHAL(EStopLatch):
             self.env.close()
             self._closed = True
         self._obs = None
+        self._frames.clear()
         self._action_dim = None
         self._action_names = ()
 
@@ -174,7 +166,7 @@ class SimAttachedHAL(EStopLatch):
         Raises:
             HalError: The model's layout cannot be stated as a tree (see the message).
         """
-        return self.env.frame_tree if isinstance(self.env, NativeScene) else None
+        return self._scene.frames() if self._scene is not None else None
 
     def camera_fovy_deg(self, sensor: str) -> float | None:
         """Vertical field of view of the scene camera that renders ``sensor`` (None when the
@@ -193,7 +185,7 @@ class SimAttachedHAL(EStopLatch):
 
         A native scene reports it in manifest units (grippers per their read mode). Another
         MuJoCo scene gives raw positions, velocities and actuator efforts; another backend
-        gives positions from ``obs["joint_positions"]`` (zeros when absent) and zero
+        gives positions from ``obs.joints`` (zeros when absent) and zero
         velocities and efforts.
         """
         obs = self._require_obs()
@@ -202,21 +194,30 @@ class SimAttachedHAL(EStopLatch):
         return self._joints.read(self.env.mujoco_handles(), obs)
 
     def read_images(self) -> dict[str, npt.NDArray[np.uint8]]:
-        """Last frame of each manifest RGB sensor the scene renders, by sensor name."""
-        images = self._require_obs().get("images") or {}
-        return {name: images[name] for name in self._rgb if name in images}
+        """Latest frame of each manifest RGB sensor the scene's observations carried (each
+        camera's frames come at its own rate), by sensor name."""
+        self._require_obs()
+        return {name: self._frames[name] for name in self._rgb if name in self._frames}
+
+    def last_observation(self) -> Observation:
+        """The scene's latest observation (its frames: those due at that step).
+
+        Raises:
+            NotConnected: Before connect.
+        """
+        return self._require_obs()
 
     # -- commands --------------------------------------------------------------------------
 
     @property
-    def last_step_info(self) -> dict[str, Any]:
-        """What the scene reported with its last step (a native scene: ``success``, …)."""
-        return dict(self._info)
+    def last_outcome(self) -> Outcome:
+        """How the scene's last step ended (reward, success, terminated, truncated)."""
+        return self._outcome
 
     @property
     def episode_done(self) -> bool:
         """True when the last step ended the episode; the next step resets first."""
-        return self._episode_done
+        return self._outcome.done
 
     @property
     def last_env_action(self) -> FloatArray:
@@ -271,11 +272,11 @@ class SimAttachedHAL(EStopLatch):
         """A new episode of the scene with the HAL's seed: start pose, objects, a mobile
         base at its start; the E-stop latch is kept (an E-stopped scene stays frozen)."""
         self._require_obs()
-        self._obs = self.env.reset(seed=self.env_reset_seed)
-        self._episode_done = False
+        obs = self.env.reset(seed=self.env_reset_seed)
+        self._observed(obs)
+        self._outcome = Outcome()
         self._last_env_action = np.zeros(self.action_dim)
-        time_s = self._obs.get("time")
-        clock = f"; simulated time {time_s:.3f} s" if isinstance(time_s, float) else ""
+        clock = f"; simulated time {obs.time_s:.3f} s"
         latch = "; the E-stop is still latched" if self._estopped else ""
         return (
             f"{self.description.name}: scene reset with seed {self.env_reset_seed} "
@@ -288,7 +289,7 @@ class SimAttachedHAL(EStopLatch):
     @property
     def base(self) -> BaseDrive | None:
         """The mobile base's drive (None: a robot without one, or not a native scene)."""
-        return self.env.base if isinstance(self.env, NativeScene) else None
+        return self._scene.base if self._scene is not None else None
 
     def command_base(self, vx_m_s: float, vy_m_s: float, wz_rad_s: float) -> BaseCommand:
         """Drive the mobile base at this base-frame velocity [m/s, m/s, rad/s], clamped to
@@ -308,9 +309,8 @@ class SimAttachedHAL(EStopLatch):
         self._require_obs()
         return self._require_base().odometry()
 
-    def estop(self) -> None:
-        """Latch the E-stop: actions and base commands are refused, the base halts at once."""
-        super().estop()
+    def _on_latch(self) -> None:
+        """The E-stop halts the mobile base at once (:mod:`openral_hal.estop`)."""
         if self.base is not None:
             self.base.halt()
 
@@ -332,10 +332,15 @@ class SimAttachedHAL(EStopLatch):
             raise NotConnected("the HAL is not connected; call connect() first")
         return self._obs
 
+    def _observed(self, obs: Observation) -> None:
+        """Keep ``obs`` and the latest frame of each camera."""
+        self._obs = obs
+        self._frames.update(obs.images)
+
     def _reset_if_done(self) -> None:
-        if self._episode_done:
-            self._obs = self.env.reset(seed=self.env_reset_seed)
-            self._episode_done = False
+        if self._outcome.done:
+            self._observed(self.env.reset(seed=self.env_reset_seed))
+            self._outcome = Outcome()
 
     def _command(self, action: object, *, glide: bool) -> None:
         self._require_obs()
@@ -350,9 +355,8 @@ class SimAttachedHAL(EStopLatch):
             result = self._manifest_env.step(action, glide=True)
         else:
             result = self.env.step(action)
-        self._obs = result.obs
-        self._info = result.info
-        self._episode_done = bool(result.terminated or result.truncated)
+        self._observed(result.obs)
+        self._outcome = result.outcome
         return result
 
     def _slot_names(self, width: int) -> tuple[str, ...]:
@@ -361,10 +365,3 @@ class SimAttachedHAL(EStopLatch):
         if width == len(self.joint_names):
             return self.joint_names
         return tuple(f"env_action[{i}]" for i in range(width))
-
-
-def native_scene(hal: object) -> NativeScene | None:
-    """The native scene behind ``hal`` (it renders cameras and depth on demand), else None."""
-    if isinstance(hal, SimAttachedHAL) and isinstance(hal.env, NativeScene):
-        return hal.env
-    return None

@@ -18,11 +18,13 @@ robot) takes velocity commands and reads odometry, and :meth:`NativeScene.step` 
 every :data:`~openral_sim.base_drive.BASE_UPDATE_STEPS` physics steps. The base is no slot
 of the action: the arm's contract stays exactly the robot's own.
 
-Cameras render on demand. With ``render_observations`` (the default, what ``openral sim
-run`` and the tests read) every ``reset``/``step`` renders each camera into
-``obs["images"]``; without it they render nothing and ``obs["images"]`` is empty, and a
-caller renders the frames it needs with :meth:`NativeScene.render_cameras`, on any thread,
-from any ``MjData`` of this model (``deploy sim`` renders snapshots on a thread of its own).
+Every ``reset``/``step`` returns a typed :class:`~openral_sim.observation.Observation`:
+the joint sample, the base's odometry, the objects' poses, and the frames of the sensors
+due at that instant (:mod:`openral_sim.sensor_schedule`: each at its manifest rate, capped
+at the control rate). With ``render_observations`` off no frame is made (``deploy sim``
+renders snapshots on threads of its own through :attr:`NativeScene.sensors`, the scene's
+:mod:`sensor sources <openral_sim.sensor_sources>`); :attr:`NativeScene.observed` narrows
+the frames to the sensors a caller reads (a sweep: its policy's cameras and its video).
 """
 
 from __future__ import annotations
@@ -47,14 +49,14 @@ from openral_mujoco.state import FloatArray, JointStateSample
 from openral_sim.base_drive import BASE_UPDATE_STEPS, BaseDrive
 from openral_sim.depth_cloud import DepthCamera, DepthFrame
 from openral_sim.frame_tree import FrameTree, scene_frame_tree
+from openral_sim.observation import Observation, Outcome, StepResult
 from openral_sim.randomization import Randomizer
 from openral_sim.range_sensors import RangeSensors
-from openral_sim.rollout import Observation, StepResult
 from openral_sim.scene_cameras import camera_sensors
 from openral_sim.scene_checks import physics_steps_per_control
 from openral_sim.scene_compose import BASE_WELD, compose
 from openral_sim.scene_geometry import place_floating_base
-from openral_sim.state_sensors import StateSensors
+from openral_sim.scene_sensors import SceneSensors
 from openral_sim.success import SuccessCheck
 
 
@@ -106,10 +108,23 @@ class NativeScene:
             self.model, description, cameras, robot_ids, self._root_body
         )
         """Depth cameras and lidars (:class:`~openral_sim.range_sensors.RangeSensors`)."""
-        self.state_sensors = StateSensors(self.model, description)
-        """IMU, force-torque and pose sensors (:class:`~openral_sim.state_sensors.StateSensors`)."""
         depth = self.range_sensors.depth
         self._sensors = {name: cam for name, cam in cameras.items() if name not in depth}
+        size = (scene.scene.observation.height, scene.scene.observation.width)
+        offset = self.base.root_in_base_frame if self.base is not None else (0.0, 0.0, 0.0)
+        self.sensors = SceneSensors(
+            self.model,
+            self.data,
+            description,
+            self._sensors,
+            self.range_sensors,
+            size,
+            robot.tables.frames,
+            offset,
+        )
+        """Every sensor the scene serves, as sensor sources (:mod:`openral_sim.scene_sensors`)."""
+        self.state_sensors = self.sensors.state
+        """IMU, force-torque and pose sensors (:class:`~openral_sim.state_sensors.StateSensors`)."""
         self._root_qpos = int(self.model.jnt_qposadr[self.model.body_jntadr[self._root_body]])
         self._width = scene.scene.observation.width
         self._height = scene.scene.observation.height
@@ -117,10 +132,11 @@ class NativeScene:
         self.substeps = physics_steps_per_control(scene, self.model.opt.timestep)
         self.horizon = options.horizon if options and options.horizon else None
         self.render_observations = render_observations
-        """Whether ``reset``/``step`` render the cameras into ``obs["images"]``; may be
-        changed at any time (the next observation follows it)."""
-        self._renderer: mujoco.Renderer | None = None
+        """Whether observations carry sensor frames; may be changed at any time."""
+        self.observed: frozenset[str] | None = None
+        """The sensors whose frames observations carry (None: every one served)."""
         self._steps = 0
+        self.sensors.reschedule(1.0 / self.control_period_s)
         self._setup_episodes(scene, description, cameras, addresses)
 
     def _setup_episodes(
@@ -144,6 +160,11 @@ class NativeScene:
         self._arm_qpos = addresses.qpos[addresses.arm_slots]
         fingers = [int(a) for g in addresses.grippers for a in g.finger_qpos]
         self.success = SuccessCheck(scene.success or [], self.model, fingers)
+        options = scene.scene.options
+        self._objects = {
+            obj.name: mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, f"scene_{obj.name}")
+            for obj in (options.objects if options and options.objects else [])
+        }
         """The scene's success predicates (:mod:`openral_sim.success`)."""
 
     # -- SimRollout ------------------------------------------------------------------------
@@ -189,6 +210,10 @@ class NativeScene:
         """
         return scene_frame_tree(self.model, self.robot, self.addresses, self._cameras, self.base)
 
+    def frames(self) -> FrameTree:
+        """:attr:`frame_tree` (the :class:`~openral_sim.rollout.SceneRollout` method)."""
+        return self.frame_tree
+
     @property
     def depth_cameras(self) -> dict[str, DepthCamera]:
         """The depth sensors the scene file names, by sensor name."""
@@ -232,15 +257,16 @@ class NativeScene:
         if self.base is not None:  # the odometry frame: where the base settled, exactly
             self.base.reset()
         self._steps = 0
+        self.sensors.schedule.restart()
         return self._observe()
 
     def step(self, action: npt.NDArray[np.floating], *, glide: bool = False) -> StepResult:
         """Apply ``action`` (one value per manifest joint) for one control period; with
         ``glide`` the arm's set point moves to it at constant speed over the period, that
         speed fed forward (the next sample of a smooth path, see
-        :class:`~openral_mujoco.joint_driver.JointDriver`). ``info["success"]`` says whether
-        the scene's ``success`` predicates all hold now (a sweep ends the episode on it;
-        ``deploy sim`` does not: the world never resets under a ROS client by itself).
+        :class:`~openral_mujoco.joint_driver.JointDriver`). The outcome's ``success`` says
+        whether the scene's ``success`` predicates all hold now (a sweep ends the episode on
+        it; ``deploy sim`` does not: the world never resets under a ROS client by itself).
 
         Raises:
             ActionRejected: Wrong type, width, or a non-finite value; nothing is changed.
@@ -252,8 +278,8 @@ class NativeScene:
         self._steps += 1
         success = self.success.update(self.data, self.control_period_s)
         truncated = self.horizon is not None and self._steps >= self.horizon
-        info = {"steps": self._steps, "success": success}  # an evaluator ends on it, not the scene
-        return StepResult(self._observe(), truncated=truncated, info=info)
+        outcome = Outcome(success=success, truncated=truncated, steps=self._steps)
+        return StepResult(self._observe(), outcome)
 
     def joint_state(self) -> JointStateSample:
         """Every manifest joint, in manifest order and units (as ``MujocoArmHAL`` reports)."""
@@ -281,53 +307,47 @@ class NativeScene:
         sensors: Iterable[str] | None = None,
         renderer: mujoco.Renderer | None = None,
     ) -> dict[str, npt.NDArray[np.uint8]]:
-        """Render the cameras of ``sensors`` (default: all) as ``data`` places them.
+        """Fresh frames (H x W x 3 uint8) of the cameras of ``sensors`` (default: all) as
+        ``data`` places them, by sensor name.
 
         ``data`` must belong to this scene's model and hold the kinematics the cameras see
-        (``xpos``/``xmat``, camera and light poses: after ``mj_step``, ``mj_forward`` or
-        ``mj_kinematics`` + ``mj_camlight``); it is only read. The live :attr:`data` is one
-        choice; a copy is another.
-
-        Args:
-            data: MjData of :attr:`model`.
-            sensors: Manifest sensor names among :attr:`camera_names`.
-            renderer: A renderer of :attr:`model` at :attr:`image_size`, created on the
-                calling thread (an EGL context is current on one thread); None uses the
-                scene's own, which then belongs to the thread that first used it.
-
-        Returns:
-            One H x W x 3 uint8 frame (a fresh array) per sensor, by sensor name.
+        (after ``mj_step``, ``mj_forward`` or ``mj_kinematics`` + ``mj_camlight``); it is only
+        read. ``renderer``: one of :attr:`model` at :attr:`image_size`, created on the calling
+        thread; None uses the scene's own (it belongs to the thread that first used it).
 
         Raises:
             KeyError: A sensor this scene does not render.
         """
         names = self.camera_names if sensors is None else tuple(sensors)
-        unknown = [name for name in names if name not in self._sensors]
-        if unknown:
-            raise KeyError(f"the scene renders no camera {unknown}; it has {self.camera_names}")
-        if renderer is None and names:
-            if self._renderer is None:
-                self._renderer = mujoco.Renderer(self.model, self._height, self._width)
-            renderer = self._renderer
-        images: dict[str, npt.NDArray[np.uint8]] = {}
-        for name in names:
-            assert renderer is not None
-            renderer.update_scene(data, camera=self._sensors[name])
-            images[name] = renderer.render().copy()
-        return images
+        return self.sensors.render(data, names, renderer)
 
     def close(self) -> None:
         """Free the offscreen renderers."""
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
-        self.range_sensors.close()
+        self.sensors.close()
 
     # -- internals -------------------------------------------------------------------------
 
     def _observe(self) -> Observation:
-        images = self.render_cameras(self.data) if self.render_observations else {}
-        return {"images": images, "time": float(self.data.time)}
+        wanted = self.observed if self.render_observations else frozenset()
+        images, depth, scans, readings = self.sensors.due_frames(wanted)
+        return Observation(
+            time_s=float(self.data.time),
+            joints=self.joint_state(),
+            images=images,
+            depth=depth,
+            scans=scans,
+            readings=readings,
+            odometry=self.base.odometry() if self.base is not None else None,
+            task_state=self._object_poses(),
+        )
+
+    def _object_poses(self) -> dict[str, FloatArray]:
+        """``<object>_pos`` [m] and ``<object>_quat`` (w, x, y, z) of every scene object."""
+        state: dict[str, FloatArray] = {}
+        for name, body in self._objects.items():
+            state[f"{name}_pos"] = self.data.xpos[body].copy()
+            state[f"{name}_quat"] = self.data.xquat[body].copy()
+        return state
 
     def _advance(self, steps: int) -> None:
         """``steps`` physics steps; a mobile base's drive is updated before every

@@ -62,7 +62,8 @@ from openral_core.located import error_at, source_of
 from openral_core.models import DeployScene, RgbSensor, RobotDescription
 from openral_core.registry import load_robot_by_id
 
-from openral_sim.rollout import Observation, StepResult
+from openral_sim.observation import Observation, Outcome, StepResult
+from openral_sim.sensor_schedule import SensorSchedule, sensor_rates
 
 _NATIVE_ONLY_OPTIONS = ("table_height_m", "objects")
 
@@ -117,6 +118,9 @@ class RobosuiteRollout:
             )
         self.env: Any = _make_env(env_name, robot, self._cameras, (width, height), options)
         self._flip = robosuite.macros.IMAGE_CONVENTION == "opengl"
+        self.schedule = SensorSchedule(dict.fromkeys(self._names, control_freq_hz))
+        """When each camera's frame enters the observation (robosuite renders every step;
+        :func:`build_robosuite_rollout` sets each camera's manifest rate)."""
 
     # -- SimRollout ------------------------------------------------------------------------
 
@@ -153,27 +157,30 @@ class RobosuiteRollout:
             rng: np.random.Generator = self.env.rng
             rng.bit_generator.state = np.random.default_rng(seed).bit_generator.state
         self._make_current()
+        self.schedule.restart()
         return self._observe(self.env.reset())
 
     def step(self, action: npt.NDArray[np.floating[Any]]) -> StepResult:
         """Apply ``action`` (``action_dim`` values) for one control period.
 
         The episode ends at the horizon (``truncated``) or when the task itself says so
-        (``terminated``, e.g. Wipe on a collision).
+        (``terminated``, e.g. Wipe on a collision). ``success`` is the environment's own
+        success check (robosuite's ``step`` reports none in its info).
         """
         values = np.asarray(action, dtype=np.float64)
         if values.shape != (self.action_dim,):
             raise RobosuiteError(f"action has shape {values.shape}; expected ({self.action_dim},)")
         self._make_current()
-        raw, reward, done, info = self.env.step(values)
+        raw, reward, done, _ = self.env.step(values)
         at_horizon = bool(done) and int(self.env.timestep) >= int(self.env.horizon)
-        return StepResult(
-            obs=self._observe(raw),
+        outcome = Outcome(
             reward=float(reward),
+            success=bool(self.env._check_success()),
             terminated=bool(done) and not at_horizon,
             truncated=at_horizon,
-            info={**info, "steps": int(self.env.timestep)},
+            steps=int(self.env.timestep),
         )
+        return StepResult(self._observe(raw), outcome)
 
     def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData]:
         """The environment's raw MuJoCo model and data (not robosuite's wrappers)."""
@@ -195,23 +202,19 @@ class RobosuiteRollout:
             context.gl_ctx.make_current()
 
     def _observe(self, raw: dict[str, Any]) -> Observation:
+        """The typed observation of robosuite's: the frames due now, top row first, and
+        every non-image entry as task state."""
+        time_s = float(self.env.sim.data.time)
         images: dict[str, npt.NDArray[np.uint8]] = {}
-        for name, camera in self._cameras.items():
-            image = np.asarray(raw[f"{camera}_image"], dtype=np.uint8)
+        for name in self.schedule.due(time_s):
+            image = np.asarray(raw[f"{self._cameras[name]}_image"], dtype=np.uint8)
             images[name] = np.ascontiguousarray(image[::-1] if self._flip else image)
         state = {
-            key: np.asarray(value)
+            key: np.asarray(value, dtype=np.float64)
             for key, value in raw.items()
             if not key.endswith(("_image", "_depth", "_segmentation"))
         }
-        obs: Observation = {
-            "images": images,
-            "time": float(self.env.sim.data.time),
-            "robosuite": state,
-        }
-        if "robot0_joint_pos" in state:
-            obs["joint_positions"] = state["robot0_joint_pos"].copy()
-        return obs
+        return Observation(time_s=time_s, images=images, task_state=state)
 
 
 def robosuite_env_name(scene: DeployScene) -> str:
@@ -239,13 +242,18 @@ def robosuite_env_name(scene: DeployScene) -> str:
 
 
 def build_robosuite_rollout(
-    scene: DeployScene, robot: RobotDescription | None = None
+    scene: DeployScene,
+    robot: RobotDescription | None = None,
+    *,
+    frame_rate_hz: float | None = None,
 ) -> RobosuiteRollout:
     """The robosuite environment a deploy scene describes.
 
     Args:
         scene: A scene with ``scene.backend: robosuite``.
         robot: The scene's robot; read from ``robots/<robot_id>/`` when None.
+        frame_rate_hz: Overrides every camera's rate in the observations (see
+            :func:`~openral_sim.sensor_schedule.sensor_rates`).
 
     Raises:
         ManifestError: At the scene file's field that robosuite cannot serve: no robot, a
@@ -264,20 +272,24 @@ def build_robosuite_rollout(
     _check_scene_options(scene)
     options = scene.scene.options
     env_name = robosuite_env_name(scene)
+    control_freq_hz = options.control_freq_hz if options else 20.0
     try:
-        return RobosuiteRollout(
+        rollout = RobosuiteRollout(
             env_name=env_name,
             robot=robot_class,
             cameras=cameras,
             width=scene.scene.observation.width,
             height=scene.scene.observation.height,
-            control_freq_hz=options.control_freq_hz if options else 20.0,
+            control_freq_hz=control_freq_hz,
             horizon=options.horizon if options else None,
             controller=options.controller if options else None,
             seed=scene.seed,
         )
     except RobosuiteError as error:
         raise error_at(scene, ("scene",), str(error)) from None
+    rates = sensor_rates(robot, control_freq_hz, frame_rate_hz=frame_rate_hz, sensors=cameras)
+    rollout.schedule = SensorSchedule(rates)
+    return rollout
 
 
 def _check_names(env_name: str, robot: str, controller: str | None) -> None:

@@ -3,28 +3,28 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
 
 import mujoco
 import numpy as np
 import numpy.typing as npt
+from openral_mujoco.robot_addresses import RobotAddresses
 from openral_mujoco.state import JointStateSample
 
-Observation = dict[str, Any]
-"""Backend observation. Camera images are ``obs["images"][<camera name>]`` (HxWx3 uint8);
-non-MuJoCo backends may report ``obs["joint_positions"]`` (a 1-D float array)."""
+from openral_sim.base_drive import BaseDrive
+from openral_sim.frame_tree import FrameTree
+from openral_sim.observation import Observation, StepResult
+from openral_sim.sensor_sources import CameraSource, DepthSource, LidarSource, StateSensorSource
 
-
-@dataclass
-class StepResult:
-    """What one ``SimRollout.step`` returns (gymnasium's five-tuple, named)."""
-
-    obs: Observation
-    reward: float = 0.0
-    terminated: bool = False
-    truncated: bool = False
-    info: dict[str, Any] = field(default_factory=dict)
+__all__ = [
+    "HoldingRollout",
+    "ManifestRollout",
+    "Observation",
+    "SceneRollout",
+    "SensorSuite",
+    "SimRollout",
+    "StepResult",
+]
 
 
 @runtime_checkable
@@ -38,7 +38,7 @@ class SimRollout(Protocol):
 
     @property
     def camera_names(self) -> tuple[str, ...]:
-        """Cameras rendered into ``obs["images"]``."""
+        """Cameras whose frames observations carry (``obs.images``)."""
         ...
 
     @property
@@ -48,7 +48,7 @@ class SimRollout(Protocol):
 
     @property
     def camera_models(self) -> Mapping[str, str]:
-        """Camera name in ``obs["images"]`` → the MJCF camera of ``mujoco_handles()``'s model
+        """Camera name in ``obs.images`` → the MJCF camera of ``mujoco_handles()``'s model
         that renders it (empty for a non-MuJoCo backend)."""
         ...
 
@@ -107,4 +107,40 @@ class ManifestRollout(HoldingRollout, Protocol):
 
     def hold_current_pose(self) -> None:
         """Make the present pose the targets (after an E-stop, so nothing jumps)."""
+        ...
+
+
+@runtime_checkable
+class SensorSuite(CameraSource, DepthSource, LidarSource, StateSensorSource, Protocol):
+    """Every sensor kind a scene can serve, behind one object."""
+
+
+@runtime_checkable
+class SceneRollout(ManifestRollout, Protocol):
+    """A rollout that serves its sensors off its step, lays out its TF frames and may carry
+    a mobile base (the native scene): a bridge renders its sensors on threads of its own
+    at their rates, and a HAL attached to it publishes them all.
+
+    Only attributes and methods, no properties: ``isinstance`` on Python 3.11 would
+    evaluate a property (laying out the frames, say)."""
+
+    sensors: SensorSuite
+    """The scene's sensors as sources."""
+    render_observations: bool
+    """Whether ``reset``/``step`` make sensor frames for their observations."""
+    observed: frozenset[str] | None
+    """The sensors whose frames observations carry (None: all)."""
+    base: BaseDrive | None
+    """The mobile base's drive (None: none)."""
+    horizon: int | None
+    """Steps per episode (None: none)."""
+    addresses: RobotAddresses
+    """Where the robot's joints are in the scene's model, per manifest joint."""
+
+    def frames(self) -> FrameTree:
+        """The TF frames of the robot and of the sensors it serves, laid out once.
+
+        Raises:
+            HalError: A layout a URDF tree cannot state.
+        """
         ...

@@ -57,12 +57,18 @@ def check_scene_robot(scene: DeployScene, robot: LoadedRobot) -> None:
 
 
 def build_scene(
-    scene: DeployScene, robot: LoadedRobot, *, render_observations: bool = True
+    scene: DeployScene,
+    robot: LoadedRobot,
+    *,
+    render_observations: bool = True,
+    frame_rate_hz: float | None = None,
 ) -> SimRollout:
     """The backend ``scene`` names, built for ``robot``; reads no file but the robot's model.
 
     ``render_observations=False`` builds a native scene that renders nothing into its
     observations (``deploy sim`` renders frames on demand instead); robosuite renders its own.
+    ``frame_rate_hz`` overrides the rate of every camera and lidar in the observations
+    (:func:`~openral_sim.sensor_schedule.sensor_rates`; ``math.inf``: every step).
 
     Raises:
         ManifestError: The scene is for another robot or cannot be built for this one;
@@ -76,11 +82,14 @@ def build_scene(
         except ModuleNotFoundError as error:
             message = f"the robosuite backend is unavailable ({error})"
             raise error_at(scene, ("scene", "backend"), message) from None
-        return build_robosuite_rollout(scene, robot.description)
+        return build_robosuite_rollout(scene, robot.description, frame_rate_hz=frame_rate_hz)
     from openral_sim.native_scene import NativeScene
 
     check_scene_cameras(scene, robot.description)
-    return NativeScene(scene, robot, render_observations=render_observations)
+    native = NativeScene(scene, robot, render_observations=render_observations)
+    if frame_rate_hz is not None:
+        native.sensors.reschedule(1.0 / native.control_period_s, frame_rate_hz)
+    return native
 
 
 def build_sim_env_from_yaml(path: str | Path, robot_id_fallback: str | None = None) -> SimRollout:

@@ -20,6 +20,7 @@ import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -30,7 +31,7 @@ from openral_cli.console import out, progress
 from openral_cli.help_text import command_group
 
 if TYPE_CHECKING:
-    from openral_hal.protocol import RobotHal
+    from openral_hal.protocol import ObservingHal, RobotHal
 
 app = command_group("Run simulated scenes, or sweep a policy over scenes and seeds.")
 app.command("sweep")(sweep)
@@ -76,7 +77,7 @@ def run(
     from openral_core import open_robot
     from openral_core.loader import load_scene
     from openral_hal.factory import HalMode, build_hal
-    from openral_sim.scene import check_scene_robot, scene_robot
+    from openral_sim.scene import build_scene, check_scene_robot, scene_robot
     from rich.table import Table
 
     if motion not in MOTIONS:
@@ -87,7 +88,8 @@ def run(
         check_scene_robot(scene, loaded)
     else:
         loaded = scene_robot(scene, robot)
-    hal = build_hal(loaded, mode=HalMode.SIM, scene=scene)
+    every_step = partial(build_scene, frame_rate_hz=math.inf)  # a frame of each camera per step
+    hal = build_hal(loaded, mode=HalMode.SIM, scene=scene, env_builder=every_step)
     hal.connect()
     try:
         if out_dir:
@@ -116,10 +118,9 @@ def _drive(
     out_dir: Path | None,
     advance: Callable[[], None],
 ) -> Recording:
-    """Step a connected HAL from its hold action, recording joints (manifest names) and
-    camera frames (PNG files in ``out_dir``)."""
-    from openral_hal.protocol import CameraHal
-    from openral_mujoco.png import write_png
+    """Step a connected HAL from its hold action, recording joints (manifest names) and the
+    sensor frames of each step's observation (files in ``out_dir``)."""
+    from openral_hal.protocol import ObservingHal
 
     hold = hal.hold_action()
     seen = Recording()
@@ -129,42 +130,37 @@ def _drive(
         state = hal.read_state()
         positions = zip(state.names, state.positions.tolist(), strict=True)
         seen.records.append({"step": step, "time": state.sim_time_s, "positions": dict(positions)})
-        images = hal.read_images() if isinstance(hal, CameraHal) else {}
-        seen.cameras = list(images)
-        if out_dir:
-            for camera, image in images.items():
-                write_png(out_dir / f"{camera}_{step:04d}.png", image)
-        seen.depth, seen.lidars = _record_range(hal, out_dir, step, state.sim_time_s)
+        if isinstance(hal, ObservingHal):
+            _record_frames(hal, seen, out_dir, step)
         advance()
     return seen
 
 
-def _record_range(
-    hal: RobotHal, out_dir: Path | None, step: int, time: float | None
-) -> tuple[list[str], list[str]]:
-    """Write each depth sensor's image and cloud and each lidar's scan of a native scene to
-    ``out_dir`` (see the module doc); the depth sensors' and the lidars' names."""
+def _record_frames(hal: ObservingHal, seen: Recording, out_dir: Path | None, step: int) -> None:
+    """Write the camera, depth and lidar frames of the HAL's last observation to ``out_dir``
+    (see the module doc) and note which sensors gave them."""
     import numpy as np
-    from openral_hal.sim_attached import native_scene
-    from openral_mujoco.png import encode_depth_png
+    from openral_hal.protocol import LidarSource
+    from openral_mujoco.png import encode_depth_png, write_png
 
-    scene = native_scene(hal)
-    if scene is None:
-        return [], []
-    sensors = scene.range_sensors
-    if out_dir:
-        for name in sensors.depth:
-            frame = sensors.depth_frame(name, scene.data)
-            depth_png = encode_depth_png(frame.depth_m)
-            (out_dir / f"{name}_{step:04d}.depth.png").write_bytes(depth_png)
-            np.save(out_dir / f"{name}_{step:04d}.points.npy", frame.points)
-        for name, scanner in sensors.lidars.items():
-            ranges = [
-                r if math.isfinite(r) else str(r) for r in sensors.scan(name, scene.data).tolist()
-            ]
-            line: dict[str, object] = {"step": step, "time": time}
-            line |= {"angle_min": scanner.angle_min, "angle_increment": scanner.angle_increment}
-            line["ranges"] = ranges
-            with (out_dir / f"{name}.scan.jsonl").open("w" if step == 0 else "a") as scans:
-                scans.write(json.dumps(line) + "\n")
-    return list(sensors.depth), list(sensors.lidars)
+    obs = hal.last_observation()
+    seen.cameras = list(dict.fromkeys([*seen.cameras, *obs.images]))
+    seen.depth = list(dict.fromkeys([*seen.depth, *obs.depth]))
+    seen.lidars = list(dict.fromkeys([*seen.lidars, *obs.scans]))
+    if not out_dir:
+        return
+    for camera, image in obs.images.items():
+        write_png(out_dir / f"{camera}_{step:04d}.png", image)
+    for name, frame in obs.depth.items():
+        (out_dir / f"{name}_{step:04d}.depth.png").write_bytes(encode_depth_png(frame.depth_m))
+        np.save(out_dir / f"{name}_{step:04d}.points.npy", frame.points)
+    lidars = hal.lidar_sensors() if isinstance(hal, LidarSource) else {}
+    for name, scan in obs.scans.items():
+        spec = lidars[name]
+        count = len(scan.ranges)
+        increment = (spec.angle_max_rad - spec.angle_min_rad) / (count - 1) if count > 1 else 0.0
+        line: dict[str, object] = {"step": step, "time": scan.sim_time_s}
+        line |= {"angle_min": spec.angle_min_rad, "angle_increment": increment}
+        line["ranges"] = [r if math.isfinite(r) else str(r) for r in scan.ranges.tolist()]
+        with (out_dir / f"{name}.scan.jsonl").open("w" if step == 0 else "a") as scans:
+            scans.write(json.dumps(line) + "\n")

@@ -85,7 +85,8 @@ def sweep(
 ) -> None:
     """Run POLICY on every (scene, seed) episode through the same HAL contract as deploy
     sim, in parallel; write ``episodes.jsonl`` and ``summary.json`` and print each scene's
-    success rate with its 95 % Wilson interval."""
+    success rate with its 95 % Wilson interval. Exits 1 when every episode failed with an
+    error."""
     from openral_eval.policies import make_policy, parse_params
     from openral_eval.ray_session import check_ray_address
 
@@ -267,3 +268,8 @@ def _report(lines: list[dict[str, object]], policy: str, out_dir: Path, clock: S
     out.print(
         f"wrote {out_dir / 'episodes.jsonl'} ({len(lines)} episodes) and {out_dir / 'summary.json'}"
     )
+    if lines and len(errors) == len(lines):
+        err.print(
+            f"every episode failed ({len(lines)} of {len(lines)}); see {out_dir}", markup=False
+        )
+        raise typer.Exit(1)

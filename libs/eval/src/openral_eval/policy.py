@@ -1,0 +1,110 @@
+"""The policy seam: what a policy sees each step, what it declares it needs, and how its
+``key=value`` parameters become its config.
+
+A policy is anything with :attr:`PolicyAdapter.required_slots` (the VLA camera slots it
+needs frames for), :attr:`PolicyAdapter.needs_privileged` (whether it reads the simulation
+itself, which only an evaluation episode can give) and ``act(observation) -> action``.
+The rskill runner and the evaluator read those declarations; neither probes a policy for
+anything else.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Iterable, Mapping
+from typing import Any, NotRequired, Protocol, TypedDict, runtime_checkable
+
+import numpy as np
+import numpy.typing as npt
+from openral_core.errors import OpenralError
+
+from openral_eval.privileged import Privileged
+
+
+class Observation(TypedDict):
+    """What a policy sees on each tick."""
+
+    images: dict[str, npt.NDArray[np.uint8]]
+    """VLA slot (``camera1`` …) → latest HxWx3 uint8 RGB frame."""
+    joint_positions: npt.NDArray[np.float64]
+    """Latest measured joint positions in manifest joint order (NaN where not reported)."""
+    action_spec: tuple[tuple[str, ...], npt.NDArray[np.float64]]
+    """HAL action slot names and the hold action that keeps the robot still."""
+    time_s: float
+    """Seconds since the runner's first tick with a complete observation."""
+    task_state: NotRequired[Mapping[str, npt.NDArray[np.float64]]]
+    """The scene's task state (object poses; robosuite's object observations), for a
+    policy with ``needs_privileged`` (episodes only)."""
+    privileged: NotRequired[Privileged]
+    """The MuJoCo simulation itself, for a policy with ``needs_privileged`` on a native
+    scene (episodes only)."""
+
+
+@runtime_checkable
+class PolicyAdapter(Protocol):
+    """What the rskill runner needs from a policy."""
+
+    @property
+    def required_slots(self) -> tuple[str, ...]:
+        """VLA camera slots that must have frames before ``act`` is called."""
+        ...
+
+    @property
+    def needs_privileged(self) -> bool:
+        """True when ``act`` reads ``task_state``/``privileged`` (the simulation itself):
+        such a policy runs only in evaluation episodes, never on a ROS graph."""
+        ...
+
+    def act(self, obs: Observation) -> npt.NDArray[np.float64]:
+        """One action: a value per action slot of ``obs["action_spec"]``."""
+        ...
+
+
+class PolicyConfigError(OpenralError):
+    """An unknown policy, parameter or parameter value."""
+
+
+def parse_params(items: Iterable[str]) -> dict[str, str]:
+    """``["k=v", …]`` → ``{"k": "v", …}``."""
+    params: dict[str, str] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise PolicyConfigError(f"policy parameter {item!r} is not key=value")
+        params[key.strip()] = value.strip()
+    return params
+
+
+def parse_config(config_type: type[Any], params: Mapping[str, str], policy: str) -> Any:
+    """An instance of the dataclass ``config_type`` with string ``params`` converted by field.
+
+    Each value is converted to the type of the field's default: float, int, str, or a
+    comma-separated tuple of strings.
+    """
+    fields = {f.name: f for f in dataclasses.fields(config_type)}
+    values: dict[str, object] = {}
+    for key, text in params.items():
+        field = fields.get(key)
+        if field is None:
+            raise PolicyConfigError(
+                f"unknown parameter {key!r} for policy {policy!r}; valid: {', '.join(fields)}"
+            )
+        default: object = field.default
+        try:
+            values[key] = _convert(text, default)
+        except ValueError as error:
+            raise PolicyConfigError(
+                f"{policy} parameter {key}={text!r}: expected {type(default).__name__}"
+            ) from error
+    return config_type(**values)
+
+
+def _convert(text: str, like: object) -> object:
+    """``text`` as the type of ``like``: float, int, str or a comma-separated str tuple."""
+    if isinstance(like, tuple):
+        return tuple(part.strip() for part in text.split(",") if part.strip())
+    if isinstance(like, float):
+        return float(text)
+    if isinstance(like, int):
+        return int(text)
+    return text
