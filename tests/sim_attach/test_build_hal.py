@@ -25,7 +25,6 @@ from openral_hal.mujoco_arm import MujocoArmHAL
 from openral_hal.protocol import EStopLatch, RobotHal, Tickable
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_mujoco.state import FloatArray, JointStateSample
-from openral_mujoco.state import JointStateSample
 from openral_sim.observation import Observation, StepResult
 from openral_sim.rollout import SimRollout
 
