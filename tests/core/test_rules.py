@@ -228,3 +228,65 @@ def test_a_legged_robot_is_mobile_without_a_mobile_base_and_cannot_ride_one(
             "a floating-base model cannot ride a mobile_base (the base carries its root body)"
         )
     }
+
+
+START_POSE = ("  joint_qpos_addr:", "  start_pose: {POSE}\n  joint_qpos_addr:")
+
+
+def _with_start_pose(pose: str) -> tuple[str, str]:
+    return START_POSE[0], START_POSE[1].replace("POSE", pose)
+
+
+def test_a_start_pose_of_arm_joints_inside_their_limits_passes(
+    write_manifest: ManifestWriter,
+) -> None:
+    """A continuous joint takes any value; an integer is a number like any other."""
+    robot = load_robot(write_manifest(_with_start_pose("shoulder: -1.5, wrist_roll: 12")))
+    assert robot.sim is not None
+    assert robot.sim.start_pose == {"shoulder": -1.5, "wrist_roll": 12.0}
+
+
+@pytest.mark.parametrize(
+    ("pose", "field", "message"),
+    [
+        (
+            "elbow: 0.1",
+            "sim.start_pose.elbow",
+            "'elbow' is not a joint of this robot; expected one of: shoulder, wrist_roll, jaw",
+        ),
+        (
+            "jaw: 0.01",
+            "sim.start_pose.jaw",
+            "'jaw' is a gripper; a start pose sets arm joints only",
+        ),
+        (
+            "shoulder: 1.6",
+            "sim.start_pose.shoulder",
+            "1.6 is outside the joint's position_limits [-1.5, 1.5]",
+        ),
+    ],
+    ids=["unknown-joint", "gripper-joint", "outside-the-limits"],
+)
+def test_a_start_pose_is_refused_at_its_joint(
+    write_manifest: ManifestWriter, pose: str, field: str, message: str
+) -> None:
+    path = write_manifest(_with_start_pose(pose))
+    assert _findings(path) == {field: message}
+    assert _only_issue(path).startswith(f"{path}:18:16: {field}: ")  # at the key
+
+
+def test_gravity_compensation_is_refused_on_a_floating_base(
+    write_manifest: ManifestWriter,
+) -> None:
+    switch = "gravity_compensation: true\n  joint_qpos_addr:"
+    robot = load_robot(write_manifest(("joint_qpos_addr:", switch)))
+    assert robot.sim is not None and robot.sim.gravity_compensation
+    legged = write_manifest(
+        ("base: fixed", "base: mobile"), ("joint_qpos_addr:", "floating_base: true\n  " + switch)
+    )
+    assert _findings(legged) == {
+        "sim.gravity_compensation": (
+            "a floating-base robot cannot compensate gravity: its whole body would float; "
+            "leave it out (or false)"
+        )
+    }

@@ -52,12 +52,6 @@ MIN_TABLE = 0.05
 MIN_HAND = 0.005
 """Least share of a wrist camera's pixels that show its body or the bodies below it (for a
 robot with a gripper: the fingers or jaws)."""
-STUCK_SIDEWAYS = {
-    "ur10e": "the model's only keyframe (home) holds the flange 1.66 m up, its tool axis "
-    "horizontal and off the table's side: no camera fixed to the tool sees the table before "
-    "the arm moves; needs a start pose over the table (a keyframe the model does not have)"
-}
-"""Default scenes whose wrist camera cannot see the table in the start pose, and why."""
 
 
 def _scene_id(path: Path) -> str:
@@ -84,7 +78,7 @@ def built() -> Iterator[Callable[[Path, Path | None], Built]]:
             scene = load_scene(scene_file)
             manifest_file = manifest or ROBOTS / str(scene.robot_id) / "robot.yaml"
             env = NativeScene(scene, open_robot(manifest_file))
-            images = env.reset(0)["images"]
+            images = env.reset(0).images
             env.close()
             scenes[key] = Built(env, images)
         return scenes[key]
@@ -213,16 +207,7 @@ def _below(model: mujoco.MjModel, body: int) -> npt.NDArray[np.bool_]:
     return below
 
 
-@pytest.mark.parametrize(
-    "scene_file",
-    [
-        pytest.param(path, marks=pytest.mark.xfail(reason=STUCK_SIDEWAYS[name], strict=True))
-        if (name := path.parent.parent.name) in STUCK_SIDEWAYS
-        else path
-        for path in DEFAULT_SCENES
-    ],
-    ids=_scene_id,
-)
+@pytest.mark.parametrize("scene_file", DEFAULT_SCENES, ids=_scene_id)
 def test_cameras_on_the_robot_see_the_table_and_wrist_cameras_the_hand(
     built: Callable[[Path, Path | None], Built], scene_file: Path
 ) -> None:

@@ -32,6 +32,11 @@ ActuatorIndexAdditionalProperty = TypeAliasType(
 )
 
 
+StartPoseAdditionalProperty = TypeAliasType(
+    "StartPoseAdditionalProperty", Annotated[StrictFloat, Field(ge=-1000.0, le=1000.0)]
+)
+
+
 class GripperReadMode(StrEnum):
     """
     How the gripper's reported position is computed from qpos. `sum_over_scale`: sum of qpos at qpos_addrs divided by qpos_scale (parallel fingers; 0 closed, 1 open). `affine_low_high`: (qpos - low) / (high - low) with (low, high) = ctrl_range, for a position-driven jaw whose closed position is not 0. `passthrough`: qpos at qpos_addrs[0] unchanged (metres or radians; not normalised).
@@ -248,9 +253,27 @@ class SimDescription(OpenralModel):
     """
     Index of an MJCF keyframe to reset to on connect, before the first mj_forward. Needed where the default qpos=0 leaves an actuator outside its control range.
     """
+    start_pose: Annotated[
+        dict[
+            Annotated[
+                str,
+                StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$", strict=True),
+            ],
+            StartPoseAdditionalProperty,
+        ]
+        | None,
+        Field(examples=[{"shoulder_lift_joint": -1.2, "elbow_joint": 1.8}]),
+    ] = None
+    """
+    Joint values the robot starts in, by manifest joint name, in manifest units [rad or m]: on connect and on every reset, after the keyframe (if any), each named joint is set to its value, so a model without a keyframe, or with one that is unusable for this robot, still starts where it should. Joints left out keep the keyframe's value (or the model's qpos0). Arm joints only (a gripper starts as its keyframe or its model leaves it); each value must lie inside the joint's position_limits.
+    """
     seed_ctrl_from_qpos: StrictBool = False
     """
     On connect, set each joint actuator's ctrl to the joint's current qpos, so position actuators hold the initial pose instead of driving every joint to 0 on the first step.
+    """
+    gravity_compensation: StrictBool = False
+    """
+    True: MuJoCo (>= 3.0) cancels gravity on the robot at every physics step, as a torque-controlled arm's controller does: the robot's model is compiled with gravcomp 1 on every body of its tree (the trees that carry its manifest joints; a body at or below a free joint is left alone) and actuatorgravcomp on its joints, so the compensating torque is added to the joints' actuator forces and the PD law of `control` only corrects what is left (without it a torque_pd arm sags by gravity torque / kp). Reported efforts stay the servo's own force. Not with floating_base (the whole robot would float). Default false: gravity pulls the arm.
     """
     settle_steps_default: Annotated[StrictInt, Field(ge=0, le=1000)] = 1
     """

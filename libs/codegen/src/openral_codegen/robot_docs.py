@@ -266,7 +266,9 @@ def _sim_section(source: RobotSource) -> str:
             "Reset keyframe",
             "none (qpos0)" if wiring.keyframe_index is None else str(wiring.keyframe_index),
         ),
+        ("Start pose (over the keyframe)", _start_pose(wiring.start_pose)),
         ("Seed ctrl from qpos", "yes" if wiring.seed_ctrl_from_qpos else "no"),
+        ("Gravity compensation", "yes" if wiring.gravity_compensation else "no"),
         ("Settle steps per action", str(wiring.settle_steps_default)),
         ("Control law", f"`{wiring.control_mode}`"),
     ]
@@ -275,6 +277,11 @@ def _sim_section(source: RobotSource) -> str:
     lines = ["## Simulation\n", "| Setting | Value |", "|---|---|"]
     lines += [f"| {name} | {value} |" for name, value in rows]
     return "\n".join(lines) + "\n"
+
+
+def _start_pose(pose: dict[str, float]) -> str:
+    """``joint = value`` per start-pose joint, or "none"."""
+    return ", ".join(f"`{joint}` = {_num(value)}" for joint, value in pose.items()) or "none"
 
 
 def _scenes_section(source: RobotSource) -> str:

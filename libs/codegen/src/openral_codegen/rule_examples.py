@@ -1,10 +1,11 @@
 """Break each cross-field rule on purpose and record the error the user would see.
 
 The reference pages list the rules JSON Schema cannot state. For each one, a single text
-edit of a real file (the franka_panda manifest or its default scene) breaks exactly that
-rule; the broken copy is run through the real validator at export time and the error it
-produces is what the page shows. A rule whose edit no longer fails, or whose edit no longer
-applies to the file, stops the export with a message saying which example to update.
+edit of a real file (a robot's manifest, mostly franka_panda's, or a default scene) breaks
+exactly that rule; the broken copy is run through the real validator at export time and the
+error it produces is what the page shows. A rule whose edit no longer fails, or whose edit
+no longer applies to the file, stops the export with a message saying which example to
+update.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ from openral_codegen.models import CodegenError
 
 ROBOT_FILE = "robots/franka_panda/robot.yaml"
 MOBILE_FILE = "robots/panda_mobile/robot.yaml"
+UR10E_FILE = "robots/ur10e/robot.yaml"
+H1_FILE = "robots/h1/robot.yaml"
 SCENE_FILE = "robots/franka_panda/scenes/tabletop.yaml"
 
 
@@ -121,6 +124,20 @@ RULE_BREAKS = (
         ROBOT_FILE,
         "frame_id: ft_sensor_link",
         "frame_id: wrist_optical_frame",
+    ),
+    RuleBreak(
+        SchemaName.ROBOT,
+        16,
+        UR10E_FILE,
+        "    elbow_joint: 1.5708\n",
+        "    elbow_joint: 3.5\n",
+    ),
+    RuleBreak(
+        SchemaName.ROBOT,
+        17,
+        H1_FILE,
+        "  floating_base: true\n",
+        "  floating_base: true\n  gravity_compensation: true\n",
     ),
     RuleBreak(
         SchemaName.SCENE,

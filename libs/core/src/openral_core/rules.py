@@ -201,6 +201,13 @@ def _sim_findings(robot: RobotDescription) -> Iterator[Finding]:
         low, high = gripper.ctrl_range
         if not low < high:
             yield (*path, "ctrl_range"), f"lower bound {low} must be below upper bound {high}"
+    yield from _start_pose_findings(robot, gripper_joints)
+    if sim.gravity_compensation and sim.floating_base:  # rule 17
+        yield (
+            ("sim", "gravity_compensation"),
+            "a floating-base robot cannot compensate gravity: its whole body would float; "
+            "leave it out (or false)",
+        )
     control = sim.control
     if isinstance(control, TorquePdControl):
         driven = [j for j in joints if j not in gripper_joints]
@@ -212,6 +219,23 @@ def _sim_findings(robot: RobotDescription) -> Iterator[Finding]:
                 missing = [j for j in driven if j not in gains]
                 if missing:
                     yield path, f"no gain for joint(s) {', '.join(missing)}; give every joint one"
+
+
+def _start_pose_findings(robot: RobotDescription, gripper_joints: set[str]) -> Iterator[Finding]:
+    """Rule 16: sim.start_pose names arm joints of this robot, each inside its limits."""
+    assert robot.sim is not None
+    joints = {j.name: j for j in robot.joints}
+    for name, value in (robot.sim.start_pose or {}).items():
+        path: PathKey = ("sim", "start_pose", name)
+        joint = joints.get(name)
+        if joint is None:
+            yield path, _not_a_joint(name, list(joints))
+        elif name in gripper_joints:
+            yield path, f"{name!r} is a gripper; a start pose sets arm joints only"
+        elif isinstance(joint, LimitedJoint):
+            low, high = joint.position_limits
+            if not low <= value <= high:
+                yield path, f"{value} is outside the joint's position_limits [{low}, {high}]"
 
 
 def _keys_known(

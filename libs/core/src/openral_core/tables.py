@@ -79,6 +79,10 @@ class HalWiring:
     kd: dict[str, float] = field(default_factory=dict)
     velocity_limit: dict[str, float] = field(default_factory=dict)
     """Arm joint → fastest its target may move (rad/s or m/s); grippers are not limited."""
+    start_pose: dict[str, float] = field(default_factory=dict)
+    """Arm joint → its value after every reset (rad or m), over the keyframe's."""
+    gravity_compensation: bool = False
+    """MuJoCo cancels gravity on the robot's bodies, through its joints' actuators."""
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> HalWiring:
@@ -238,6 +242,8 @@ def hal_wiring(robot: RobotDescription) -> HalWiring | None:
         velocity_limit={
             j.name: j.velocity_limit for j in robot.joints if j.name not in gripper_joints
         },
+        start_pose=dict(sim.start_pose or {}),
+        gravity_compensation=sim.gravity_compensation,
     )
 
 

@@ -142,7 +142,8 @@ class MujocoArmHAL(EStopLatch):
         return self._model is not None
 
     def connect(self) -> None:
-        """Load and check the model, reset (keyframe), hold the start pose and settle.
+        """Load and check the model (its gravity compensated if the manifest says so), reset
+        (keyframe, then ``sim.start_pose``), hold that pose and settle.
 
         Raises:
             ManifestError: The model does not load, or contradicts the manifest (located).
@@ -225,8 +226,8 @@ class MujocoArmHAL(EStopLatch):
         return self.step(self._control_steps())
 
     def reset(self) -> str:
-        """Back to the keyframe, held and settled as :meth:`connect` leaves it; the E-stop
-        latch is kept."""
+        """Back to the keyframe and start pose, held and settled as :meth:`connect` leaves
+        it; the E-stop latch is kept."""
         model, data, driver = self._handles()
         mujoco.mj_resetData(model, data)
         driver.reset_to_keyframe(model, data)

@@ -40,9 +40,11 @@ from openral_mujoco.action import validated_action
 from openral_mujoco.command_limits import CommandLimits
 from openral_mujoco.control_law import compile_pd_servos, seed_position_servos
 from openral_mujoco.errors import SimulationDiverged
+from openral_mujoco.gravity import require_gravity_compensation
 from openral_mujoco.gripper import command_map, gripper_command, reading_map
 from openral_mujoco.mjcf_model import ctrl_limits, is_position_servo
 from openral_mujoco.robot_addresses import LocatedGripper, RobotAddresses
+from openral_mujoco.start_pose import start_pose_addresses
 from openral_mujoco.state import FloatArray
 
 SLEW_CHUNK_STEPS = 5
@@ -77,6 +79,9 @@ class JointDriver:
         arm_names = [self.names[i] for i in self._arm]
         self._arm_qpos = addresses.qpos[self._arm]
         self._arm_act = addresses.actuator[self._arm]
+        if wiring.gravity_compensation:
+            require_gravity_compensation(model, addresses.qvel[self._arm])
+        self._start_qpos, self._start_values = start_pose_addresses(wiring, addresses.qpos)
         if wiring.control_mode == "torque_pd":  # before the ctrl limits are read below
             kp = np.array([wiring.kp.get(n, 0.0) for n in arm_names])
             kd = np.array([wiring.kd.get(n, 0.0) for n in arm_names])
@@ -112,9 +117,12 @@ class JointDriver:
     # -- start and hold --------------------------------------------------------------------
 
     def reset_to_keyframe(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
-        """Load the manifest's keyframe (if any) into ``data``."""
+        """Load the manifest's keyframe (if any) into ``data``, then its start pose over it
+        (``sim.start_pose``, see :mod:`openral_mujoco.start_pose`)."""
         if self.wiring.keyframe_index is not None:
             mujoco.mj_resetDataKeyframe(model, data, self.wiring.keyframe_index)
+        if self._start_qpos.size:
+            data.qpos[self._start_qpos] = self._start_values
 
     def start(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
         """Seed the servos (if the manifest says so), forward, and hold the pose now."""

@@ -103,15 +103,24 @@ def mjcf_fingerprint(path: Path) -> str | None:
 
 
 def cached_mjcf(
-    path: Path, kind: str, refused: Callable[[ValueError], Exception]
+    path: Path,
+    kind: str,
+    refused: Callable[[ValueError], Exception],
+    edit: Callable[[mujoco.MjSpec], object] | None = None,
 ) -> tuple[mujoco.MjModel, str | None]:
     """The model of the MJCF file at ``path``, compiled or read from the cache under
     ``kind`` (what the file is: ``robot``, ``base``), and its :func:`mjcf_fingerprint`
-    (None: not cached). MuJoCo's refusal (a ValueError) is raised as ``refused(error)``."""
+    (None: not cached). MuJoCo's refusal (a ValueError) is raised as ``refused(error)``.
+    ``edit`` changes the file's spec before it is compiled (``kind`` must then name the
+    edit, so an entry compiled without it is never read)."""
 
     def build() -> mujoco.MjModel:
         try:
-            return mujoco.MjModel.from_xml_path(str(path))
+            if edit is None:
+                return mujoco.MjModel.from_xml_path(str(path))
+            spec = mujoco.MjSpec.from_file(str(path))
+            edit(spec)
+            return spec.compile()
         except ValueError as error:  # MuJoCo's parser and compiler report this way
             raise refused(error) from None
 
