@@ -11,6 +11,7 @@ from openral_core.models import LimitedJoint, RgbSensor, RobotDescription, Torqu
 from openral_core.registry import load_robot_by_id, manifest_path, robot_ids
 from openral_hal.errors import HalError
 from openral_hal.scaffold import SCHEMA_LINE, scaffold_manifest
+from openral_hal.scaffold_gains import BANDWIDTH_RAD_S, inertia_diagonal
 from openral_mujoco.mjcf_uri import MjcfUriError, resolve_mjcf_uri
 from openral_mujoco.model_check import check_robot
 
@@ -102,14 +103,23 @@ def test_franka_draft_has_a_tendon_gripper_over_both_fingers(tmp_path: Path) -> 
     assert "finger_joint2" in comments
 
 
-def test_h1_draft_uses_placeholder_torque_pd(tmp_path: Path) -> None:
-    draft, _, text = _draft_of("h1", tmp_path)
+def test_h1_draft_has_torque_pd_gains_per_joint_and_no_gravity_compensation(
+    tmp_path: Path,
+) -> None:
+    draft, model, text = _draft_of("h1", tmp_path)
     assert draft.sim is not None
     control = draft.sim.control
     assert isinstance(control, TorquePdControl)
     assert control.mode == "torque_pd"
-    assert (control.kp, control.kd) == (100.0, 2.0)
-    assert "# REVIEW: gains are placeholders" in text
+    assert isinstance(control.kp, dict) and isinstance(control.kd, dict)
+    inertia = inertia_diagonal(model)
+    for joint in draft.joints:  # no friction loss: the bandwidth law, joint by joint
+        jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint.name)
+        m_ii = inertia[model.jnt_dofadr[jid]]
+        assert control.kp[joint.name] == pytest.approx(m_ii * BANDWIDTH_RAD_S**2, rel=1e-3)
+        assert control.kd[joint.name] == pytest.approx(2 * m_ii * BANDWIDTH_RAD_S, rel=1e-3)
+    assert "    kp:  # REVIEW: from the model's inertia" in text
+    assert not draft.sim.gravity_compensation  # a floating base would float
     assert draft.sim.keyframe_index is None  # h1.xml has no keyframe
     assert not draft.sim.seed_ctrl_from_qpos
     # Motor actuators: effort is ctrlrange upper x gear (left_knee: 300 N·m).

@@ -1,10 +1,11 @@
 """Draft a ``robot.yaml`` from an MJCF model (`openral robot scaffold`).
 
 The draft is written by hand, line by line, so it can carry ``# REVIEW:`` comments on
-every value that is a guess or a placeholder (velocity limits, guessed grippers, PD
-gains). It is built so that it loads (:func:`openral_core.loader.load_robot`) and passes
-:func:`openral_mujoco.model_check.check_robot` against the model it came from; a human still
-has to read it before it describes a real robot.
+every value that is a guess or a placeholder (velocity limits, guessed grippers) or a first
+estimate (PD gains from the model's inertia, :mod:`openral_hal.scaffold_gains`). It is
+built so that it loads (:func:`openral_core.loader.load_robot`) and passes
+:func:`openral_mujoco.model_check.check_robot` against the model it came from; a human
+still has to read it before it describes a real robot.
 
 How the model becomes a manifest:
 
@@ -13,11 +14,12 @@ How the model becomes a manifest:
   differs from the canonical one.
 - qpos/qvel/actuator overrides are written only where the model differs from the
   default wiring (1:1 in manifest order, +7/+6 with a floating base).
+- A model whose actuators are all motors gets a ``torque_pd`` law with per-joint gains
+  from its inertia and, on a fixed or wheeled base, ``gravity_compensation: true``.
 """
 
 from __future__ import annotations
 
-import json
 import math
 import re
 import textwrap
@@ -33,6 +35,7 @@ from openral_mujoco.mjcf_model import (
 from openral_mujoco.mjcf_uri import resolve_mjcf_uri
 
 from openral_hal.errors import HalError
+from openral_hal.scaffold_gains import control_lines
 from openral_hal.scaffold_joints import (
     MJCF_NAME,
     Driven,
@@ -40,6 +43,7 @@ from openral_hal.scaffold_joints import (
     joint_name,
     sensor_name,
 )
+from openral_hal.scaffold_text import DIGITS, REVIEW, num, scalar
 
 SCHEMA_LINE = "# yaml-language-server: $schema=../../schema/robot.schema.json"
 """First line of every manifest under ``robots/<name>/``."""
@@ -54,18 +58,11 @@ LIMIT_BOUND = 1000.0
 EFFORT_BOUND = 100000.0
 CTRL_BOUND = 10000.0
 QPOS_SCALE_BOUND = 1000.0
-DIGITS = 6
 
 PLACEHOLDER_VELOCITY = 1.0
 PLACEHOLDER_EFFORT = 1.0
-PLACEHOLDER_KP = 100.0
-PLACEHOLDER_KD = 2.0
 CAMERA_SIZE = 128
 CAMERA_RATE_HZ = 10.0
-
-_REVIEW = "  # REVIEW:"
-_RESERVED = {"true", "false", "null", "yes", "no", "on", "off", "y", "n", "~"}
-_PLAIN = re.compile(r"[A-Za-z][A-Za-z0-9_./:-]*(?: [A-Za-z0-9_./-]+)*")
 
 
 def scaffold_manifest(
@@ -142,8 +139,8 @@ def _manifest_lines(
     lines += _comment_block("REVIEW: actuators left out of joints:", skipped)
     lines += [
         'schema_version: "0.1"',
-        f"name: {_scalar(name)}",
-        f"display_name: {_scalar(name.replace('_', ' ').title())}",
+        f"name: {scalar(name)}",
+        f"display_name: {scalar(name.replace('_', ' ').title())}",
         f"base: {'mobile' if floating else 'fixed'}",
         "joints:",
     ]
@@ -162,9 +159,9 @@ def _comment_block(title: str, items: Sequence[str]) -> list[str]:
 
 
 def _joint_lines(model: mujoco.MjModel, joint: Driven) -> list[str]:
-    lines = [f"  - name: {_scalar(joint.name)}"]
+    lines = [f"  - name: {scalar(joint.name)}"]
     if joint.name != joint.mjcf_name:
-        lines.append(f"    sim_joint_name: {_scalar(joint.mjcf_name)}")
+        lines.append(f"    sim_joint_name: {scalar(joint.mjcf_name)}")
     jid = joint.jid
     limited = bool(model.jnt_limited[jid])
     low, high = (float(v) for v in model.jnt_range[jid])
@@ -173,7 +170,7 @@ def _joint_lines(model: mujoco.MjModel, joint: Driven) -> list[str]:
         if limits is None:
             lines.append("    type: continuous")
             if limited:
-                lines[-1] += f"{_REVIEW} its MJCF range [{low:g}, {high:g}] is empty"
+                lines[-1] += f"{REVIEW} its MJCF range [{low:g}, {high:g}] is empty"
         else:
             lines.append("    type: revolute")
             lines.append(_limits_line(limits, low, high))
@@ -182,21 +179,21 @@ def _joint_lines(model: mujoco.MjModel, joint: Driven) -> list[str]:
         limits = _limits(low, high) if limited else None
         if limits is None:
             lines.append(
-                f"    position_limits: [-1.0, 1.0]{_REVIEW} the MJCF slide joint has no range"
+                f"    position_limits: [-1.0, 1.0]{REVIEW} the MJCF slide joint has no range"
             )
         else:
             lines.append(_limits_line(limits, low, high))
-    lines.append(f"    velocity_limit: {_num(PLACEHOLDER_VELOCITY)}{_REVIEW} not in the MJCF")
+    lines.append(f"    velocity_limit: {num(PLACEHOLDER_VELOCITY)}{REVIEW} not in the MJCF")
     effort, source = _effort(model, joint)
     if effort is None:
-        lines.append(f"    effort_limit: {_num(PLACEHOLDER_EFFORT)}{_REVIEW} {source}")
+        lines.append(f"    effort_limit: {num(PLACEHOLDER_EFFORT)}{REVIEW} {source}")
     elif effort > EFFORT_BOUND:
         lines.append(
-            f"    effort_limit: {_num(EFFORT_BOUND)}{_REVIEW} clipped; the MJCF {source} "
+            f"    effort_limit: {num(EFFORT_BOUND)}{REVIEW} clipped; the MJCF {source} "
             f"gives {effort:g}"
         )
     else:
-        lines.append(f"    effort_limit: {_num(effort)}")
+        lines.append(f"    effort_limit: {num(effort)}")
     return lines
 
 
@@ -212,10 +209,10 @@ def _limits_line(limits: tuple[float, float], low: float, high: float) -> str:
     lower, upper = max(limits[0], -LIMIT_BOUND), min(limits[1], LIMIT_BOUND)
     mjcf_range = f"the MJCF range is [{low:g}, {high:g}]"
     if not lower < upper:
-        return f"    position_limits: [-1.0, 1.0]{_REVIEW} {mjcf_range}, outside +-1000"
-    line = f"    position_limits: [{_num(lower, rounded=False)}, {_num(upper, rounded=False)}]"
+        return f"    position_limits: [-1.0, 1.0]{REVIEW} {mjcf_range}, outside +-1000"
+    line = f"    position_limits: [{num(lower, rounded=False)}, {num(upper, rounded=False)}]"
     if (lower, upper) != limits:
-        line += f"{_REVIEW} clipped to +-1000; {mjcf_range}"
+        line += f"{REVIEW} clipped to +-1000; {mjcf_range}"
     return line
 
 
@@ -251,12 +248,12 @@ def _sensor_lines(model: mujoco.MjModel) -> list[str]:
             continue
         taken.add(sensor)
         lines += [
-            f"  - name: {_scalar(sensor)}",
+            f"  - name: {scalar(sensor)}",
             "    kind: rgb",
-            f"    camera: {_scalar(camera)}",
+            f"    camera: {scalar(camera)}",
             f"    width: {CAMERA_SIZE}",
             f"    height: {CAMERA_SIZE}",
-            f"    rate_hz: {_num(CAMERA_RATE_HZ)}",
+            f"    rate_hz: {num(CAMERA_RATE_HZ)}",
             f"    frame_id: {sensor}_optical_frame",
         ]
     return ["sensors:", *lines] if lines else ["sensors: []"]
@@ -265,7 +262,7 @@ def _sensor_lines(model: mujoco.MjModel) -> list[str]:
 def _sim_lines(
     model: mujoco.MjModel, mjcf_uri: str, driven: Sequence[Driven], floating: bool
 ) -> list[str]:
-    lines = ["sim:", f"  mjcf_uri: {_scalar(mjcf_uri)}"]
+    lines = ["sim:", f"  mjcf_uri: {scalar(mjcf_uri)}"]
     if floating:
         lines.append("  floating_base: true")
     qpos_offset = FREE_JOINT_NQPOS if floating else 0
@@ -283,7 +280,7 @@ def _sim_lines(
         differing = [(joint, real) for joint, real, default in rows if real != default]
         if differing:
             lines.append(f"  {field}:")
-            lines += [f"    {_scalar(joint)}: {real}" for joint, real in differing]
+            lines += [f"    {scalar(joint)}: {real}" for joint, real in differing]
     if model.nkey > 0:
         lines.append("  keyframe_index: 0")
     actuators = [d.actuator for d in driven]
@@ -296,10 +293,10 @@ def _sim_lines(
     if entries:
         lines += ["  grippers:", *entries]
     if all(is_motor(model, a) for a in actuators):
-        lines.append(
-            f"  control: {{mode: torque_pd, kp: {_num(PLACEHOLDER_KP)}, "
-            f"kd: {_num(PLACEHOLDER_KD)}}}{_REVIEW} gains are placeholders"
-        )
+        if not floating:
+            lines.append("  gravity_compensation: true  # motors: the servo does not hold gravity")
+        efforts = [_effort(model, d)[0] for d in driven]
+        lines += control_lines(model, [(d.jid, d.name) for d in driven], efforts)
     return lines
 
 
@@ -333,12 +330,12 @@ def _gripper_lines(model: mujoco.MjModel, joint: Driven) -> list[str]:
             f"  # REVIEW: {joint.name} looks like a gripper, but its control range is empty; "
             "no gripper entry was drafted"
         ]
-    shown_low, shown_high = (_num(v, rounded=False) for v in ctrl_range)
+    shown_low, shown_high = (num(v, rounded=False) for v in ctrl_range)
     return [
-        f"    - joint: {_scalar(joint.name)}{_REVIEW} guessed gripper",
+        f"    - joint: {scalar(joint.name)}{REVIEW} guessed gripper",
         f"      ctrl_range: [{shown_low}, {shown_high}]",
         f"      qpos_addrs: [{', '.join(str(a) for a in addrs)}]",
-        f"      qpos_scale: {_num(scale)}",
+        f"      qpos_scale: {num(scale)}",
         f"      read_mode: {modes[0]}",
         f"      write_mode: {modes[1]}",
     ]
@@ -353,26 +350,3 @@ def _inward(low: float, high: float) -> tuple[float, float]:
     if rounded_high > high:
         rounded_high = math.floor(high * step) / step
     return rounded_low, rounded_high
-
-
-def _num(value: float, *, rounded: bool = True) -> str:
-    """A float YAML reads back as a float: ``round(x, 6)`` in ``repr`` form, with a dot."""
-    number = round(float(value), DIGITS) if rounded else float(value)
-    if number == 0:
-        number = 0.0  # no "-0.0"
-    text = repr(number)
-    mantissa, e, exponent = text.partition("e")
-    if "." not in mantissa:
-        mantissa += ".0"
-    return f"{mantissa}{e}{exponent}"
-
-
-def _scalar(text: str) -> str:
-    """``text`` as a YAML plain scalar where that reads back as the same string, else quoted."""
-    plain = (
-        _PLAIN.fullmatch(text) is not None
-        and ": " not in text
-        and not text.endswith(":")
-        and text.lower() not in _RESERVED
-    )
-    return text if plain else json.dumps(text)
