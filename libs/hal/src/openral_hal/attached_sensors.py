@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from openral_core.models import RgbSensor
 from openral_sim.depth_cloud import DepthFrame
 from openral_sim.observation import ImageArray, LidarScan
-from openral_sim.rollout import SceneRollout, SensorSuite
+from openral_sim.rollout import SensorSuite
 from openral_sim.sensor_sources import DepthSpec, FrameCapture, LidarSpec, StateSpec
 from openral_sim.state_sensors import Reading
 
@@ -25,16 +25,6 @@ class AttachedSensors:
     """Sensor sources delegated to ``_suite`` (None: the scene serves none)."""
 
     _suite: SensorSuite | None = None
-    _scene: SceneRollout | None = None
-
-    def render_in_observations(self, enabled: bool) -> bool:
-        """Let the scene's steps render sensor frames into observations or not (a bridge
-        that renders them itself turns this off); returns the previous setting."""
-        if self._scene is None:
-            return False
-        before = self._scene.render_observations
-        self._scene.render_observations = enabled
-        return before
 
     def camera_sensors(self) -> Mapping[str, RgbSensor]:
         """The RGB sensors the scene renders off its step (empty: none)."""

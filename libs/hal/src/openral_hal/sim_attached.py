@@ -199,6 +199,18 @@ class SimAttachedHAL(AttachedSensors, EStopLatch):
         self._require_obs()
         return {name: self._frames[name] for name in self._rgb if name in self._frames}
 
+    def render_in_observations(self, enabled: bool) -> bool:
+        """Let the scene's steps render sensor frames into observations or not (a bridge
+        that renders them itself turns this off, and the frames kept so far are dropped:
+        they would only grow stale); returns the previous setting."""
+        if self._scene is None:
+            return False
+        before = self._scene.render_observations
+        self._scene.render_observations = enabled
+        if not enabled:
+            self._frames.clear()
+        return before
+
     def last_observation(self) -> Observation:
         """The scene's latest observation (its frames: those due at that step).
 

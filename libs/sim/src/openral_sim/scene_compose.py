@@ -27,6 +27,7 @@ from openral_core.models import (
     RobotDescription,
     SceneObject,
 )
+from openral_mujoco.gravity import apply_gravity_compensation
 from openral_mujoco.model_cache import cached_model, code_digest
 from openral_mujoco.model_check import require_agreement, unloadable_model
 from openral_mujoco.robot_bodies import root_body
@@ -58,7 +59,7 @@ def robot_spec(robot: RobotDescription, path: Path) -> mujoco.MjSpec:
         ManifestError: At ``sim.mjcf_uri`` when MuJoCo cannot read the file.
     """
     try:
-        return mujoco.MjSpec.from_file(str(path))
+        return apply_gravity_compensation(mujoco.MjSpec.from_file(str(path)), robot)
     except ValueError as error:
         raise unloadable_model(robot, path, error) from None
 

@@ -14,6 +14,7 @@ import numpy as np
 import numpy.typing as npt
 from openral_core.models import BasePose, RobotDescription
 from openral_mujoco.robot_bodies import root_body
+from openral_mujoco.start_pose import set_start_pose
 
 CORNERS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
 """The eight corners of a box of half-size 1."""
@@ -47,8 +48,8 @@ def start_pose(
     model: mujoco.MjModel, robot: RobotDescription, pose: BasePose | None
 ) -> mujoco.MjData:
     """A fresh ``MjData`` of a composed scene in the robot's start pose, kinematics done:
-    the manifest's keyframe (if any), a floating base's moved to the scene's base pose, as
-    a reset puts it before the settle steps."""
+    the manifest's keyframe (if any), a floating base's moved to the scene's base pose,
+    then ``sim.start_pose`` over it, as a reset puts it before the settle steps."""
     data = mujoco.MjData(model)
     key = robot.sim.keyframe_index if robot.sim is not None else None
     if key is not None:
@@ -56,6 +57,7 @@ def start_pose(
         if robot.sim is not None and robot.sim.floating_base:
             root = root_body(model, robot)
             place_floating_base(data, int(model.jnt_qposadr[model.body_jntadr[root]]), pose)
+    set_start_pose(model, data, robot)
     mujoco.mj_kinematics(model, data)
     return data
 

@@ -196,7 +196,8 @@ class SceneSensors:
         due = self.schedule.due(float(self.data.time))
         if wanted is not None:
             due &= wanted
-        images = self.render(self.data, [n for n in self.cameras if n in due])
+        cameras = [n for n in self.cameras if n in due]
+        images = self.render(self.data, cameras) if cameras else {}
         depth = {n: self.depth_frame(n) for n in self.ranges.depth if n in due}
         scans = {n: self.scan(n) for n in self.ranges.lidars if n in due}
         readings = {n: self.read_sensor(n) for n in self.state.sensors if n in due}
