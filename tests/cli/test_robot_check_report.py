@@ -147,3 +147,22 @@ def test_an_unknown_scene_camera_is_located_with_the_closest_names(tmp_path: Pat
         "'franka_panda' (did you mean wrist?); its camera sensors are: agentview, wrist, "
         "front_depth"
     )
+
+
+def test_the_deprecated_robosuite_scheme_still_resolves_and_is_reported(tmp_path: Path) -> None:
+    folder = tmp_path / "panda_mobile"
+    folder.mkdir()
+    source = (ROBOTS / "panda_mobile" / "robot.yaml").read_text()
+    modern = "pkg:robosuite/robosuite/models/assets/bases/omron_mobile_base.xml"
+    assert modern in source  # the repository's own robot uses the one scheme
+    manifest = folder / "robot.yaml"
+    manifest.write_text(source.replace(modern, "robosuite:bases/omron_mobile_base.xml"))
+    result = runner.invoke(app, ["robot", "check", str(manifest)], env=WIDE)
+    assert result.exit_code == 0, result.output  # an alias: the same file, every check passes
+    where = position(manifest, "robosuite:bases", "mjcf_uri")
+    assert (
+        f"! {manifest.parent}/{where}: mobile_base.mjcf_uri: 'robosuite:bases/omron_mobile_base"
+        f".xml' is deprecated; write '{modern}' (the same file)"
+    ) in result.output
+    plain = runner.invoke(app, ["robot", "check", str(ROBOTS / "panda_mobile" / "robot.yaml")])
+    assert plain.exit_code == 0 and "deprecated" not in plain.output

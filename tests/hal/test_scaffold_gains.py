@@ -21,7 +21,7 @@ from openral_hal.scaffold_gains import (
     joint_gains,
 )
 
-XARM7 = "robosuite:robots/xarm7/robot.xml"
+XARM7 = "pkg:robosuite/robosuite/models/assets/robots/xarm7/robot.xml"
 """robosuite's xArm7: seven motors (±80 N·m), friction loss 1 N·m per joint, no keyframe."""
 HOLD_S = 10.0
 HOLD_TOLERANCE_RAD = 0.005

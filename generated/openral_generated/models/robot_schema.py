@@ -673,12 +673,14 @@ class MobileBase(OpenralModel):
     mjcf_uri: Annotated[
         StrictStr,
         Field(
-            examples=["robosuite:bases/omron_mobile_base.xml"],
+            examples=[
+                "pkg:robosuite/robosuite/models/assets/bases/omron_mobile_base.xml"
+            ],
             pattern="^(file|pkg|robosuite):[A-Za-z0-9_./-]+$",
         ),
     ]
     """
-    Where the base's MJCF model is found, resolved offline like `sim.mjcf_uri` (the same schemes `file:`, `pkg:` and `robosuite:`, and the same confinement: the model and every file it loads stay in the robot's folder or in the installed distribution).
+    Where the base's MJCF model is found, resolved offline like `sim.mjcf_uri` (the same schemes `file:` and `pkg:` (`robosuite:` deprecated), and the same confinement: the model and every file it loads stay in the robot's folder or in the installed distribution).
     """
     mount_body: Annotated[
         StrictStr,

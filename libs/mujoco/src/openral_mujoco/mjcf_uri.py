@@ -8,7 +8,10 @@ Schemes:
   the end of each recorded path, so data files installed outside site-packages resolve too
   (``pkg:openarm-mujoco/openarm_mujoco/v2/openarm_bimanual.xml`` finds
   ``share/openarm_mujoco/v2/openarm_bimanual.xml``).
-- ``robosuite:<path>``: ``robosuite/models/assets/<path>`` of the installed robosuite.
+- ``robosuite:<path>`` (deprecated): ``robosuite/models/assets/<path>`` of the installed
+  robosuite, the same file as ``pkg:robosuite/robosuite/models/assets/<path>``. It still
+  resolves; ``openral robot check`` reports each use with its replacement
+  (:func:`deprecated_uris`).
 
 ``<distribution>`` must be a distribution name (PEP 508: letters, digits, ``.``, ``_``, ``-``,
 starting and ending with a letter or digit) and a ``pkg:``/``robosuite:`` ``<path>`` must
@@ -154,6 +157,23 @@ def locate_mjcf_uri(uri: str, manifest_dir: Path | None = None) -> tuple[Path, C
         )
         raise MjcfUriError(uri, message, manifest_dir)
     return distribution_file(distribution, inner, uri, manifest_dir)
+
+
+DEPRECATED_SCHEMES = {"robosuite": "pkg:robosuite/robosuite/models/assets/"}
+"""A deprecated scheme → the ``pkg:`` prefix that replaces it."""
+
+
+def deprecated_uris(robot: RobotDescription) -> list[tuple[tuple[str, ...], str, str]]:
+    """``(field, uri, replacement)`` of each model URI of ``robot`` in a deprecated scheme."""
+    found: list[tuple[tuple[str, ...], str, str]] = []
+    uris = [(("sim", "mjcf_uri"), robot.sim.mjcf_uri if robot.sim else None)]
+    base = robot.mobile_base
+    uris.append((("mobile_base", "mjcf_uri"), base.mjcf_uri if base else None))
+    for field, uri in uris:
+        scheme, _, rest = (uri or "").partition(":")
+        if scheme in DEPRECATED_SCHEMES:
+            found.append((field, str(uri), DEPRECATED_SCHEMES[scheme] + rest))
+    return found
 
 
 def _package_parts(rest: str, uri: str, manifest_dir: Path | None) -> tuple[str, str]:

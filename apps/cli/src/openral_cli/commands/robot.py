@@ -245,6 +245,16 @@ def check(
         raise typer.Exit(1)
 
 
+def _warn_deprecated(robot: RobotDescription) -> None:
+    """One located warning per model URI in a deprecated scheme, with its replacement."""
+    from openral_core.located import issue_at
+    from openral_mujoco.mjcf_uri import deprecated_uris
+
+    for field, uri, replacement in deprecated_uris(robot):
+        message = f"{uri!r} is deprecated; write {replacement!r} (the same file)"
+        err.print(line(("!", "yellow"), f" {issue_at(robot, field, message).format()}"))
+
+
 def _check_one(file: Path, verbose: bool, summary: Table) -> str:
     """Check one manifest: print its table of rows (failed ones, all with ``verbose``) and
     add its summary row; ``"ok"``, ``"mismatch"`` or ``"unchecked"`` (it did not load)."""
@@ -262,6 +272,7 @@ def _check_one(file: Path, verbose: bool, summary: Table) -> str:
             err.print(line(("✗", "red"), f" {text}"))
         summary.add_row(file.parent.name, "-", "-", styled("could not be checked", "red"))
         return "unchecked"
+    _warn_deprecated(robot)
     rows = check_robot(robot, model)
     failures = [row for row in rows if not row.ok]
     shown = rows if verbose else failures
