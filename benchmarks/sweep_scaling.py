@@ -13,8 +13,9 @@ sweep's own (``summary.json``):
 
 Workloads:
 
-- ``cameras``: ``wave`` observing its two camera slots, 200 steps, seeds 0:40 (two frames
-  rendered per step, as a VLA observes: ~6 s per episode, ~2 minutes on two cores);
+- ``cameras``: ``wave`` observing its two camera slots, 200 steps, seeds 0:40 (each 10 Hz
+  camera rendered at 10 Hz on the 20 Hz control loop: 202 frames an episode, about half the 400
+  rendered before frames followed the sensor schedule; the table's title counts them);
 - ``lift``: ``scripted_lift`` over seeds 0:20 (the issue's sweep; ~60 steps,
   about a second on two cores; ~60-90 ms an episode).
 
@@ -128,7 +129,8 @@ def measure(workload: str, seeds: str, ray_s: float, console: Console) -> dict[s
         for run, runs in every.items()
     }
     episodes = len(files["workers 1"])
-    console.print(_table(workload, seeds, episodes, times, ray_s))
+    frames = statistics.mean(float(str(line.get("frames", 0))) for line in files["workers 1"])
+    console.print(_table(workload, seeds, episodes, times, ray_s, frames))
     speedup = times["workers 1"]["run_wall_s"] / times["workers 2"]["run_wall_s"]
     over = {
         f"{ray}, {name}": times[ray][key] / times["workers 2"][key] - 1.0
@@ -140,6 +142,7 @@ def measure(workload: str, seeds: str, ray_s: float, console: Console) -> dict[s
     return {
         "seeds": seeds,
         "episodes": episodes,
+        "frames_per_episode": frames,
         "repeats": REPEATS[workload],
         "times_s": times,
         "ray_alone_s": ray_s,
@@ -153,12 +156,18 @@ PHASES = {"run_wall_s": "end to end", "episodes_wall_s": "episodes"}
 
 
 def _table(
-    workload: str, seeds: str, episodes: int, times: dict[str, Times], ray_s: float
+    workload: str,
+    seeds: str,
+    episodes: int,
+    times: dict[str, Times],
+    ray_s: float,
+    frames: float,
 ) -> Table:
     """One row per run: its start-up, episodes and end-to-end seconds, and the ratios."""
     table = Table(
         title=f"{workload}: {' '.join(WORKLOADS[workload])}, seeds {seeds} ({episodes} "
-        f"episodes), {os.cpu_count()} cores, median of {REPEATS[workload]}"
+        f"episodes, {frames:.0f} camera frames each), {os.cpu_count()} cores, median of "
+        f"{REPEATS[workload]}"
     )
     columns = ("run", "start-up s", "episodes s", "end to end s", "vs workers 1 (end to end)")
     for column in (*columns, "vs workers 2 (episodes)", "vs workers 2 (end to end)"):

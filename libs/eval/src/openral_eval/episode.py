@@ -84,6 +84,9 @@ class EpisodeResult:
     error: str | None
     trajectory_sha256: str
     video: str | None = None
+    frames: int = 0
+    """Camera frames the scene rendered for the episode (each camera at its own rate, only
+    those the policy and the video read)."""
 
     @classmethod
     def unfinished(cls, spec: EpisodeSpec, why: str) -> EpisodeResult:
@@ -114,9 +117,9 @@ def run_episode(spec: EpisodeSpec) -> EpisodeResult:
     """Run one episode (see the module doc); errors become the result's ``error``."""
     started = time.perf_counter()
     digest = hashlib.sha256()
-    steps, success, sim_time, error = 0, False, 0.0, None
+    run, error = _Run(), None
     try:
-        steps, success, sim_time = _drive(spec, digest)
+        run = _drive(spec, digest)
     except Exception as failure:  # the sweep goes on; the result says what happened
         frame = traceback.extract_tb(failure.__traceback__)[-1]
         error = f"{type(failure).__name__}: {failure} ({Path(frame.filename).name}:{frame.lineno})"
@@ -125,18 +128,29 @@ def run_episode(spec: EpisodeSpec) -> EpisodeResult:
         seed=spec.seed,
         policy=spec.policy,
         params=dict(spec.params),
-        success=success,
-        steps=steps,
-        sim_time_s=round(sim_time, 9),
+        success=run.success,
+        steps=run.steps,
+        sim_time_s=round(run.sim_time_s, 9),
         wall_time_s=round(time.perf_counter() - started, 4),
         error=error,
         trajectory_sha256=digest.hexdigest(),
         video=spec.video,
+        frames=run.frames,
     )
 
 
-def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> tuple[int, bool, float]:
-    """(steps, success, simulated time [s]) of one episode; may raise."""
+@dataclass
+class _Run:
+    """What :func:`_drive` measured of one episode."""
+
+    steps: int = 0
+    success: bool = False
+    sim_time_s: float = 0.0
+    frames: int = 0
+
+
+def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> _Run:
+    """Steps, success, simulated time [s] and frames of one episode; may raise."""
     hal, robot = scene_for(spec.scene)
     policy = make_policy(spec.policy, dict(spec.params))
     inputs = _Inputs(hal, robot, policy)
@@ -147,22 +161,24 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> tuple[int, bool, float]:
     hal.release_estop()
     hal.connect()  # a new episode: the scene reset with the seed
     limit = spec.steps or _horizon(hal) or DEFAULT_STEPS
-    steps, success, started = 0, False, hal.read_state().sim_time_s or 0.0
+    run, started = _Run(frames=len(hal.last_observation().images)), hal.read_state().sim_time_s
     try:
-        while steps < limit and not success:
+        while run.steps < limit and not run.success:
             state = hal.read_state()
             digest.update(state.positions.tobytes())
             video.add(hal.last_observation())
-            hal.send_action(policy.act(inputs.observation(state.positions, steps)))
-            steps += 1
-            success = hal.last_outcome.success
-            if hal.episode_done and not success:
+            hal.send_action(policy.act(inputs.observation(state.positions, run.steps)))
+            run.steps += 1
+            run.frames += len(hal.last_observation().images)
+            run.success = hal.last_outcome.success
+            if hal.episode_done and not run.success:
                 break
         video.add(hal.last_observation())
     finally:
         video.close()
     digest.update(hal.read_state().positions.tobytes())
-    return steps, success, float(hal.read_state().sim_time_s or 0.0) - started
+    run.sim_time_s = float(hal.read_state().sim_time_s or 0.0) - float(started or 0.0)
+    return run
 
 
 def _frame_rate_hz(hal: SimAttachedHAL, robot: LoadedRobot, camera: str | None) -> float:
