@@ -40,7 +40,8 @@ CameraRate = Annotated[
         "--camera-rate",
         min=0.1,
         max=1000.0,
-        help="Publish every camera at this rate [Hz] (default: each sensor's rate_hz).",
+        help="Publish every camera, depth camera and lidar at this rate [Hz], at most the "
+        "control rate (default: each sensor's rate_hz).",
     ),
 ]
 NoTf = Annotated[
