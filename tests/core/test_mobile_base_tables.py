@@ -12,7 +12,7 @@ from tests.conftest import MOCK_ARM, ROBOTS
 def test_panda_mobile_base_is_wired_with_every_default_filled_in() -> None:
     wiring = robot_tables(load_robot(ROBOTS / "panda_mobile" / "robot.yaml")).mobile_base
     assert wiring == MobileBaseWiring(
-        mjcf_uri="robosuite:bases/omron_mobile_base.xml",
+        mjcf_uri="pkg:robosuite/robosuite/models/assets/bases/omron_mobile_base.xml",
         mount_body="support",
         mount_position_m=(0.0, 0.0, 0.0),
         mount_quat_wxyz=(1.0, 0.0, 0.0, 0.0),

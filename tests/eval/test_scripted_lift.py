@@ -82,3 +82,21 @@ def test_the_gripper_holds_the_lifted_cube() -> None:
         [GripperHolds(kind="gripper_holds", object="red_cube")], env.model, fingers
     )
     assert holds.update(env.data, 0.05)  # both fingers touch the cube it lifted
+
+
+def test_without_a_tool_centre_point_in_the_manifest_it_says_where_to_add_one() -> None:
+    import mujoco
+    from openral_eval.privileged import Privileged, PrivilegedGripper
+
+    model = mujoco.MjModel.from_xml_string("<mujoco><worldbody/></mujoco>")
+    bare = PrivilegedGripper(slot=0, tcp_body=-1, tcp_offset_m=(0.0, 0.0, 0.0))
+    world = Privileged(model, mujoco.MjData(model), {}, (), (), (bare,))
+    obs = {
+        "images": {},
+        "joint_positions": np.zeros(1),
+        "action_spec": (("finger",), np.zeros(1)),
+        "time_s": 0.0,
+        "privileged": world,
+    }
+    with pytest.raises(PolicyConfigError, match=r"set sim\.grippers\[0\]\.tcp_body"):
+        make_policy("scripted_lift").act(obs)  # type: ignore[arg-type]

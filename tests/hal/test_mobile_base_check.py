@@ -62,8 +62,8 @@ def test_panda_mobile_passes_every_check(write_manifest: ManifestWriter) -> None
         ),
         (
             (
-                "mjcf_uri: robosuite:bases/omron_mobile_base.xml",
-                "mjcf_uri: robosuite:bases/none.xml",
+                "mjcf_uri: pkg:robosuite/robosuite/models/assets/bases/omron_mobile_base.xml",
+                "mjcf_uri: pkg:robosuite/robosuite/models/assets/bases/none.xml",
             ),
             ("mobile_base.mjcf_uri", "ships no file"),
         ),

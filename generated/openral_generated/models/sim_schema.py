@@ -64,6 +64,11 @@ CtrlRangeItem = TypeAliasType(
 QposAddr = TypeAliasType("QposAddr", Annotated[StrictInt, Field(ge=0, le=10000)])
 
 
+TcpOffsetMItem = TypeAliasType(
+    "TcpOffsetMItem", Annotated[StrictFloat, Field(ge=-10.0, le=10.0)]
+)
+
+
 class SimGripperDescription(OpenralModel):
     """
     Wiring of one gripper.
@@ -105,6 +110,20 @@ class SimGripperDescription(OpenralModel):
     mirror_actuator_index: Annotated[StrictInt | None, Field(ge=0, le=10000)] = None
     """
     Optional second actuator that receives the negated command, for antisymmetric parallel jaws whose second finger is not a canonical joint.
+    """
+    tcp_body: Annotated[
+        StrictStr | None,
+        Field(examples=["hand"], pattern="^[A-Za-z_][A-Za-z0-9_./-]{0,127}$"),
+    ] = None
+    """
+    MJCF body of the robot's model that the gripper is mounted on (the hand or flange), whose frame carries the tool centre point. Absent: the gripper has no tool centre point, and a policy that needs one must be told it.
+    """
+    tcp_offset_m: Annotated[
+        list[TcpOffsetMItem] | None,
+        Field(examples=[[0.0, 0.0, 0.1034]], max_length=3, min_length=3),
+    ] = None
+    """
+    The tool centre point (between the fingertips when closed) in `tcp_body`'s frame [m]. Absent with a `tcp_body`: the body's origin.
     """
 
 

@@ -58,6 +58,10 @@ class GripperWiring:
     write_mode: str
     actuator_index: int
     mirror_actuator_index: int | None
+    tcp_body: str | None = None
+    """MJCF body carrying the tool centre point (None: not declared)."""
+    tcp_offset_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    """The tool centre point in ``tcp_body``'s frame [m]."""
 
 
 @dataclass(frozen=True)
@@ -93,6 +97,7 @@ class HalWiring:
                     **g,
                     "ctrl_range": tuple(g["ctrl_range"]),
                     "qpos_addrs": tuple(g["qpos_addrs"]),
+                    "tcp_offset_m": tuple(g.get("tcp_offset_m", (0.0, 0.0, 0.0))),
                 }
             )
             for g in data["grippers"]
@@ -220,6 +225,8 @@ def hal_wiring(robot: RobotDescription) -> HalWiring | None:
             write_mode=g.write_mode.value,
             actuator_index=g.actuator_index if g.actuator_index is not None else actuators[g.joint],
             mirror_actuator_index=g.mirror_actuator_index,
+            tcp_body=g.tcp_body,
+            tcp_offset_m=_triple(g.tcp_offset_m),
         )
         for g in sim.grippers
     )
@@ -340,3 +347,9 @@ def _gains(
         return {n: float(gains) for n in driven}
 
     return per_joint(control.kp), per_joint(control.kd)
+
+
+def _triple(values: list[float] | None) -> tuple[float, float, float]:
+    """Three floats (zeros when absent)."""
+    x, y, z = values if values is not None else (0.0, 0.0, 0.0)
+    return (float(x), float(y), float(z))

@@ -41,7 +41,7 @@ from openral_sim.sensor_schedule import sensor_rates
 
 from openral_eval.policies import make_policy
 from openral_eval.policy import Observation, PolicyAdapter
-from openral_eval.privileged import Pose, Privileged
+from openral_eval.privileged import Pose, Privileged, PrivilegedGripper
 from openral_eval.video import VideoWriter
 
 DEFAULT_STEPS = 300
@@ -198,7 +198,7 @@ class _Inputs:
     when it needs cameras, the task state and the simulation when it asks for them."""
 
     def __init__(self, hal: SimAttachedHAL, robot: LoadedRobot, policy: PolicyAdapter) -> None:
-        self.hal, self.policy = hal, policy
+        self.hal, self.policy, self.robot = hal, policy, robot
         self.scene = hal.env if isinstance(hal.env, SceneRollout) else None
         slots = {slot.slot: slot.sensor for slot in robot.tables.vla_slots}
         self.slots = {slot: slots[slot] for slot in policy.required_slots if slot in slots}
@@ -256,6 +256,23 @@ class _Inputs:
             objects=object_poses(scene_obs),
             arm_slots=tuple(int(s) for s in slots),
             arm_dofs=tuple(int(d) for d in scene.addresses.qvel[slots]),
+            grippers=self._grippers(model),
+        )
+
+    def _grippers(self, model: mujoco.MjModel) -> tuple[PrivilegedGripper, ...]:
+        """The manifest's grippers: action slot and tool centre point in ``model``."""
+        wiring = self.robot.tables.hal_wiring
+        names = self.hal.action_names
+        return tuple(
+            PrivilegedGripper(
+                slot=names.index(g.joint),
+                tcp_body=-1
+                if g.tcp_body is None
+                else mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, g.tcp_body),
+                tcp_offset_m=g.tcp_offset_m,
+            )
+            for g in (wiring.grippers if wiring is not None else ())
+            if g.joint in names
         )
 
 

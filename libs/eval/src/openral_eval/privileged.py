@@ -1,9 +1,10 @@
 """Privileged observations: what a scripted policy may know that a camera-only one cannot.
 
 A policy that sets ``needs_privileged = True`` gets ``obs["privileged"]`` on every step of
-an episode (never under ROS: the rskill runner refuses such a policy): the scene's model,
-a scratch copy of the simulation state it may compute on (``mj_kinematics``, Jacobians),
-and the world pose of every scene object.
+an episode on a native scene (never under ROS: the rskill runner refuses such a policy):
+the scene's model, a scratch copy of the simulation state it may compute on
+(``mj_kinematics``, Jacobians), the world pose of every scene object, and the robot's
+grippers as the manifest declares them (action slot, tool centre point).
 """
 
 from __future__ import annotations
@@ -15,6 +16,18 @@ from openral_mujoco.state import FloatArray
 
 Pose = tuple[FloatArray, FloatArray]
 """World position [m] and orientation quaternion (w, x, y, z)."""
+
+
+@dataclass(frozen=True)
+class PrivilegedGripper:
+    """One gripper of the manifest, located in the scene."""
+
+    slot: int
+    """Its action slot (write mode ``normalised``: 1 open, 0 closed)."""
+    tcp_body: int
+    """Body id of its ``tcp_body`` in the scene's model (-1: the manifest declares none)."""
+    tcp_offset_m: tuple[float, float, float]
+    """The tool centre point in that body's frame [m]."""
 
 
 @dataclass(frozen=True)
@@ -30,3 +43,5 @@ class Privileged:
     """Action slots that are arm joints (position targets), in manifest order."""
     arm_dofs: tuple[int, ...]
     """Each of those joints' degree of freedom in :attr:`model` (Jacobian columns)."""
+    grippers: tuple[PrivilegedGripper, ...] = ()
+    """The manifest's grippers, in manifest order."""

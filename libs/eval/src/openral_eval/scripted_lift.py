@@ -1,8 +1,9 @@
 """``scripted_lift``: a privileged scripted policy that lifts a cube from above.
 
 It reads the simulation (:class:`~openral_eval.privileged.Privileged`): the cube's pose and
-the hand's. It then moves the gripper's centre (``tcp_offset_m`` along the hand's z axis)
-through four phases:
+the robot's first gripper as its manifest declares it (``sim.grippers[0]``: its action
+slot, ``tcp_body`` and ``tcp_offset_m``), so nothing of any one robot is written here. It
+then moves the gripper's tool centre point through four phases:
 
 1. ``approach``: ``approach_m`` above the cube, fingers pointing down and turned to the
    cube's nearest face;
@@ -26,7 +27,7 @@ import numpy as np
 from openral_mujoco.state import FloatArray
 
 from openral_eval.policy import Observation, PolicyConfigError
-from openral_eval.privileged import Privileged
+from openral_eval.privileged import Privileged, PrivilegedGripper
 
 PHASES = ("approach", "descend", "close", "lift")
 DAMPING = 0.05
@@ -43,12 +44,6 @@ class LiftConfig:
 
     object: str = "red_cube"
     """The scene object to lift."""
-    hand_body: str = "hand"
-    """The body the gripper is mounted on (MJCF name)."""
-    gripper_slot: str = "panda_finger_joint1"
-    """The gripper's action slot (write mode ``normalised``: 1 open, 0 closed)."""
-    tcp_offset_m: float = 0.1034
-    """Distance of the point between the fingertips from the hand's origin, along its z [m]."""
     approach_m: float = 0.10
     lift_m: float = 0.12
     speed_m_s: float = 0.35
@@ -82,22 +77,24 @@ class ScriptedLift:
         world = obs.get("privileged")
         if world is None:
             raise PolicyConfigError("scripted_lift needs privileged state (episodes only)")
-        names, hold = obs["action_spec"]
+        _, hold = obs["action_spec"]
         if self._command is None:
             self._command = np.asarray(hold, dtype=np.float64).copy()
         now = float(obs["time_s"])
         if self._last_time_s is not None and now > self._last_time_s:
             self._period_s = now - self._last_time_s  # the control period
         self._last_time_s = now
-        if self.config.gripper_slot not in names:
-            raise PolicyConfigError(f"no action slot {self.config.gripper_slot!r}; slots: {names}")
+        gripper = _gripper(world)
+        if self.config.object not in world.objects:
+            have = ", ".join(sorted(world.objects)) or "none"
+            raise PolicyConfigError(f"no scene object {self.config.object!r}; objects: {have}")
         position, quat = world.objects[self.config.object]
         if self._start is None:
             self._start = np.array(position, dtype=np.float64)
-        hand = self._tcp(world)  # the kinematics of this step, computed once
-        target, gripper = self._phase_target(np.asarray(position), hand[0])
+        hand = _tcp(world, gripper)  # the kinematics of this step, computed once
+        target, closing = self._phase_target(np.asarray(position), hand[0])
         self._command[list(world.arm_slots)] += self._ik_step(world, hand, target, np.asarray(quat))
-        self._command[names.index(self.config.gripper_slot)] = gripper
+        self._command[gripper.slot] = closing
         return self._command.copy()
 
     # -- phases ----------------------------------------------------------------------------
@@ -123,16 +120,6 @@ class ScriptedLift:
         return self._start + np.array([0.0, 0.0, config.lift_m]), 0.0
 
     # -- kinematics ------------------------------------------------------------------------
-
-    def _tcp(self, world: Privileged) -> tuple[FloatArray, FloatArray, int]:
-        """(gripper centre in the world [m], hand rotation matrix, hand body id)."""
-        model, data = world.model, world.data
-        mujoco.mj_kinematics(model, data)
-        body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, self.config.hand_body)
-        if body < 0:
-            raise PolicyConfigError(f"no body {self.config.hand_body!r} in the scene")
-        rotation = data.xmat[body].reshape(3, 3).copy()
-        return data.xpos[body] + rotation[:, 2] * self.config.tcp_offset_m, rotation, body
 
     def _ik_step(
         self,
@@ -162,6 +149,26 @@ class ScriptedLift:
         rates = jacobian.T @ np.linalg.solve(damped, twist)
         step: FloatArray = rates * self._period_s
         return step
+
+
+def _gripper(world: Privileged) -> PrivilegedGripper:
+    """The robot's first gripper with a tool centre point (refused when there is none)."""
+    for gripper in world.grippers:
+        if gripper.tcp_body >= 0:
+            return gripper
+    raise PolicyConfigError(
+        "scripted_lift needs a gripper with a tool centre point: set sim.grippers[0].tcp_body "
+        "(and tcp_offset_m) in the robot's manifest"
+    )
+
+
+def _tcp(world: Privileged, gripper: PrivilegedGripper) -> tuple[FloatArray, FloatArray, int]:
+    """(tool centre point in the world [m], its body's rotation matrix, body id)."""
+    model, data, body = world.model, world.data, gripper.tcp_body
+    mujoco.mj_kinematics(model, data)
+    rotation = data.xmat[body].reshape(3, 3).copy()
+    offset = rotation @ np.asarray(gripper.tcp_offset_m, dtype=np.float64)
+    return data.xpos[body] + offset, rotation, body
 
 
 def _orientation_error(rotation: FloatArray, cube_quat: FloatArray) -> FloatArray:

@@ -204,6 +204,10 @@ def _gripper_rows(wiring: HalWiring, model: mujoco.MjModel) -> Iterator[CheckRow
                 gripper.mirror_actuator_index,
                 model,
             )
+        if gripper.tcp_body is not None:
+            found = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, gripper.tcp_body) >= 0
+            actual = "a body of the model" if found else "no such body"
+            yield CheckRow(f"{prefix}.tcp_body", gripper.tcp_body, actual, ok=found)
 
 
 def _ctrl_range_row(
