@@ -676,7 +676,7 @@ class MobileBase(OpenralModel):
             examples=[
                 "pkg:robosuite/robosuite/models/assets/bases/omron_mobile_base.xml"
             ],
-            pattern="^(file|pkg|robosuite):[A-Za-z0-9_./-]+$",
+            pattern="^(file:|pkg:[A-Za-z0-9]([A-Za-z0-9._-]*[A-Za-z0-9])?/|robosuite:)[A-Za-z0-9_./-]+$",
         ),
     ]
     """

