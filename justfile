@@ -17,9 +17,10 @@ demo_command := "openral deploy sim --config robots/franka_panda/scenes/tabletop
 demo:
     {{demo_command}}
 
-# The whole test suite (extra arguments go to pytest).
+# The whole test suite, test files spread over every core (pytest-xdist; each worker claims
+# its own ROS domain). Extra arguments go to pytest (`just test -n 0` runs in one process).
 test *ARGS:
-    pytest {{ARGS}}
+    pytest -n auto --dist loadfile {{ARGS}}
 
 # ruff lint and format check.
 lint:

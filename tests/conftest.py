@@ -15,10 +15,21 @@ os.environ.setdefault("MUJOCO_GL", "egl")  # before any test module imports mujo
 from openral_core.paths import repo_root
 
 # The suite (and every process it starts) keeps compiled models in a folder of its own,
-# never reading or filling the user's cache (openral_mujoco.model_cache).
-_MODEL_CACHE = tempfile.mkdtemp(prefix="openral-test-models-")
+# never reading or filling the user's cache (openral_mujoco.model_cache). pytest-xdist's
+# workers inherit the folder the controlling process made (the cache is safe to share
+# between processes), so a model is compiled once per run, not once per worker.
+_MODEL_CACHE = os.environ.get("OPENRAL_TEST_MODEL_CACHE", "")
+if not _MODEL_CACHE:
+    _MODEL_CACHE = tempfile.mkdtemp(prefix="openral-test-models-")
+    os.environ["OPENRAL_TEST_MODEL_CACHE"] = _MODEL_CACHE
+    atexit.register(shutil.rmtree, _MODEL_CACHE, ignore_errors=True)
 os.environ["OPENRAL_MODEL_CACHE"] = _MODEL_CACHE
-atexit.register(shutil.rmtree, _MODEL_CACHE, ignore_errors=True)
+
+# execnet gives pytest-xdist's workers COLUMNS=80 and LINES=24; a serial run has neither, and
+# the CLI's tables (and the tutorials' expected output) follow $COLUMNS when it is set.
+if os.environ.get("PYTEST_XDIST_WORKER"):
+    for _name in ("COLUMNS", "LINES"):
+        os.environ.pop(_name, None)
 
 REPO = repo_root()
 ROBOTS = REPO / "robots"

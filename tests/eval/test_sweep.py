@@ -215,6 +215,7 @@ def _free_port() -> int:
         (f"127.0.0.1:{_free_port()}", "nothing answers (Connection refused)"),
         ("no-port-here", "expected 'local', 'auto' or a cluster's HOST:PORT"),
     ],
+    ids=["free-port", "no-port"],  # the same in every process (the port is not)
 )
 def test_a_ray_address_where_nothing_answers_is_one_line_at_once(
     tmp_path: Path, address: str, expected: str

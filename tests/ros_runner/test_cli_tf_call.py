@@ -328,6 +328,7 @@ def test_bad_arguments_are_one_line_and_exit_1_at_once(
             "(did you mean /openral/estop?)",
         ),
     ],
+    ids=["unknown-field", "wrong-type", "misspelt-service"],  # the same in every process
 )
 def test_calls_the_graph_refuses_are_one_line_and_exit_1(
     peer: Peer,

@@ -26,7 +26,7 @@ from tests.conftest import ROBOTS
 
 MOBILE = ROBOTS / "panda_mobile"
 ROOM = MOBILE / "scenes" / "room.yaml"
-BASE_URI = "robosuite:bases/omron_mobile_base.xml"
+BASE_URI = "pkg:robosuite/robosuite/models/assets/bases/omron_mobile_base.xml"
 
 
 @pytest.fixture(scope="module")

@@ -123,10 +123,12 @@ def prose(text: str) -> str:
 
 
 def code(text: str) -> str:
-    """Inline code that survives a table cell (a ``|`` inside backticks would show its ``\\``)."""
+    """Inline code that survives a table cell (a ``|`` inside backticks would show its ``\\``;
+    inside ``<code>`` a ``[...](...)`` would still read as a link, so brackets are escaped)."""
     if "|" not in text:
         return f"`{text}`"
-    return "<code>" + html.escape(text).replace("|", "&#124;") + "</code>"
+    escaped = html.escape(text).replace("|", "&#124;").replace("[", "&#91;").replace("]", "&#93;")
+    return "<code>" + escaped + "</code>"
 
 
 def cell(text: str) -> str:

@@ -14,7 +14,8 @@ import mujoco
 from openral_core.loaded import LoadedRobot, loaded_robot
 from openral_core.models import RobotDescription
 from openral_core.tables import GripperWiring, HalWiring
-from openral_mujoco.errors import SimulationDiverged
+from openral_mujoco.action import split_action
+from openral_mujoco.errors import ActionRejected, SimulationDiverged
 from openral_mujoco.joint_driver import JointDriver
 from openral_mujoco.mjcf_uri import robot_model_file
 from openral_mujoco.model_check import compile_robot_model, require_agreement
@@ -193,15 +194,23 @@ class MujocoArmHAL(EStopLatch):
         return driver.hold_action(data)
 
     def send_action(self, action: object) -> None:
-        """Set joint targets and gripper commands (one value per manifest joint).
+        """Set joint targets and gripper commands: one value per manifest joint, or a typed
+        :class:`~openral_mujoco.action.Action` (named slots, the gripper; no base here).
 
         Raises:
-            ActionRejected: Wrong type, width, or a non-finite value; nothing is changed.
+            ActionRejected: Wrong type, width, a non-finite value, or a base twist for this
+                robot alone; nothing is changed.
             EStopLatched: The E-stop is latched.
         """
         _, data, driver = self._handles()
+        gripper = self.wiring.grippers[0].joint if self.wiring.grippers else None
+        joints, twist = split_action(action, self.action_names, self.hold_action, gripper)
+        if twist is not None:
+            raise ActionRejected(
+                "a base twist needs a mobile base in a scene; this is the arm alone"
+            )
         self._refuse_when_estopped()
-        driver.command(action, data)
+        driver.command(joints, data)
 
     @property
     def control_period_s(self) -> float:

@@ -23,7 +23,7 @@ import numpy as np
 import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
 from openral_core.models import RgbSensor, RobotDescription
-from openral_mujoco.action import validated_action
+from openral_mujoco.action import split_action, validated_action
 from openral_mujoco.state import FloatArray, JointStateSample
 from openral_sim.base_drive import BaseCommand, BaseDrive, BaseOdometry
 from openral_sim.frame_tree import FrameTree
@@ -86,6 +86,9 @@ class SimAttachedHAL(AttachedSensors, EStopLatch):
         self._closed = False
         mjcf_names = tuple(robot.tables.joint_name_map[n] for n in self.joint_names)
         self._joints = SceneJointReader(description, mjcf_names, type(env).__name__)
+        wiring = robot.tables.hal_wiring
+        self._gripper = wiring.grippers[0].joint if wiring and wiring.grippers else None
+        """The first gripper's joint (the slot an :class:`Action`'s ``gripper`` sets)."""
 
     @property
     def description(self) -> RobotDescription:
@@ -237,7 +240,8 @@ class SimAttachedHAL(AttachedSensors, EStopLatch):
         return self._last_env_action.copy()
 
     def send_action(self, action: object) -> None:
-        """Step the scene with ``action`` (``action_dim`` values).
+        """Step the scene with ``action``: ``action_dim`` values, or a typed
+        :class:`~openral_mujoco.action.Action` (named slots, the gripper, a base twist).
 
         Raises:
             ActionRejected: Wrong type, width, or a non-finite value; nothing is changed.
@@ -355,10 +359,15 @@ class SimAttachedHAL(AttachedSensors, EStopLatch):
             self._outcome = Outcome()
 
     def _command(self, action: object, *, glide: bool) -> None:
+        """Validate everything first (a refused action changes nothing), then step."""
         self._require_obs()
-        values = validated_action(action, self._action_names)
+        joints, twist = split_action(action, self._action_names, self.hold_action, self._gripper)
+        values = validated_action(joints, self._action_names)
         self._refuse_when_estopped()
+        base = self._require_base() if twist is not None else None
         self._reset_if_done()
+        if base is not None and twist is not None:
+            base.command(twist.vx_m_s, twist.vy_m_s, twist.wz_rad_s)
         self._last_env_action = self.merge(values)
         self._step(self._last_env_action.copy(), glide=glide)
 

@@ -103,6 +103,26 @@ class NativeScene:
         self.base = None if base is None else BaseDrive(base, self.model, self.data)
         """The mobile base's drive and odometry (None for a robot without a mobile base)."""
         self._root_body = root_body(self.model, description)
+        self._setup_sensors(scene, robot, cameras)
+        self._root_qpos = int(self.model.jnt_qposadr[self.model.body_jntadr[self._root_body]])
+        self._width = scene.scene.observation.width
+        self._height = scene.scene.observation.height
+        options = scene.scene.options
+        self.substeps = physics_steps_per_control(scene, self.model.opt.timestep)
+        self.horizon = options.horizon if options and options.horizon else None
+        self.render_observations = render_observations
+        """Whether observations carry sensor frames; may be changed at any time."""
+        self.observed: frozenset[str] | None = None
+        """The sensors whose frames observations carry (None: every one served)."""
+        self._steps = 0
+        self.sensors.reschedule(1.0 / self.control_period_s)
+        self._setup_episodes(scene, description, cameras, addresses)
+
+    def _setup_sensors(
+        self, scene: DeployScene, robot: LoadedRobot, cameras: dict[str, str]
+    ) -> None:
+        """The depth cameras and lidars, and every sensor as sources."""
+        description = robot.description
         robot_ids = robot_bodies(self.model, description)
         self.range_sensors = RangeSensors(
             self.model, description, cameras, robot_ids, self._root_body
@@ -125,19 +145,6 @@ class NativeScene:
         """Every sensor the scene serves, as sensor sources (:mod:`openral_sim.scene_sensors`)."""
         self.state_sensors = self.sensors.state
         """IMU, force-torque and pose sensors (:class:`~openral_sim.state_sensors.StateSensors`)."""
-        self._root_qpos = int(self.model.jnt_qposadr[self.model.body_jntadr[self._root_body]])
-        self._width = scene.scene.observation.width
-        self._height = scene.scene.observation.height
-        options = scene.scene.options
-        self.substeps = physics_steps_per_control(scene, self.model.opt.timestep)
-        self.horizon = options.horizon if options and options.horizon else None
-        self.render_observations = render_observations
-        """Whether observations carry sensor frames; may be changed at any time."""
-        self.observed: frozenset[str] | None = None
-        """The sensors whose frames observations carry (None: every one served)."""
-        self._steps = 0
-        self.sensors.reschedule(1.0 / self.control_period_s)
-        self._setup_episodes(scene, description, cameras, addresses)
 
     def _setup_episodes(
         self,

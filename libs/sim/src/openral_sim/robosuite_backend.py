@@ -25,33 +25,18 @@ so a HAL attached once stays attached.
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Mapping
 from typing import Any, cast
 
 from openral_mujoco.display import use_offscreen_gl
 
+from openral_sim.robosuite_quiet import quiet_robosuite_notices
+
 use_offscreen_gl()  # robosuite picks its GL backend on import
 
 
-class _ImportNotices(logging.Filter):
-    """Drops the notices robosuite logs about optional parts openral never uses (a private
-    macros file, robosuite_models, mink's whole-body IK) and about loading its default
-    controller file; everything else robosuite logs still shows."""
+quiet_robosuite_notices()  # before robosuite's import logs them
 
-    NOTICES = (
-        "private macro file",
-        "setup_macros.py",
-        "robosuite_models",
-        "mink-based",
-        "Loading controller configuration from",
-    )
-
-    def filter(self, record: logging.LogRecord) -> bool:
-        return not any(notice in record.getMessage() for notice in self.NOTICES)
-
-
-logging.getLogger("robosuite_logs").addFilter(_ImportNotices())
 
 import mujoco
 import numpy as np
