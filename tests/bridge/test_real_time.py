@@ -5,6 +5,8 @@ from __future__ import annotations
 import pytest
 from openral_bridge.real_time import RealTimeWatch
 
+pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
+
 
 def _run(
     watch: RealTimeWatch, factor: float, seconds: float, start: tuple[float, float]

@@ -45,6 +45,8 @@ from tests.conftest import ROBOTS
 from tests.ros.lifecycle_client import deploy_output, deploy_sim
 from tests.ros.ros_helpers import FRANKA_SCENE, Probe, wait_until
 
+pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
+
 ALOHA_SCENE = ROBOTS / "aloha" / "scenes" / "tabletop.yaml"
 START_WAIT_S = 90.0
 """Longest wait for deploy sim to load its scene and publish on a loaded machine [s]."""

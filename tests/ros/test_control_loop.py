@@ -21,6 +21,8 @@ from rclpy.node import Node
 
 from tests.ros.ros_helpers import wait_until
 
+pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
+
 
 class CountingHal:
     """Just enough of a Tickable HAL: simulated time advances one period per tick; every

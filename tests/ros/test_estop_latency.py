@@ -9,11 +9,14 @@ import statistics
 import time
 from pathlib import Path
 
+import pytest
 from openral_nodes.runtime import claim_domain_id
 from sensor_msgs.msg import JointState
 
 from tests.ros.lifecycle_client import DEPLOY_NODE, deploy_output, deploy_sim, outside_client
 from tests.ros.ros_helpers import FRANKA_SCENE, Probe
+
+pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
 
 CALLS = 20
 """E-stop round trips measured."""

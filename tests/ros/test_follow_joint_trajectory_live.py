@@ -27,6 +27,8 @@ from openral_bridge.topics import ESTOP, JOINT_STATES, JOINT_TRAJECTORY_STATE, R
 from tests.ros.action_client import PANDA_ARM, TrajectoryActionClient, goal
 from tests.ros.trajectory_client import Client, franka_graph, stamp_s
 
+pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
+
 Result = FollowJointTrajectory.Result
 PERIOD_S = 0.05
 """The franka tabletop's control period [s]."""

@@ -24,6 +24,8 @@ from sensor_msgs.msg import JointState
 
 from tests.ros.ros_helpers import Probe
 
+pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
+
 
 class StateHal:
     """Counts reads and whether each held the lock."""

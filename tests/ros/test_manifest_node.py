@@ -33,6 +33,8 @@ from tests.ros.ros_helpers import (
     wait_until,
 )
 
+pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
+
 CONTROL_PERIOD_S = 0.05
 """One scene step of the franka tabletop scene (control_freq_hz 20) [s]."""
 CAMERA_HZ = 10.0

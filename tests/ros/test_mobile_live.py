@@ -38,6 +38,8 @@ from tests.conftest import ROBOTS
 from tests.ros.lifecycle_client import deploy_output, deploy_sim
 from tests.ros.ros_helpers import Probe
 
+pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
+
 ROOM = ROBOTS / "panda_mobile" / "scenes" / "room.yaml"
 POINTS = depth_points("head_depth")
 START_WAIT_S = 90.0

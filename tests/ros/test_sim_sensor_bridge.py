@@ -25,6 +25,8 @@ from sensor_msgs.msg import CameraInfo, Image
 
 from tests.ros.ros_helpers import Probe, image_topic, info_topic, wait_until
 
+pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
+
 FRANKA = load_robot_by_id("franka_panda")
 SHAPE = (48, 64, 3)
 CAMERAS = ("agentview", "wrist")

@@ -25,6 +25,8 @@ from sensor_msgs.msg import Image
 from tests.ros.ros_helpers import FRANKA_SCENE, Probe, image_topic, wait_until
 from tests.ros.test_sim_sensor_bridge import CAMERAS, FRANKA, entity_counts
 
+pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
+
 
 def every_camera(rate_hz: float) -> dict[str, float]:
     """Every camera of the Panda at ``rate_hz`` (the deploy override's rule)."""

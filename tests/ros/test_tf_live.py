@@ -51,6 +51,8 @@ from tests.conftest import ROBOTS
 from tests.ros.lifecycle_client import deploy_output, deploy_sim
 from tests.ros.ros_helpers import WAIT_S, Probe, wait_until
 
+pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
+
 SCENES = {
     "franka_panda": ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml",
     "panda_mobile": ROBOTS / "panda_mobile" / "scenes" / "room.yaml",
