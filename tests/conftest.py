@@ -6,15 +6,13 @@ import atexit
 import os
 import shutil
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # before any test module imports mujoco
 from openral_core.paths import repo_root
-
-from tests.exclusive import lock_dir, turn
 
 # The suite (and every process it starts) keeps compiled models in a folder of its own,
 # never reading or filling the user's cache (openral_mujoco.model_cache). pytest-xdist's
@@ -32,8 +30,6 @@ os.environ["OPENRAL_MODEL_CACHE"] = _MODEL_CACHE
 if os.environ.get("PYTEST_XDIST_WORKER"):
     for _name in ("COLUMNS", "LINES"):
         os.environ.pop(_name, None)
-
-lock_dir()  # made by the controlling process, before pytest-xdist starts its workers
 
 REPO = repo_root()
 ROBOTS = REPO / "robots"
@@ -72,12 +68,6 @@ def write_manifest(tmp_path: Path) -> ManifestWriter:
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers",
-        "exclusive: measures real time; runs while no other test runs (see tests/exclusive.py)",
+        "exclusive: measures real time; `just test` runs these after the others, in one "
+        "process of their own, never beside another test",
     )
-
-
-@pytest.hookimpl(hookwrapper=True)
-def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> Iterator[None]:
-    """Each test's setup, call and teardown under the suite's lock (tests/exclusive.py)."""
-    with turn(exclusive=item.get_closest_marker("exclusive") is not None):
-        yield

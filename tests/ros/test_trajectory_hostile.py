@@ -39,6 +39,8 @@ from tests.ros.action_client import TrajectoryActionClient, goal
 from tests.ros.lifecycle_client import DEPLOY_NODE, outside_client
 from tests.ros.trajectory_client import JOINTS, Client, franka_graph
 
+pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
+
 Result = FollowJointTrajectory.Result
 
 OPENRAL = Path(sys.executable).parent / "openral"

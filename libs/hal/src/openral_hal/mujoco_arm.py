@@ -207,7 +207,7 @@ class MujocoArmHAL(EStopLatch):
         joints, twist = split_action(action, self.action_names, self.hold_action, gripper)
         if twist is not None:
             raise ActionRejected(
-                "a base twist needs a mobile base in a scene; this is the arm alone"
+                "a base twist needs a mobile base in a scene, not the arm alone"
             )
         self._refuse_when_estopped()
         driver.command(joints, data)
