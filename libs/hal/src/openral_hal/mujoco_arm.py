@@ -206,9 +206,7 @@ class MujocoArmHAL(EStopLatch):
         gripper = self.wiring.grippers[0].joint if self.wiring.grippers else None
         joints, twist = split_action(action, self.action_names, self.hold_action, gripper)
         if twist is not None:
-            raise ActionRejected(
-                "a base twist needs a mobile base in a scene, not the arm alone"
-            )
+            raise ActionRejected("a base twist needs a mobile base in a scene, not the arm alone")
         self._refuse_when_estopped()
         driver.command(joints, data)
 
