@@ -22,6 +22,7 @@ result with its ``error``, never an exception.
 
 from __future__ import annotations
 
+import atexit
 import hashlib
 import time
 import traceback
@@ -109,8 +110,18 @@ def scene_for(path: str) -> tuple[SimAttachedHAL, LoadedRobot]:
         hal = build_hal(robot, mode=HalMode.SIM, scene=scene)
         if not isinstance(hal, SimAttachedHAL):  # build_hal attaches every scene
             raise TypeError(f"build_hal gave a {type(hal).__name__} for scene {path}")
+        if not _HALS:
+            atexit.register(close_scenes)
         _HALS[path] = (hal, robot)
     return _HALS[path]
+
+
+def close_scenes() -> None:
+    """Disconnect this process's scenes (their renderers' GL contexts are freed while the
+    display still exists, not at the interpreter's teardown)."""
+    while _HALS:
+        _, (hal, _) = _HALS.popitem()
+        hal.disconnect()
 
 
 def run_episode(spec: EpisodeSpec) -> EpisodeResult:
