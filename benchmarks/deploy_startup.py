@@ -68,7 +68,8 @@ def one_run(
     ``model_cache``, the launch's compiled-model cache is that folder; ``tf=False`` launches
     with ``--no-tf``."""
     env = {"OPENRAL_MODEL_CACHE": model_cache} if model_cache else None
-    options = ("--camera-rate", str(rate_hz), *(() if tf else ("--no-tf",)))
+    rate = ("--camera-rate", str(rate_hz)) if rate_hz else ()
+    options = (*rate, *(() if tf else ("--no-tf",)))
     extra = {stream.topic: stream.kind for stream in streams}
     with watched_deploy(scene, [], *options, env=env, extra=extra) as (launch, watcher):
         booted = watcher.wait(lambda: all(watcher.arrivals.values()), BOOT_TIMEOUT_S)
@@ -107,7 +108,12 @@ def parse_args() -> argparse.Namespace:
     )
     parser.add_argument("--runs", type=int, default=5, help="launches to time")
     parser.add_argument("--window", type=float, default=10.0, help="rate/CPU window [s]")
-    parser.add_argument("--camera-rate", type=float, default=10.0, help="camera rate [Hz]")
+    parser.add_argument(
+        "--camera-rate",
+        type=float,
+        default=10.0,
+        help="deploy sim --camera-rate [Hz] (RGB, depth and lidar alike; 0: each sensor's own)",
+    )
     parser.add_argument(
         "--cold-runs", type=int, default=3, help="launches with an empty model cache"
     )
@@ -289,7 +295,7 @@ def main() -> int:
     clean = True
     for scene in args.scene or [DEFAULT_SCENE, ROOM_SCENE]:
         args.scene = scene
-        streams = sensor_streams(scene, args.camera_rate)
+        streams = sensor_streams(scene, args.camera_rate or None)
         load = os.getloadavg()
         runs = time_runs(args, streams, console)
         console.print(results_table(args, streams, runs, load))
