@@ -88,6 +88,11 @@ class HalWiring:
     gravity_compensation: bool = False
     """MuJoCo cancels gravity on the robot's bodies, through its joints' actuators."""
 
+    @property
+    def first_gripper(self) -> str | None:
+        """The first gripper's joint (the slot an action's ``gripper`` sets), or None."""
+        return self.grippers[0].joint if self.grippers else None
+
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> HalWiring:
         """Inverse of ``dataclasses.asdict`` (the ``hal_wiring`` of a tables JSON file)."""

@@ -203,8 +203,9 @@ class MujocoArmHAL(EStopLatch):
             EStopLatched: The E-stop is latched.
         """
         _, data, driver = self._handles()
-        gripper = self.wiring.grippers[0].joint if self.wiring.grippers else None
-        joints, twist = split_action(action, self.action_names, self.hold_action, gripper)
+        joints, twist = split_action(
+            action, self.action_names, self.hold_action, self.wiring.first_gripper
+        )
         if twist is not None:
             raise ActionRejected("a base twist needs a mobile base in a scene, not the arm alone")
         self._refuse_when_estopped()

@@ -87,7 +87,7 @@ class SimAttachedHAL(AttachedSensors, EStopLatch):
         mjcf_names = tuple(robot.tables.joint_name_map[n] for n in self.joint_names)
         self._joints = SceneJointReader(description, mjcf_names, type(env).__name__)
         wiring = robot.tables.hal_wiring
-        self._gripper = wiring.grippers[0].joint if wiring and wiring.grippers else None
+        self._gripper = wiring.first_gripper if wiring is not None else None
         """The first gripper's joint (the slot an :class:`Action`'s ``gripper`` sets)."""
 
     @property
