@@ -15,12 +15,11 @@ from typing import Any
 import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
-from hypothesis_jsonschema import from_schema
 from openral_core.models import DeployScene, RobotDescription, SimDescription
 from openral_core.schemas import SchemaName, validator
 from pydantic import BaseModel, ValidationError
 
-from tests.properties.schema_bundle import bundled_schema
+from tests.properties.schema_strategy import documents
 
 MODELS: dict[SchemaName, type[BaseModel]] = {
     SchemaName.ROBOT: RobotDescription,
@@ -92,7 +91,7 @@ WRONG_TYPE_VALUES = st.sampled_from(
 @st.composite
 def mutated(draw: st.DrawFn, name: SchemaName) -> tuple[str, Any]:
     """A schema-valid document with one random mutation applied."""
-    document = draw(from_schema(bundled_schema(name)))
+    document = draw(documents(name))
     nodes = _nodes(document)
     kind = draw(st.sampled_from(["extra_key", "wrong_type", "drop_key", "out_of_range", "as_text"]))
     objects = [(p, n) for p, n in nodes if isinstance(n, dict)]
@@ -123,7 +122,7 @@ def mutated(draw: st.DrawFn, name: SchemaName) -> tuple[str, Any]:
 @pytest.mark.parametrize("name", list(SchemaName), ids=lambda n: n.value)
 def test_documents_drawn_from_the_schema_are_accepted_by_the_model(name: SchemaName) -> None:
     @SETTINGS
-    @given(from_schema(bundled_schema(name)))
+    @given(documents(name))
     def check(document: Any) -> None:
         assert _schema_accepts(name, document)
         assert _model_accepts(name, document)

@@ -7,7 +7,6 @@ from typing import Any
 
 from hypothesis import HealthCheck, Phase, assume, given, settings
 from hypothesis import strategies as st
-from hypothesis_jsonschema import from_schema
 from openral_core.models import RgbSensor, RobotDescription, Sensor
 from openral_core.rules import robot_findings
 from openral_core.schemas import SchemaName
@@ -20,7 +19,7 @@ from openral_core.tables import (
 )
 from pydantic import TypeAdapter
 
-from tests.properties.schema_bundle import bundled_schema
+from tests.properties.schema_strategy import documents
 
 SETTINGS = settings(
     max_examples=40,
@@ -77,7 +76,7 @@ def _repair(document: dict[str, Any]) -> dict[str, Any]:
 
 
 @SETTINGS
-@given(from_schema(bundled_schema(SchemaName.ROBOT)).map(_repair))
+@given(documents(SchemaName.ROBOT).map(_repair))
 def test_exported_tables_equal_runtime_resolution(document: Any) -> None:
     robot = RobotDescription.model_validate_json(json.dumps(document), strict=True)
     assume(not robot_findings(robot, None))

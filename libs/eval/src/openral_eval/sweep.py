@@ -8,6 +8,8 @@ same (scene, seed, policy) gives the same result anywhere; only the wall times d
   of the sweep is built here (so a worker starts in milliseconds with the scenes ready,
   instead of importing and composing for a second or more). Nothing in this process has
   rendered (no GL context is inherited): each worker renders offscreen on its own. A
+  robosuite scene opens its GL context as it is built, and a forked copy of a GL context
+  hangs the child's first render, so those scenes are built by each worker on first use. A
   worker that dies costs only the episode it was running, which runs again in a new
   worker, at most :data:`RETRIES` times, then is recorded with an error
   (:mod:`openral_eval.fork_pool`).
@@ -26,7 +28,12 @@ start-up, a fixed cost; what comes after it is the episodes.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from types import ModuleType
+
+from openral_core.errors import OpenralError
+from openral_core.loader import load_scene
+from openral_core.models import Backend
 
 from openral_eval.episode import EpisodeResult, EpisodeSpec, run_episode, scene_for
 from openral_eval.fork_pool import ForkPool
@@ -60,10 +67,19 @@ def run_pool(
 ) -> None:
     """Every episode in a :class:`~openral_eval.fork_pool.ForkPool` of ``workers``
     processes forked once the scenes are built here (see the module doc)."""
-    build_scenes(_scene_paths(specs))  # before the forks: inherited
+    build_scenes([path for path in _scene_paths(specs) if _inheritable(path)])
     with ForkPool(run_episode, workers, RETRIES) as pool:
         on_ready()
         pool.run(specs, on_result, _died)
+
+
+def _inheritable(path: str) -> bool:
+    """Whether the scene of ``path`` may be built before the pool forks: one that opens no
+    GL context as it is built (not a robosuite one; see the module doc)."""
+    try:
+        return load_scene(Path(path)).scene.backend is not Backend.robosuite
+    except OpenralError:  # every episode of that scene will say why
+        return False
 
 
 def _died(spec: EpisodeSpec) -> EpisodeResult:
