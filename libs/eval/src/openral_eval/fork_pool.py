@@ -7,9 +7,13 @@ own and runs one episode at a time:
 
 - a worker that dies (its pipe closes) is replaced by a new fork, and only the episode it
   was running is tried again, at most ``retries`` times, then recorded with an error;
-- workers are forked from this process, so they inherit whatever it has built (the
-  sweep's scenes) and start in milliseconds; they ignore Ctrl-C (this process decides
-  when they stop) and are killed when this process dies, even by ``SIGKILL``.
+- workers are forked from this process (start method ``fork``), so they inherit whatever
+  it has built (the sweep's scenes) and start in milliseconds; or, when this process holds
+  state a fork cannot carry (a GL context: the rasteriser's threads are not forked, so a
+  child's first render waits for them forever), from a fresh server process (start method
+  ``forkserver``), so they build what they need themselves;
+- they ignore Ctrl-C (this process decides when they stop) and are killed when their
+  parent dies, even by ``SIGKILL`` (a ``forkserver`` exits when this process does).
 """
 
 from __future__ import annotations
@@ -22,11 +26,14 @@ from collections.abc import Callable, Sequence
 from contextlib import suppress
 from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
+from multiprocessing.context import ForkContext, ForkServerContext
 from multiprocessing.process import BaseProcess
+from typing import Literal
 
 from openral_eval.episode import EpisodeResult, EpisodeSpec
 
 Run = Callable[[EpisodeSpec], EpisodeResult]
+StartMethod = Literal["fork", "forkserver"]
 _PR_SET_PDEATHSIG = 1
 
 
@@ -60,13 +67,18 @@ def _hand_out(worker: _Worker, queue: deque[EpisodeSpec]) -> None:
 
 
 class ForkPool:
-    """``workers`` forked processes running ``run`` on one spec each at a time."""
+    """``workers`` forked processes running ``run`` (a module-level function, for
+    ``forkserver``) on one spec each at a time."""
 
-    def __init__(self, run: Run, workers: int, retries: int) -> None:
+    def __init__(self, run: Run, workers: int, retries: int, start: StartMethod = "fork") -> None:
         if workers < 1:
             raise ValueError(f"a pool needs at least one worker, not {workers}")
-        self._run, self._retries = run, retries
-        self._context = multiprocessing.get_context("fork")
+        self._run, self._retries, self._start = run, retries, start
+        self._context: ForkContext | ForkServerContext = (
+            multiprocessing.get_context("fork")
+            if start == "fork"
+            else multiprocessing.get_context("forkserver")
+        )
         self._workers: list[_Worker] = []
         for _ in range(workers):
             self._workers.append(self._fork())
@@ -74,6 +86,8 @@ class ForkPool:
     def _fork(self) -> _Worker:
         mine, theirs = self._context.Pipe()
         inherited = [mine, *(worker.pipe for worker in self._workers)]
+        if self._start != "fork":  # nothing is inherited; sending our ends would copy them
+            inherited = []
         process = self._context.Process(
             target=_serve, args=(self._run, theirs, inherited), daemon=True
         )

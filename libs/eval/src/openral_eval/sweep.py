@@ -9,9 +9,10 @@ same (scene, seed, policy) gives the same result anywhere; only the wall times d
   instead of importing and composing for a second or more). Nothing in this process has
   rendered (no GL context is inherited): each worker renders offscreen on its own. A
   robosuite scene opens its GL context as it is built, and a forked copy of a GL context
-  hangs the child's first render, so those scenes are built by each worker on first use. A
-  worker that dies costs only the episode it was running, which runs again in a new
-  worker, at most :data:`RETRIES` times, then is recorded with an error
+  hangs the child's first render (its rasteriser threads are not forked), so a sweep with
+  one starts its workers from a fresh ``forkserver`` process instead, each building its
+  scenes on first use. A worker that dies costs only the episode it was running, which
+  runs again in a new worker, at most :data:`RETRIES` times, then is recorded with an error
   (:mod:`openral_eval.fork_pool`).
 - Ray (the optional ``ray`` extra; :mod:`openral_eval.ray_session`): ``address``
   ``local`` starts a Ray instance on this machine with ``workers`` CPUs; any other address
@@ -36,7 +37,7 @@ from openral_core.loader import load_scene
 from openral_core.models import Backend
 
 from openral_eval.episode import EpisodeResult, EpisodeSpec, run_episode, scene_for
-from openral_eval.fork_pool import ForkPool
+from openral_eval.fork_pool import ForkPool, StartMethod
 from openral_eval.ray_session import ray_session
 
 RETRIES = 2
@@ -66,16 +67,21 @@ def run_pool(
     on_ready: OnReady = _nothing,
 ) -> None:
     """Every episode in a :class:`~openral_eval.fork_pool.ForkPool` of ``workers``
-    processes forked once the scenes are built here (see the module doc)."""
-    build_scenes([path for path in _scene_paths(specs) if _inheritable(path)])
-    with ForkPool(run_episode, workers, RETRIES) as pool:
+    processes, forked once the scenes are built here or started from a fresh process when
+    one of them cannot cross a fork (see the module doc)."""
+    paths = _scene_paths(specs)
+    start: StartMethod = "fork" if all(_inheritable(path) for path in paths) else "forkserver"
+    if start == "fork":
+        build_scenes(paths)  # before the forks: inherited
+    with ForkPool(run_episode, workers, RETRIES, start) as pool:
         on_ready()
         pool.run(specs, on_result, _died)
 
 
 def _inheritable(path: str) -> bool:
     """Whether the scene of ``path`` may be built before the pool forks: one that opens no
-    GL context as it is built (not a robosuite one; see the module doc)."""
+    GL context as it is built (not a robosuite one; see the module doc). The caller may
+    have built it already (the CLI does, to refuse a bad file before any episode)."""
     try:
         return load_scene(Path(path)).scene.backend is not Backend.robosuite
     except OpenralError:  # every episode of that scene will say why
