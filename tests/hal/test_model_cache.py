@@ -188,3 +188,28 @@ def test_a_scene_from_the_cache_moves_as_a_compiled_one(cache: Path) -> None:
     assert len(_entries(cache)) == 2  # the robot alone, and the scene
     assert models[0] == models[1]
     np.testing.assert_array_equal(trajectories[0], trajectories[1])
+
+
+def test_a_process_hands_out_copies_of_what_it_read_and_reads_a_replaced_entry_again(
+    cache: Path, robot: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    first = _compile(robot)
+    reads: list[str] = []
+    with monkeypatch.context() as patch:
+        patch.setattr(mujoco.MjModel, "from_binary_path", lambda path: reads.append(path))
+        second = _compile(robot)  # from this process's memory: no read
+        assert reads == [] and _bytes(second) == _bytes(first)
+        second.opt.gravity[:] = 0.0  # a caller's edit stays in its copy
+        assert _compile(robot).opt.gravity[2] == pytest.approx(-9.81)
+    (entry,) = _entries(cache)
+    entry.write_bytes(b"not a model" * 10)  # damaged in place: read, refused, compiled
+    assert _bytes(_compile(robot)) == _bytes(first)
+    assert entry.stat().st_size == len(_bytes(first))
+
+
+def test_memory_holds_at_most_its_bound(cache: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(model_cache, "_MEMORY", type(model_cache._MEMORY)())
+    monkeypatch.setattr(model_cache, "MEMORY_BYTES", 1)
+    for name in ("a", "b", "c"):
+        cached_model((name,), lambda: mujoco.MjModel.from_xml_string("<mujoco/>"))
+    assert len(model_cache._MEMORY) == 1  # only the most recent: each is over the bound
