@@ -71,3 +71,30 @@ def test_missing_file_is_reported_not_raised_raw(tmp_path: Path) -> None:
 def test_format_field_renders_dots_and_indices() -> None:
     assert format_field(("sim", "grippers", 0, "joint")) == "sim.grippers[0].joint"
     assert format_field(()) == ""
+
+
+def test_a_file_parsed_again_is_a_copy_and_an_edit_is_parsed_afresh(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from openral_core import yaml_source
+
+    parses: list[Path] = []
+    parse = yaml_source._parse
+    monkeypatch.setattr(
+        yaml_source, "_parse", lambda file, text: parses.append(file) or parse(file, text)
+    )
+    file = tmp_path / "doc.yaml"
+    file.write_text("a: [1, 2]\n")
+    first = load_located(file)
+    first.data["a"].append(3)  # a caller's change stays in its copy
+    second = load_located(file)
+    assert second.data == {"a": [1, 2]} and second.position(("a",)) == (1, 1)
+    assert len(parses) == 1
+    file.write_text("a: [1, 5]\n")  # same size, other text: parsed again
+    assert load_located(file).data == {"a": [1, 5]} and len(parses) == 2
+    file.write_text("a: [1\n")
+    with pytest.raises(ManifestError):
+        load_located(file)
+    with pytest.raises(ManifestError):  # a failure is not remembered: it fails again
+        load_located(file)
+    assert len(parses) == 4
