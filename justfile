@@ -89,6 +89,10 @@ bench-realtime *ARGS:
 bench-sweep *ARGS:
     python -m benchmarks.sweep_scaling {{ARGS}}
 
+# A manifest load and a HAL connect, the second time in one process, against the same with the in-process memories cleared; writes benchmarks/results/reload_cost.json.
+bench-reload *ARGS:
+    python -m benchmarks.reload_cost {{ARGS}}
+
 # Joint-trajectory tracking on the franka tabletop: error against the path with and without the glide, and a following tick's cost over a holding one; writes benchmarks/results/trajectory_tracking.json.
 bench-trajectory *ARGS:
     python -m benchmarks.trajectory_tracking {{ARGS}}
