@@ -169,3 +169,49 @@ def test_a_period_that_is_not_positive_and_finite_is_refused(period: float) -> N
 def test_stop_without_start_and_twice_is_fine() -> None:
     pacer = Pacer()
     assert pacer.stop() and pacer.stop()
+
+
+def test_a_job_that_asks_again_is_called_soon_for_the_same_grid_time(
+    pacers: list[Pacer],
+) -> None:
+    """A refused frame (the previous one still in flight) is requested again a few ms later,
+    not a whole period later; the retries never push the job past its next grid time."""
+    period, retry = 0.1, 0.01
+    calls: list[float] = []
+    done: list[float] = []
+
+    def job() -> float | None:
+        calls.append(time.monotonic())
+        if len(calls) % 4 == 1:  # refused three times, then done, each grid time
+            return None if len(calls) == 1 else retry
+        if len(calls) % 4 == 0:
+            done.append(calls[-1])
+            return None
+        return retry
+
+    pacer = Pacer()
+    pacers.append(pacer)
+    paced = pacer.every(period, job, "camera")
+    pacer.start()
+    wait_until(lambda: len(done) >= 4, "four grid times served after retries")
+    assert pacer.stop()
+    assert paced.skipped == 0  # retries cost no grid time
+    gaps = [b - a for a, b in itertools.pairwise(done)]
+    assert all(period - 0.01 <= gap <= period + 0.03 for gap in gaps), gaps
+    first_retries = [b - a for a, b in itertools.pairwise(calls[1:4])]
+    assert all(retry - 0.002 <= gap <= retry + 0.02 for gap in first_retries), first_retries
+
+
+def test_a_retry_never_runs_past_the_next_grid_time(pacers: list[Pacer]) -> None:
+    period = 0.05
+    calls: list[float] = []
+    pacer = Pacer()
+    pacers.append(pacer)
+    paced = pacer.every(period, lambda: calls.append(time.monotonic()) or 10.0, "stubborn")
+    started = time.monotonic()
+    pacer.start()
+    wait_until(lambda: len(calls) >= 6, "six calls")
+    assert pacer.stop()
+    assert paced.skipped == 0
+    gaps = [b - a for a, b in itertools.pairwise([started, *calls])]
+    assert all(gap >= period - 0.002 for gap in gaps), gaps  # no faster than its rate

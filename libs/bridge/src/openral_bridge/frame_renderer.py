@@ -47,6 +47,9 @@ FrameT = TypeVar("FrameT")
 PublishFn = Callable[[str, FrameT, float], None]
 """Publish one sensor's frame with the snapshot's simulated time [s] (render thread)."""
 
+RETRY_S = 0.01
+"""How soon a sensor's job asks again for a frame refused because the previous one is
+still in flight [s] (see :mod:`openral_bridge.pacer`: never past the next due time)."""
 STOP_TIMEOUT_S = 5.0
 """Longest wait for the render thread to finish its frame when stopping [s]."""
 

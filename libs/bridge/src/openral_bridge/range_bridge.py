@@ -33,7 +33,7 @@ from openral_sim.depth_cloud import DepthFrame
 from openral_sim.sensor_sources import DepthSource, LidarSource
 
 from openral_bridge import ros_messages
-from openral_bridge.frame_renderer import FrameRenderer
+from openral_bridge.frame_renderer import RETRY_S, FrameRenderer
 from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.sim_sensor_bridge import NOW_WAIT_S
 from openral_bridge.topics import TopicInfo, camera_info, depth_image, depth_points, scan
@@ -195,12 +195,14 @@ class RangeBridge:
 
     # -- both --------------------------------------------------------------------------------
 
-    def _due(self, name: str, wait_s: float = 0.0) -> None:
-        """A sensor's job: request a depth frame, or cast and publish a scan."""
+    def _due(self, name: str, wait_s: float = 0.0) -> float | None:
+        """A sensor's job: request a depth frame, or cast and publish a scan; returns
+        :data:`~openral_bridge.frame_renderer.RETRY_S` when the previous depth frame is
+        still in flight (the pacer asks again shortly), else None."""
         frames = self._streams[name].frames
         if frames is None:
             self._publish_scan(name)
-            return
+            return None
         if frames.error is not None:  # as a camera does: said once, its job ends
             stream = self._streams[name]
             if self._pacer is not None and stream.job is not None:
@@ -210,9 +212,10 @@ class RangeBridge:
                 f"depth sensor {name} stopped rendering ({type(frames.error).__name__}: "
                 f"{frames.error}); the robot keeps running without its depth"
             )
-            return
+            return None
         with self.lock:
-            frames.request(name, wait_s=wait_s)
+            queued = frames.request(name, wait_s=wait_s)
+        return None if queued or frames.error is not None else RETRY_S
 
     def _rate(self, name: str, manifest_hz: float) -> float:
         return float(self.rates_hz.get(name, manifest_hz))

@@ -45,7 +45,7 @@ from openral_sim.sensor_sources import CameraSource, ObservationFrames
 
 from openral_bridge import ros_messages
 from openral_bridge.camera_messages import CameraMessages
-from openral_bridge.frame_renderer import FrameRenderer, ImageArray
+from openral_bridge.frame_renderer import RETRY_S, FrameRenderer, ImageArray
 from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.topics import TopicInfo, camera_image, camera_info
 
@@ -254,24 +254,30 @@ class SimSensorBridge:
             self._observing = source
             self._observed_before = source.render_in_observations(False)
 
-    def _due(self, name: str, wait_s: float = 0.0) -> None:
-        """A camera's job: request a rendered frame, or publish the last observed one."""
+    def _due(self, name: str, wait_s: float = 0.0) -> float | None:
+        """A camera's job: request a rendered frame, or publish the last observed one.
+
+        Returns:
+            :data:`~openral_bridge.frame_renderer.RETRY_S` when the camera's previous frame
+            is still being rendered (the pacer asks again shortly), else None.
+        """
         frames = self._frames
         if frames is not None:
             if frames.error is not None:
                 self._camera_failed(frames.error)
-            else:
-                with self.lock:
-                    frames.request(name, wait_s=wait_s)
-            return
+                return None
+            with self.lock:
+                queued = frames.request(name, wait_s=wait_s)
+            return None if queued or frames.error is not None else RETRY_S
         camera_hal = self._camera_hal
         if camera_hal is None:
-            return
+            return None
         with self.lock:
             image = camera_hal.read_images().get(name)
             sim_time_s = self._sim_time_s() if image is not None else 0.0
         if image is not None:
             self._publish(name, image, sim_time_s)
+        return None
 
     def _publish(self, name: str, image: npt.NDArray[np.uint8], sim_time_s: float) -> None:
         """Publish one frame and its camera info (pacer or render thread)."""
