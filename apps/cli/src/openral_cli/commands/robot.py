@@ -19,25 +19,16 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from openral_core import (
-    ManifestError,
-    RobotDescription,
-    load_robot,
-    load_robot_by_id,
-    manifest_path,
-    robot_ids,
-    robot_tables,
-)
-from openral_core.errors import OpenralError, one_line
-from openral_core.models import LimitedJoint
-from openral_core.registry import MANIFEST_NAME
+from openral_core.errors import ManifestError, OpenralError, one_line
 
 from openral_cli.console import err, highlighted, line, out, styled
 from openral_cli.console import error as print_error
 from openral_cli.help_text import command_group
 
 if TYPE_CHECKING:
+    from openral_core import RobotDescription
     from rich.table import Table
+
 
 app = command_group("Inspect and validate robot manifests.")
 
@@ -45,6 +36,7 @@ app = command_group("Inspect and validate robot manifests.")
 @app.command("list")
 def list_robots() -> None:
     """Table of every robot: id, joints, grippers, cameras, floating base."""
+    from openral_core import load_robot_by_id, robot_ids
     from rich.table import Table
 
     table = Table(title="robots/")
@@ -93,6 +85,8 @@ def _short_uri(uri: str) -> str:
 @app.command("show")
 def show(robot_id: Annotated[str, typer.Argument(help="Robot id (folder under robots/).")]) -> None:
     """The resolved HAL wiring, VLA slot table and joint-name map of one robot."""
+    from openral_core import load_robot_by_id, manifest_path, robot_tables
+    from openral_core.models import LimitedJoint
     from rich.table import Table
 
     robot = load_robot_by_id(robot_id)
@@ -126,6 +120,7 @@ def show(robot_id: Annotated[str, typer.Argument(help="Robot id (folder under ro
 
 
 def _print_sim_summary(mjcf_uri: str, robot: RobotDescription) -> None:
+    from openral_core import robot_tables
     from rich.table import Table
 
     wiring = robot_tables(robot).hal_wiring
@@ -176,6 +171,9 @@ def validate(
 
     Exits 1 when any file is invalid, 2 when nothing was named.
     """
+    from openral_core import load_robot
+    from openral_core.registry import MANIFEST_NAME
+
     files = _named_manifests(targets, all_robots, "validate")
     failures = 0
     for file in files:
@@ -195,6 +193,8 @@ def validate(
 
 def _named_manifests(targets: list[str] | None, all_robots: bool, verb: str) -> list[Path]:
     """Manifest files named on the command line (plus every robot with --all); exit 2 if none."""
+    from openral_core import manifest_path, robot_ids
+
     files = [_manifest_file(t) for t in targets or []]
     if all_robots:
         files += [manifest_path(robot_id) for robot_id in robot_ids()]
@@ -205,6 +205,9 @@ def _named_manifests(targets: list[str] | None, all_robots: bool, verb: str) -> 
 
 
 def _manifest_file(target: str) -> Path:
+    from openral_core import manifest_path
+    from openral_core.registry import MANIFEST_NAME
+
     path = Path(target)
     if path.is_dir():
         return path / MANIFEST_NAME
@@ -258,6 +261,8 @@ def _warn_deprecated(robot: RobotDescription) -> None:
 def _check_one(file: Path, verbose: bool, summary: Table) -> str:
     """Check one manifest: print its table of rows (failed ones, all with ``verbose``) and
     add its summary row; ``"ok"``, ``"mismatch"`` or ``"unchecked"`` (it did not load)."""
+    from openral_core import load_robot
+    from openral_core.registry import MANIFEST_NAME
     from openral_mujoco.mjcf_uri import robot_model_file
     from openral_mujoco.model_check import check_robot, compile_robot_model, row_location
     from rich.table import Table
@@ -325,6 +330,7 @@ def scaffold(
 ) -> None:
     """Draft a robot.yaml from an MJCF model; lines marked `# REVIEW:` need a human."""
     from openral_core.paths import repo_root
+    from openral_core.registry import MANIFEST_NAME
     from openral_hal.scaffold import scaffold_manifest
 
     folder = out_dir or repo_root() / "robots" / name
@@ -357,6 +363,7 @@ def urdf(
     Exits 1 when the robot does not load or its model has no URDF form.
     """
     from openral_core import open_robot
+    from openral_core.registry import MANIFEST_NAME
     from openral_mujoco.robot_tree import TreeUnsupported
     from openral_sim.robot_description import robot_description
 
