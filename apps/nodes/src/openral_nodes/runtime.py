@@ -33,8 +33,12 @@ import rclpy
 from openral_core.errors import OpenralError
 from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
+
+_InvalidHandle: type[Exception] = rclpy_implementation.InvalidHandle
+"""rclpy's error for an entity used after it was destroyed (not exported elsewhere)."""
 
 T = TypeVar("T")
 
@@ -211,7 +215,9 @@ def spin_until(
 
     A callback that raises does not end the spinning (rclpy re-raises it from
     ``spin_once``): it is reported in one line on stderr, at most once per
-    :data:`REPORT_EVERY_S`, and the executor goes on serving everything else.
+    :data:`REPORT_EVERY_S`, and the executor goes on serving everything else. An entity
+    destroyed by another thread while this one waited on it (rclpy's ``InvalidHandle``: a
+    probe's subscriptions ending after their window, say) is no failure and is not reported.
 
     Returns:
         True when ``stop`` was set, False when the timeout elapsed or the context ended.
@@ -226,6 +232,8 @@ def spin_until(
             executor.spin_once(timeout_sec=min(SPIN_PERIOD_S, left))
         except ExternalShutdownException:  # the context was shut down under us
             return False
+        except _InvalidHandle:  # destroyed by another thread while we waited on it
+            continue
         except Exception as error:  # a callback's bug: said, never the end of the executor
             if time.monotonic() - reported >= REPORT_EVERY_S:
                 reported = time.monotonic()
