@@ -198,7 +198,7 @@ class Pacer:
         except Exception as error:  # reported; the job and the thread go on
             self._report(job, error)
         now = self._clock()
-        if retry_s is not None and retry_s > 0.0:
+        if isinstance(retry_s, float) and retry_s > 0.0:  # anything else: done
             assert self._start_s is not None
             next_grid_s = self._start_s + (job.slot + 1) * job.period_s
             if now + retry_s < next_grid_s - MERGE_S:
