@@ -16,9 +16,9 @@ from __future__ import annotations
 import gc
 import subprocess
 import sys
-import threading
 import time
 from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -36,6 +36,7 @@ from openral_nodes.trajectory_request import trajectory_msg
 
 from tests.conftest import REPO
 from tests.ros.action_client import TrajectoryActionClient, goal
+from tests.ros.goal_flood import READY as FLOOD_READY
 from tests.ros.lifecycle_client import DEPLOY_NODE, outside_client
 from tests.ros.trajectory_client import JOINTS, Client, franka_graph
 
@@ -166,8 +167,6 @@ def test_ros_reset_prints_what_was_reset(client: Client) -> None:
     assert result.stdout.startswith("franka_panda: scene reset with seed 0 (start pose, objects)")
 
 
-FLOOD_HZ = 100.0
-"""Goals per second of the flood."""
 ESTOP_LIMIT_S = 0.1
 """Longest E-stop round trip accepted while the flood runs [s]."""
 
@@ -201,50 +200,48 @@ def test_each_hostile_goal_ends_aborted_with_its_reason(client: Client) -> None:
         action.destroy()
 
 
-def _flood(client: Client, stop: threading.Event, sent: list[int]) -> None:
-    """100 goals a second (good and bad in turn) and a 1e5-name trajectory twice a second."""
-    action = TrajectoryActionClient(client.probe.node)
-    q = client.positions(client.probe.latest(JOINT_STATES))
-    good = goal(JOINTS, [(0.5, (q + 0.01).tolist())])
-    bad = goal(JOINTS, [(1.0, [q[0], float("nan")])])
-    names = trajectory_msg(("panda_joint1",) * 100_000, [1.0], [[q[0]] * 100_000])
-    count = 0
-    next_at = time.monotonic()
-    while not stop.is_set():
-        action.client.send_goal_async(good if count % 2 else bad)
-        if count % 50 == 0:
-            client.trajectory.publish(names)
-        count += 1
-        next_at += 1.0 / FLOOD_HZ
-        time.sleep(max(0.0, next_at - time.monotonic()))
-    sent.append(count)
+@contextmanager
+def _goal_flood(client: Client) -> Iterator[list[int]]:
+    """:mod:`tests.ros.goal_flood` running on the graph's domain until the block ends; the
+    list then holds the number of goals it sent."""
+    q = client.positions(client.probe.latest(JOINT_STATES)).tolist()
+    command = [sys.executable, "-m", "tests.ros.goal_flood", str(client.domain), *map(str, q)]
+    process = subprocess.Popen(
+        command, cwd=REPO, env=client.env, text=True, stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    )  # fmt: skip
+    assert process.stdout is not None
+    if process.stdout.readline().strip() != FLOOD_READY:
+        pytest.fail(f"the flood did not start: {process.communicate('', timeout=30.0)[1]}")
+    sent: list[int] = []
+    try:
+        yield sent
+    finally:
+        out, err = process.communicate("", timeout=30.0)
+    assert process.returncode == 0, err
+    sent.append(int(out.split()[-1]))
 
 
-def test_a_flood_of_goals_never_delays_the_estop_or_joint_states(
-    client: Client, tmp_path: Path
-) -> None:
-    stop, sent = threading.Event(), []
-    flood = threading.Thread(target=_flood, args=(client, stop, sent), daemon=True)
+def test_a_flood_of_goals_never_delays_the_estop_or_joint_states(client: Client) -> None:
     with outside_client(client.domain, DEPLOY_NODE, "estop_during_flood") as peer:
         peer.trigger(RELEASE_ESTOP)  # discovery and a first call, not measured
         # What is measured is the graph: a garbage collection in this process (which holds
-        # the objects of every test run before) would read as a late E-stop or a gap.
+        # the objects of every test run before) would read as a late E-stop or a gap, and
+        # the flood runs in a process of its own (its serialising would hold this GIL).
         gc.collect()
         gc.disable()
-        flood.start()
-        started = time.monotonic()
-        round_trips = []
         try:
-            time.sleep(0.5)
-            for _ in range(10):
-                response, round_trip = peer.trigger(ESTOP)
-                assert response.success, response.message
-                round_trips.append(round_trip)
-                assert peer.trigger(RELEASE_ESTOP)[0].success
-                time.sleep(0.2)
+            with _goal_flood(client) as sent:
+                started = time.monotonic()
+                round_trips = []
+                time.sleep(0.5)
+                for _ in range(10):
+                    response, round_trip = peer.trigger(ESTOP)
+                    assert response.success, response.message
+                    round_trips.append(round_trip)
+                    assert peer.trigger(RELEASE_ESTOP)[0].success
+                    time.sleep(0.2)
         finally:
-            stop.set()
-            flood.join(10.0)
             gc.enable()
     received = client.probe.since(JOINT_STATES, started)
     gaps = np.diff([r.at for r in received])

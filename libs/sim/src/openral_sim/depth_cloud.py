@@ -34,6 +34,8 @@ import numpy as np
 import numpy.typing as npt
 from openral_core.models import DepthSensor
 
+from openral_sim.gl_guard import GL_LOCK
+
 SELF_MARGIN_M = 0.01
 """Points closer than this to the robot's own visible surface leave the cloud [m]."""
 
@@ -103,17 +105,18 @@ class DepthCamera:
     ) -> tuple[Depth, npt.NDArray[np.int32]]:
         """Depth [m] (raw, before the range) and the geom id seen at each pixel (-1: none),
         from a renderer of this sensor's size; ``data`` is only read."""
-        renderer.update_scene(data, camera=self.camera_id)
-        renderer.enable_depth_rendering()
-        try:
-            depth = renderer.render().copy()
-        finally:
-            renderer.disable_depth_rendering()
-        renderer.enable_segmentation_rendering()
-        try:
-            segments = renderer.render()
-        finally:
-            renderer.disable_segmentation_rendering()
+        with GL_LOCK:
+            renderer.update_scene(data, camera=self.camera_id)
+            renderer.enable_depth_rendering()
+            try:
+                depth = renderer.render().copy()
+            finally:
+                renderer.disable_depth_rendering()
+            renderer.enable_segmentation_rendering()
+            try:
+                segments = renderer.render()
+            finally:
+                renderer.disable_segmentation_rendering()
         is_geom = segments[:, :, 1] == int(mujoco.mjtObj.mjOBJ_GEOM)
         geoms = np.where(is_geom, segments[:, :, 0], -1).astype(np.int32)
         return depth, geoms

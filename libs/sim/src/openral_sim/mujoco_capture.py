@@ -17,6 +17,8 @@ from typing import Generic, TypeVar
 
 import mujoco
 
+from openral_sim.gl_guard import close_renderer, open_renderer
+
 FrameT = TypeVar("FrameT")
 RenderFn = Callable[[mujoco.Renderer, mujoco.MjData, str], FrameT]
 """Render one sensor's frame of a snapshot with the developer's renderer."""
@@ -56,7 +58,7 @@ class MujocoCapture(Generic[FrameT]):
 
     def open(self) -> _Developer[FrameT]:
         """A renderer of the model, for the calling thread."""
-        renderer = mujoco.Renderer(self._model, *self._size)
+        renderer = open_renderer(self._model, *self._size)
         return _Developer(renderer, self._copies, self._render)
 
 
@@ -75,4 +77,4 @@ class _Developer(Generic[FrameT]):
 
     def close(self) -> None:
         """Free the renderer."""
-        self._renderer.close()
+        close_renderer(self._renderer)

@@ -19,6 +19,7 @@ from openral_core.located import error_at
 from openral_core.models import DepthSensor, LidarSensor, RobotDescription
 
 from openral_sim.depth_cloud import DepthCamera, DepthFrame
+from openral_sim.gl_guard import close_renderer, open_renderer
 from openral_sim.lidar_scan import LidarScanner, Ranges
 
 
@@ -75,7 +76,7 @@ class RangeSensors:
         if renderer is None:
             renderer = self._renderers.get(name)
             if renderer is None:
-                renderer = mujoco.Renderer(self.model, camera.height, camera.width)
+                renderer = open_renderer(self.model, camera.height, camera.width)
                 self._renderers[name] = renderer
         return camera.frame(renderer, data)
 
@@ -91,5 +92,5 @@ class RangeSensors:
     def close(self) -> None:
         """Free the depth renderers."""
         for renderer in self._renderers.values():
-            renderer.close()
+            close_renderer(renderer)
         self._renderers.clear()

@@ -18,6 +18,7 @@ from openral_core.models import RgbSensor, RobotDescription
 from openral_core.tables import FrameNames
 
 from openral_sim.depth_cloud import DepthFrame
+from openral_sim.gl_guard import GL_LOCK, close_renderer, open_renderer
 from openral_sim.mujoco_capture import MujocoCapture
 from openral_sim.observation import ImageArray, LidarScan
 from openral_sim.range_sensors import RangeSensors
@@ -91,8 +92,9 @@ class SceneSensors:
         cameras, buffers = self.cameras, dict(out or {})
 
         def render(renderer: mujoco.Renderer, data: mujoco.MjData, sensor: str) -> ImageArray:
-            renderer.update_scene(data, camera=cameras[sensor])
-            return renderer.render(out=buffers.get(sensor))
+            with GL_LOCK:
+                renderer.update_scene(data, camera=cameras[sensor])
+                return renderer.render(out=buffers.get(sensor))
 
         return MujocoCapture(self.model, self.data, tuple(cameras), self.size, render)
 
@@ -114,13 +116,14 @@ class SceneSensors:
             raise KeyError(f"the scene renders no camera {unknown}; it has {tuple(self.cameras)}")
         if renderer is None and names:
             if self._renderer is None:
-                self._renderer = mujoco.Renderer(self.model, *self.size)
+                self._renderer = open_renderer(self.model, *self.size)
             renderer = self._renderer
         images: dict[str, ImageArray] = {}
         for name in names:
             assert renderer is not None
-            renderer.update_scene(data, camera=self.cameras[name])
-            images[name] = renderer.render().copy()
+            with GL_LOCK:
+                renderer.update_scene(data, camera=self.cameras[name])
+                images[name] = renderer.render().copy()
         return images
 
     # -- DepthSource -----------------------------------------------------------------------
@@ -206,6 +209,6 @@ class SceneSensors:
     def close(self) -> None:
         """Free the renderers."""
         if self._renderer is not None:
-            self._renderer.close()
+            close_renderer(self._renderer)
             self._renderer = None
         self.ranges.close()
