@@ -5,20 +5,23 @@ line each, what would otherwise cost unbounded time or memory or end in a traceb
 
 - :func:`read_text`: files over :data:`MAX_FILE_BYTES`, anything but a regular file, bytes
   that are not UTF-8, and control characters YAML does not allow;
-- :func:`scan_events`: one pass over ruamel's event stream (its parser keeps explicit
-  stacks, so no input makes it recurse) that refuses nesting deeper than :data:`MAX_DEPTH`,
-  more than :data:`MAX_NODES` values (aliases included), aliases that would expand the
-  document (a "billion laughs" bomb, or many aliases to one long string) or that refer to
-  their own node, tags, directives, merge keys (``<<``), keys that are not plain scalars,
-  repeated keys, more than one document and integers longer than :data:`MAX_INT_DIGITS`.
+- :func:`scan_events`: one pass over the document's event stream from libyaml's C parser
+  (through PyYAML: explicit stacks, so no input makes it recurse; 0.4 ms for the franka
+  manifest, where ruamel's pure-Python parser takes 15 ms) that refuses nesting deeper
+  than :data:`MAX_DEPTH`, more than :data:`MAX_NODES` values (aliases included), aliases
+  that would expand the document (a "billion laughs" bomb, or many aliases to one long
+  string) or that refer to their own node, tags, directives, merge keys (``<<``), keys
+  that are not plain scalars, repeated keys, more than one document and integers longer
+  than :data:`MAX_INT_DIGITS`.
 
-Only a document that passed both is handed to ruamel's loader. The scan counts an alias as
-the size of the node it names, in constant time: its nodes and the characters of every
-scalar (keys included) in it. Aliases may add at most :data:`MAX_ALIAS_NODES` nodes (and
-:data:`ALIAS_FACTOR` times the nodes written) and :data:`MAX_ALIAS_CHARS` characters, so a
-loaded document holds at most ~3 Mi characters of text (the file's own 1 MiB plus 2 Mi from
-aliases) whatever the file; a bomb is refused at the alias that crosses a bound, after
-reading only the text before it, never by expanding it.
+Only a document that passed both is handed to ruamel's loader (YAML 1.2 values and the
+position of every key). The scan counts an alias as the size of the node it names, in
+constant time: its nodes and the characters of every scalar (keys included) in it.
+Aliases may add at most :data:`MAX_ALIAS_NODES` nodes (and :data:`ALIAS_FACTOR` times the
+nodes written) and :data:`MAX_ALIAS_CHARS` characters, so a loaded document holds at most
+~3 Mi characters of text (the file's own 1 MiB plus 2 Mi from aliases) whatever the file;
+a bomb is refused at the alias that crosses a bound, after reading only the text before
+it, never by expanding it.
 """
 
 from __future__ import annotations
@@ -30,9 +33,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ruamel.yaml import YAML
-from ruamel.yaml.error import MarkedYAMLError, YAMLError
-from ruamel.yaml.events import (
+import yaml
+from yaml.error import MarkedYAMLError, YAMLError
+from yaml.events import (
     AliasEvent,
     CollectionStartEvent,
     DocumentStartEvent,
@@ -50,7 +53,7 @@ MAX_DEPTH = 32
 """Deepest nesting of mappings and lists accepted (manifests nest about 5 deep)."""
 MAX_NODES = 20_000
 """Most values written in one file, aliases included (the largest manifest in robots/ has
-~600; ruamel parses some 15,000-40,000 a second, so this bounds the scan to ~1 s)."""
+~600; ruamel's loader reads some 15,000-40,000 a second, so this bounds a load to ~1 s)."""
 MAX_ALIAS_NODES = 100_000
 """Most nodes that aliases may add to a document, whatever its size."""
 MAX_ALIAS_CHARS = 1 << 21
@@ -179,10 +182,15 @@ class _Scan:
     """A resource limit was hit: the rest of the stream is not read."""
 
     def issue(self, event: Event, path: PathKey, message: str, *, fatal: bool = False) -> None:
-        mark = event.start_mark
-        line, column = mark.line + 1, mark.column + 1
+        line, column = _position(event)
         self.issues.append(Issue(self.file, line, column, format_field(path), message))
         self.stopped = self.stopped or fatal
+
+
+def _position(event: Event) -> tuple[int, int]:
+    """(line, column) of ``event``'s start, 1-based (every event the parser gives has one)."""
+    mark = event.start_mark
+    return (mark.line + 1, mark.column + 1) if mark is not None else (1, 1)
 
 
 def scan_events(file: Path, text: str) -> None:
@@ -210,7 +218,7 @@ def scan_events(file: Path, text: str) -> None:
 
 
 def _events(text: str) -> Iterator[Event]:
-    yield from YAML(typ="rt").parse(text)
+    yield from yaml.parse(text, Loader=yaml.CSafeLoader)
 
 
 def _visit(scan: _Scan, event: Event) -> None:
@@ -262,7 +270,7 @@ def _node(scan: _Scan, event: NodeEvent) -> None:
     assert isinstance(event, ScalarEvent)
     if is_key and parent is not None:
         _key(scan, event, parent)
-    if event.style is None and _LONG_INT.fullmatch(event.value):
+    if not event.style and _LONG_INT.fullmatch(event.value):  # plain ("" from libyaml)
         digits = sum(ch.isdigit() for ch in event.value)
         if digits > MAX_INT_DIGITS:
             message = f"an integer of {digits} digits; at most {MAX_INT_DIGITS} are accepted"
@@ -282,8 +290,8 @@ def _count_value(scan: _Scan, event: NodeEvent, path: PathKey) -> None:
 
 
 def _key(scan: _Scan, event: ScalarEvent, frame: _Frame) -> None:
-    key, line = event.value, event.start_mark.line + 1
-    if key == "<<" and event.style is None:
+    key, line = event.value, _position(event)[0]
+    if key == "<<" and not event.style:
         message = "merge keys (<<) are not supported; write the keys out"
         scan.issue(event, frame.path, message)
     elif key in frame.keys:

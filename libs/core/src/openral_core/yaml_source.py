@@ -9,7 +9,7 @@ converted once and shared, not copied for each alias.
 
 A process remembers the documents it parsed, by file name and SHA-256 of the text (at most
 :data:`MAX_REMEMBERED_CHARS` of text), and hands out copies: parsing takes 25-90 ms per
-manifest in ruamel's pure-Python parser, a copy well under 1 ms, and a tool or test that
+manifest in ruamel's pure-Python loader, a copy well under 1 ms, and a tool or test that
 loads the same files again and again (``schema-export``, ``robot check`` of a folder, a
 sweep) need not parse them again. A changed file has another digest, so it is parsed
 afresh; a file that fails is never remembered.
@@ -28,7 +28,7 @@ from typing import Any
 
 from ruamel.yaml import YAML
 from ruamel.yaml.comments import CommentedMap, CommentedSeq
-from ruamel.yaml.error import YAMLError
+from ruamel.yaml.error import MarkedYAMLError, YAMLError
 
 from openral_core.errors import Issue, ManifestError, PathKey, format_field
 from openral_core.yaml_guard import read_text, scan_events
@@ -89,6 +89,11 @@ def _parse(file: Path, text: str) -> LocatedDocument:
     scan_events(file, text)
     try:
         raw = YAML(typ="rt").load(text)
+    except MarkedYAMLError as error:  # YAML 1.2 that libyaml's 1.1 parser let through
+        mark = error.problem_mark or error.context_mark
+        line, column = (mark.line + 1, mark.column + 1) if mark else (1, 1)
+        issue = Issue(file, line, column, "", f"invalid YAML: {error.problem or error.context}")
+        raise ManifestError(file, [issue]) from None
     except (YAMLError, ValueError, RecursionError) as error:  # the scan should prevent these
         issue = Issue(file, 1, 1, "", f"cannot be read as YAML ({type(error).__name__})")
         raise ManifestError(file, [issue]) from None
