@@ -15,7 +15,7 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 import pytest
-from openral_bridge.frame_renderer import FrameRenderer
+from openral_bridge.frame_renderer import RETRY_S, FrameRenderer
 from openral_sim.mujoco_capture import MujocoCapture
 from openral_sim.native_scene import NativeScene
 from openral_sim.scene import build_sim_env_from_yaml
@@ -170,6 +170,25 @@ def test_request_only_copies_while_a_frame_renders(
     finally:
         gate.open.set()
         frames.stop()
+
+
+def test_a_paced_request_asks_for_a_retry_only_while_its_frame_is_in_flight(
+    tiny: tuple[mujoco.MjModel, mujoco.MjData],
+) -> None:
+    gate, lock = Gate(), threading.Lock()
+    frames, published = make(tiny, gate)
+    try:
+        assert frames.request_or_retry("a", lock) is None  # queued
+        assert gate.entered.acquire(timeout=WAIT_S)
+        assert frames.request_or_retry("a", lock) == RETRY_S  # in flight: ask again soon
+        assert not lock.locked()  # held only for the request
+        gate.open.set()
+        published.wait(1)
+        frames.error = RuntimeError("GL exploded")
+        assert frames.request_or_retry("a", lock) is None  # failed: no retry, ever
+    finally:
+        gate.open.set()
+        assert frames.stop()
 
 
 def test_a_failing_render_stops_the_thread_and_is_reported(

@@ -33,6 +33,7 @@ from __future__ import annotations
 import queue
 import threading
 from collections.abc import Callable
+from contextlib import AbstractContextManager
 from typing import Generic, TypeVar
 
 from openral_sim.observation import ImageArray
@@ -160,6 +161,19 @@ class FrameRenderer(Generic[FrameT]):
             return False
         self._jobs.put(slot)
         return True
+
+    def request_or_retry(
+        self, sensor: str, lock: AbstractContextManager[object], *, wait_s: float = 0.0
+    ) -> float | None:
+        """A sensor's paced job: :meth:`request` a frame holding ``lock`` (the HAL's).
+
+        Returns:
+            :data:`RETRY_S` when the previous frame of ``sensor`` is still in flight (the
+            pacer asks again that much later), else None (queued, or the renderer failed).
+        """
+        with lock:
+            queued = self.request(sensor, wait_s=wait_s)
+        return None if queued or self.error is not None else RETRY_S
 
     def stop(self, timeout_s: float = STOP_TIMEOUT_S) -> bool:
         """Stop the thread after the frame it is rendering (idempotent).

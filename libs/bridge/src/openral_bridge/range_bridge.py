@@ -33,7 +33,7 @@ from openral_sim.depth_cloud import DepthFrame
 from openral_sim.sensor_sources import DepthSource, LidarSource
 
 from openral_bridge import ros_messages
-from openral_bridge.frame_renderer import RETRY_S, FrameRenderer
+from openral_bridge.frame_renderer import FrameRenderer
 from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.sim_sensor_bridge import NOW_WAIT_S
 from openral_bridge.topics import TopicInfo, camera_info, depth_image, depth_points, scan
@@ -213,9 +213,7 @@ class RangeBridge:
                 f"{frames.error}); the robot keeps running without its depth"
             )
             return None
-        with self.lock:
-            queued = frames.request(name, wait_s=wait_s)
-        return None if queued or frames.error is not None else RETRY_S
+        return frames.request_or_retry(name, self.lock, wait_s=wait_s)
 
     def _rate(self, name: str, manifest_hz: float) -> float:
         return float(self.rates_hz.get(name, manifest_hz))

@@ -45,7 +45,7 @@ from openral_sim.sensor_sources import CameraSource, ObservationFrames
 
 from openral_bridge import ros_messages
 from openral_bridge.camera_messages import CameraMessages
-from openral_bridge.frame_renderer import RETRY_S, FrameRenderer, ImageArray
+from openral_bridge.frame_renderer import FrameRenderer, ImageArray
 from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.topics import TopicInfo, camera_image, camera_info
 
@@ -266,9 +266,7 @@ class SimSensorBridge:
             if frames.error is not None:
                 self._camera_failed(frames.error)
                 return None
-            with self.lock:
-                queued = frames.request(name, wait_s=wait_s)
-            return None if queued or frames.error is not None else RETRY_S
+            return frames.request_or_retry(name, self.lock, wait_s=wait_s)
         camera_hal = self._camera_hal
         if camera_hal is None:
             return None
