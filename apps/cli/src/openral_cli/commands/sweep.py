@@ -41,9 +41,12 @@ def parse_seeds(text: str) -> list[int]:
     try:
         if ":" in text:
             start, stop = (int(part) for part in text.split(":", 1))
-            seeds = list(range(start, stop)) if stop - start <= MAX_EPISODES else []
+            if stop <= start:
+                message = f"{text!r} is an empty range: STOP must be greater than START"
+                raise typer.BadParameter(message, param_hint="--seeds")
             if stop - start > MAX_EPISODES:
                 raise typer.BadParameter(f"at most {MAX_EPISODES} seeds", param_hint="--seeds")
+            seeds = list(range(start, stop))
         else:
             seeds = [int(part) for part in text.split(",")]
     except ValueError:
@@ -51,9 +54,48 @@ def parse_seeds(text: str) -> list[int]:
             f"{text!r}: expected START:STOP (0:100), a seed (7) or a list (1,5,9)",
             param_hint="--seeds",
         ) from None
-    if not seeds or min(seeds) < 0:
-        raise typer.BadParameter(f"{text!r} gives no non-negative seed", param_hint="--seeds")
+    if min(seeds) < 0:
+        raise typer.BadParameter(f"{text!r} gives a negative seed", param_hint="--seeds")
+    repeated = sorted({seed for seed in seeds if seeds.count(seed) > 1})
+    if repeated:
+        message = f"{text!r} gives seed {repeated[0]} more than once; each seed runs once"
+        raise typer.BadParameter(message, param_hint="--seeds")
     return seeds
+
+
+def check_distinct_scenes(config: list[Path]) -> None:
+    """Refuse a scene file given twice (also by another spelling of its path).
+
+    Raises:
+        typer.BadParameter: Naming the first file given more than once.
+    """
+    seen: set[Path] = set()
+    for path in config:
+        if path.resolve() in seen:
+            message = f"{path} is given more than once; each scene runs once"
+            raise typer.BadParameter(message, param_hint="--config")
+        seen.add(path.resolve())
+
+
+def check_out_dir(out_dir: Path) -> None:
+    """Refuse an ``--out`` that could not hold the results, before anything runs and
+    without making it (a refused sweep leaves no folder behind).
+
+    Raises:
+        typer.BadParameter: ``out_dir`` or a folder above it is a file, or the folder that
+            would hold it cannot be written to.
+    """
+    for path in (out_dir, *out_dir.parents):
+        if not path.exists():
+            continue
+        if not path.is_dir():
+            where = "is a file" if path == out_dir else f"is under {path}, which is a file"
+            raise typer.BadParameter(
+                f"{out_dir} {where}; expected a folder (made if missing)", param_hint="--out"
+            )
+        if not os.access(path, os.W_OK | os.X_OK):
+            raise typer.BadParameter(f"{out_dir}: cannot write in {path}", param_hint="--out")
+        return
 
 
 def sweep(
@@ -90,10 +132,7 @@ def sweep(
     from openral_eval.policies import make_policy, parse_params
     from openral_eval.ray_session import check_ray_address
 
-    if video not in VIDEO_CHOICES:
-        raise typer.BadParameter(
-            f"expected one of {', '.join(VIDEO_CHOICES)}", param_hint="--video"
-        )
+    _check_arguments(config, out_dir, video)
     pairs = tuple(sorted(parse_params(params or []).items()))
     make_policy(policy, dict(pairs))  # a bad name or parameter stops here, before any episode
     for path in config:
@@ -116,6 +155,16 @@ def sweep(
         )
         raise typer.Exit(130) from None
     _report(log.sort(plan), policy, out_dir, clock)
+
+
+def _check_arguments(config: list[Path], out_dir: Path, video: str) -> None:
+    """Refuse a bad ``--video``, ``--out`` or repeated ``--config`` before anything runs."""
+    if video not in VIDEO_CHOICES:
+        raise typer.BadParameter(
+            f"expected one of {', '.join(VIDEO_CHOICES)}", param_hint="--video"
+        )
+    check_out_dir(out_dir)
+    check_distinct_scenes(config)
 
 
 def _open_log(path: Path, *, resume: bool) -> EpisodeLog:
