@@ -1,14 +1,26 @@
-"""The sweep's fork pool: its workers never outlive the process that forked them."""
+"""The sweep's fork pool: its workers never outlive the process that forked them; a
+policy that hangs, exits or crashes its process costs only its own episode."""
 
 from __future__ import annotations
 
+import faulthandler
+import os
 import signal
 import subprocess
 import sys
+import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 
+import pytest
+from openral_eval.episode import EpisodeResult, EpisodeSpec
+from openral_eval.fork_pool import ForkPool
+
 from tests.eval.processes import alive, children
+
+TIMEOUT_S = 2.0
+"""The pool's time limit of one episode in these tests [s]."""
 
 DRIVER = """
 import time
@@ -42,3 +54,42 @@ def test_workers_busy_with_an_episode_die_with_a_killed_sweep() -> None:
     finally:
         driver.kill()
         driver.wait()
+
+
+def _hostile(spec: EpisodeSpec) -> EpisodeResult:
+    """Seed 0 ends well; 1 hangs, 2 calls sys.exit, 3 segfaults its process."""
+    if spec.seed == 1:
+        threading.Event().wait()
+    elif spec.seed == 2:
+        sys.exit(3)
+    elif spec.seed == 3:
+        faulthandler.disable()  # pytest's would print this child's stacks into the log
+        os.kill(os.getpid(), signal.SIGSEGV)
+    return EpisodeResult.unfinished(spec, "")  # a stand-in for a finished episode
+
+
+def _gave_up(why: str) -> Callable[[EpisodeSpec], EpisodeResult]:
+    return lambda spec: EpisodeResult.unfinished(spec, why)
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_hung_an_exiting_and_a_crashing_policy_each_cost_only_their_episode(
+    workers: int,
+) -> None:
+    specs = [EpisodeSpec("scene.yaml", seed, "hostile") for seed in range(4)]
+    specs.append(EpisodeSpec("scene.yaml", 4, "hostile"))  # after them all: still runs
+    results: list[EpisodeResult] = []
+    started = time.monotonic()
+    # forkserver: a fork of this test process would carry the GL contexts and ROS state of
+    # the tests run before it here, which a sweep's process never has
+    with ForkPool(_hostile, workers, 1, "forkserver", TIMEOUT_S) as pool:
+        pool.run(specs, results.append, _gave_up("died"), _gave_up("timeout"))
+    by_seed = {result.seed: result.error for result in results}
+    assert len(results) == 5
+    assert by_seed == {0: "", 1: "timeout", 2: "died", 3: "died", 4: ""}, by_seed
+    assert time.monotonic() - started < TIMEOUT_S + 20.0  # the hung one is not waited twice
+
+
+def test_a_time_limit_must_be_positive() -> None:
+    with pytest.raises(ValueError, match="time limit must be positive"):
+        ForkPool(_hostile, 1, retries=0, timeout_s=0.0)

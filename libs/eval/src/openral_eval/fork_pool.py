@@ -12,6 +12,8 @@ own and runs one episode at a time:
   state a fork cannot carry (a GL context: the rasteriser's threads are not forked, so a
   child's first render waits for them forever), from a fresh server process (start method
   ``forkserver``), so they build what they need themselves;
+- a worker still on one episode after ``timeout_s`` of wall time (a policy that hangs) is
+  killed and replaced; that episode is given up at once (it would hang again);
 - they ignore Ctrl-C (this process decides when they stop) and are killed when their
   parent dies, even by ``SIGKILL`` (a ``forkserver`` exits when this process does).
 """
@@ -19,8 +21,10 @@ own and runs one episode at a time:
 from __future__ import annotations
 
 import ctypes
+import math
 import multiprocessing
 import signal
+import time
 from collections import deque
 from collections.abc import Callable, Sequence
 from contextlib import suppress
@@ -37,11 +41,17 @@ StartMethod = Literal["fork", "forkserver"]
 _PR_SET_PDEATHSIG = 1
 
 
+GiveUp = Callable[[EpisodeSpec], EpisodeResult]
+"""The result recorded for an episode given up (its worker died too often, or hung)."""
+
+
 @dataclass
 class _Worker:
     process: BaseProcess
     pipe: Connection
     spec: EpisodeSpec | None = None
+    started: float = 0.0
+    """When it was handed its episode (``time.monotonic``) [s]."""
 
 
 def _serve(run: Run, pipe: Connection, inherited: Sequence[Connection]) -> None:
@@ -61,19 +71,30 @@ def _serve(run: Run, pipe: Connection, inherited: Sequence[Connection]) -> None:
 def _hand_out(worker: _Worker, queue: deque[EpisodeSpec]) -> None:
     """Give an idle worker the next episode, if there is one."""
     if worker.spec is None and queue:
-        worker.spec = queue.popleft()
+        worker.spec, worker.started = queue.popleft(), time.monotonic()
         with suppress(OSError):  # it died idle: its death is found when its pipe is read
             worker.pipe.send(worker.spec)
 
 
 class ForkPool:
     """``workers`` forked processes running ``run`` (a module-level function, for
-    ``forkserver``) on one spec each at a time."""
+    ``forkserver``) on one spec each at a time, each spec for at most ``timeout_s`` of wall
+    time (``math.inf``: no limit)."""
 
-    def __init__(self, run: Run, workers: int, retries: int, start: StartMethod = "fork") -> None:
+    def __init__(
+        self,
+        run: Run,
+        workers: int,
+        retries: int,
+        start: StartMethod = "fork",
+        timeout_s: float = math.inf,
+    ) -> None:
         if workers < 1:
             raise ValueError(f"a pool needs at least one worker, not {workers}")
+        if not timeout_s > 0.0:
+            raise ValueError(f"an episode's time limit must be positive, not {timeout_s}")
         self._run, self._retries, self._start = run, retries, start
+        self._timeout_s = timeout_s
         self._context: ForkContext | ForkServerContext = (
             multiprocessing.get_context("fork")
             if start == "fork"
@@ -99,18 +120,24 @@ class ForkPool:
         self,
         specs: Sequence[EpisodeSpec],
         on_result: Callable[[EpisodeResult], None],
-        died: Callable[[EpisodeSpec], EpisodeResult],
+        died: GiveUp,
+        timed_out: GiveUp | None = None,
     ) -> None:
         """Every spec, each result to ``on_result`` as it arrives; a spec whose worker died
-        more than ``retries`` times gets ``died(spec)`` instead."""
+        more than ``retries`` times gets ``died(spec)`` instead, and one that ran over the
+        time limit ``timed_out(spec)`` (``died`` when not given)."""
         queue, attempts = deque(specs), dict.fromkeys(specs, 0)
         while queue or any(worker.spec for worker in self._workers):
             for worker in self._workers:
                 _hand_out(worker, queue)
             busy = [worker for worker in self._workers if worker.spec is not None]
-            wait([worker.pipe for worker in busy])
+            wait([worker.pipe for worker in busy], self._wait_s(busy))
             for worker in busy:
                 if not worker.pipe.poll():
+                    if worker.spec and time.monotonic() - worker.started > self._timeout_s:
+                        worker.process.kill()
+                        attempts[worker.spec] = self._retries  # no second try: it hangs again
+                        self._replace(worker, queue, attempts, on_result, timed_out or died)
                     continue
                 try:
                     result = worker.pipe.recv()
@@ -121,13 +148,21 @@ class ForkPool:
                 _hand_out(worker, queue)  # its next episode first, then the bookkeeping
                 on_result(result)
 
+    def _wait_s(self, busy: Sequence[_Worker]) -> float | None:
+        """How long to wait for a result before the first busy worker's time is up [s]
+        (None: no limit)."""
+        if math.isinf(self._timeout_s) or not busy:
+            return None
+        first = min(worker.started for worker in busy) + self._timeout_s
+        return max(first - time.monotonic(), 0.0)
+
     def _replace(
         self,
         worker: _Worker,
         queue: deque[EpisodeSpec],
         attempts: dict[EpisodeSpec, int],
         on_result: Callable[[EpisodeResult], None],
-        died: Callable[[EpisodeSpec], EpisodeResult],
+        give_up: GiveUp,
     ) -> None:
         """Fork a new worker in the dead one's place; try its episode again or give it up."""
         spec = worker.spec
@@ -137,7 +172,7 @@ class ForkPool:
         self._workers[self._workers.index(worker)] = self._fork()
         attempts[spec] += 1
         if attempts[spec] > self._retries:
-            on_result(died(spec))
+            on_result(give_up(spec))
         else:
             queue.appendleft(spec)
 

@@ -1,10 +1,10 @@
-"""Running many episodes: in this process, in a local process pool, or as Ray tasks.
+"""Running many episodes: in a local process pool, or as Ray tasks.
 
-All three run the same :func:`~openral_eval.episode.run_episode` on the same specs, so the
+Both run the same :func:`~openral_eval.episode.run_episode` on the same specs, so the
 same (scene, seed, policy) gives the same result anywhere; only the wall times differ.
 
-- ``workers == 1``: one after another in this process.
-- ``workers > 1``: a pool of that many processes, forked from this one once every scene
+- a pool of ``workers`` processes (one is a pool too: a policy that crashes its process
+  costs only its episode), forked from this one once every scene
   of the sweep is built here (so a worker starts in milliseconds with the scenes ready,
   instead of importing and composing for a second or more). Nothing in this process has
   rendered (no GL context is inherited): each worker renders offscreen on its own. A
@@ -13,7 +13,8 @@ same (scene, seed, policy) gives the same result anywhere; only the wall times d
   one starts its workers from a fresh ``forkserver`` process instead, each building its
   scenes on first use. A worker that dies costs only the episode it was running, which
   runs again in a new worker, at most :data:`RETRIES` times, then is recorded with an error
-  (:mod:`openral_eval.fork_pool`).
+  (:mod:`openral_eval.fork_pool`). An episode still running after ``timeout_s`` of wall
+  time (a policy that hangs) is recorded with a ``timeout:`` error and its worker replaced.
 - Ray (the optional ``ray`` extra; :mod:`openral_eval.ray_session`): ``address``
   ``local`` starts a Ray instance on this machine with ``workers`` CPUs; any other address
   joins that cluster. Each episode is one task of one CPU, retried :data:`RETRIES` times
@@ -21,14 +22,16 @@ same (scene, seed, policy) gives the same result anywhere; only the wall times d
 
 Every finished episode goes to ``on_result`` on this process's main thread, as soon as it
 ends, in whatever order episodes end. ``on_ready`` is called once, when every worker is up
-with the sweep's scenes built (at once in this process; after the forks for the pool; after
+with the sweep's scenes built (after the forks for the pool; after
 Ray has started and one warm-up task per CPU has built the scenes): what comes before it is
 start-up, a fixed cost; what comes after it is the episodes.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
+from functools import partial
 from pathlib import Path
 from types import ModuleType
 
@@ -50,21 +53,12 @@ def _nothing() -> None:
     """The default ``on_ready``."""
 
 
-def run_serial(
-    specs: Sequence[EpisodeSpec], on_result: OnResult, on_ready: OnReady = _nothing
-) -> None:
-    """Every episode in this process, in order."""
-    build_scenes(_scene_paths(specs))
-    on_ready()
-    for spec in specs:
-        on_result(run_episode(spec))
-
-
 def run_pool(
     specs: Sequence[EpisodeSpec],
     workers: int,
     on_result: OnResult,
     on_ready: OnReady = _nothing,
+    timeout_s: float = math.inf,
 ) -> None:
     """Every episode in a :class:`~openral_eval.fork_pool.ForkPool` of ``workers``
     processes, forked once the scenes are built here or started from a fresh process when
@@ -73,9 +67,9 @@ def run_pool(
     start: StartMethod = "fork" if all(_inheritable(path) for path in paths) else "forkserver"
     if start == "fork":
         build_scenes(paths)  # before the forks: inherited
-    with ForkPool(run_episode, workers, RETRIES, start) as pool:
+    with ForkPool(run_episode, workers, RETRIES, start, timeout_s) as pool:
         on_ready()
-        pool.run(specs, on_result, _died)
+        pool.run(specs, on_result, _died, partial(_timed_out, timeout_s))
 
 
 def _inheritable(path: str) -> bool:
@@ -90,6 +84,11 @@ def _inheritable(path: str) -> bool:
 
 def _died(spec: EpisodeSpec) -> EpisodeResult:
     return EpisodeResult.unfinished(spec, "its worker process died, every time it ran")
+
+
+def _timed_out(timeout_s: float, spec: EpisodeSpec) -> EpisodeResult:
+    why = f"timeout: still running after {timeout_s:g} s of wall time; its worker was stopped"
+    return EpisodeResult.unfinished(spec, why)
 
 
 def run_ray(

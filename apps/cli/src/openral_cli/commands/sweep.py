@@ -29,6 +29,8 @@ if TYPE_CHECKING:
     from openral_eval.results import EpisodeLog
 
 VIDEO_CHOICES = ("first", "failures", "all", "none")
+EPISODE_TIMEOUT_S = 600.0
+"""Default wall-time limit of one episode (``--episode-timeout``) [s]."""
 MAX_EPISODES = 100_000
 
 
@@ -124,6 +126,10 @@ def sweep(
     resume: Annotated[
         bool, typer.Option("--resume", help="Keep finished episodes, run the rest.")
     ] = False,
+    episode_timeout: Annotated[
+        float,
+        typer.Option("--episode-timeout", min=0.001, help="Wall-time limit of one episode [s]."),
+    ] = EPISODE_TIMEOUT_S,
 ) -> None:
     """Run POLICY on every (scene, seed) episode through the same HAL contract as deploy
     sim, in parallel; write ``episodes.jsonl`` and ``summary.json`` and print each scene's
@@ -141,19 +147,9 @@ def sweep(
         check_ray_address(ray)  # before the results file is touched
     plan = _plan(config, parse_seeds(seeds), policy, pairs, steps, video, out_dir)
     log = _open_log(out_dir / "episodes.jsonl", resume=resume)
-    done = log.done()
-    todo = [spec for spec in plan if spec.key not in done]
-    count = workers or os.cpu_count() or 1
+    where = (workers or os.cpu_count() or 1, ray, episode_timeout)
     clock = SweepClock()
-    try:
-        _run(todo, len(plan) - len(todo), len(plan), count, ray, log, video, out_dir, clock)
-    except KeyboardInterrupt:
-        err.print(
-            f"interrupted: {len(log.done())} of {len(plan)} episodes are in {log.path}; the "
-            "same command with --resume runs the rest",
-            markup=False,
-        )
-        raise typer.Exit(130) from None
+    _run_plan(plan, log, where, video, out_dir, clock)
     _report(log.sort(plan), policy, out_dir, clock)
 
 
@@ -165,6 +161,29 @@ def _check_arguments(config: list[Path], out_dir: Path, video: str) -> None:
         )
     check_out_dir(out_dir)
     check_distinct_scenes(config)
+
+
+def _run_plan(
+    plan: list[EpisodeSpec],
+    log: EpisodeLog,
+    where: tuple[int, str | None, float],
+    video: str,
+    out_dir: Path,
+    clock: SweepClock,
+) -> None:
+    """Run the episodes of ``plan`` that ``log`` does not hold yet (see :func:`_run`); on
+    Ctrl-C say how many are written and exit 130."""
+    done = log.done()
+    todo = [spec for spec in plan if spec.key not in done]
+    try:
+        _run(todo, (len(plan) - len(todo), len(plan)), where, log, video, out_dir, clock)
+    except KeyboardInterrupt:
+        err.print(
+            f"interrupted: {len(log.done())} of {len(plan)} episodes are in {log.path}; the "
+            "same command with --resume runs the rest",
+            markup=False,
+        )
+        raise typer.Exit(130) from None
 
 
 def _open_log(path: Path, *, resume: bool) -> EpisodeLog:
@@ -247,20 +266,23 @@ def _plan(
 
 def _run(
     todo: list[EpisodeSpec],
-    already: int,
-    total: int,
-    workers: int,
-    ray: str | None,
+    counts: tuple[int, int],
+    where: tuple[int, str | None, float],
     log: EpisodeLog,
     video: str,
     out_dir: Path,
     clock: SweepClock,
 ) -> None:
     """Run ``todo`` with a progress bar; every result is written as it arrives (and
-    ``clock`` marks when the workers were ready and when the last result was written)."""
+    ``clock`` marks when the workers were ready and when the last result was written).
+
+    ``counts`` is (episodes already done, episodes in all); ``where`` (workers, Ray
+    address or None, an episode's wall-time limit [s])."""
+    already, total = counts
+    workers, ray, timeout_s = where
     from dataclasses import replace
 
-    from openral_eval.sweep import run_pool, run_ray, run_serial
+    from openral_eval.sweep import run_pool, run_ray
 
     with progress() as bar:
         task = bar.add_task("episodes", total=total, completed=already)
@@ -280,10 +302,9 @@ def _run(
         clock.start()
         if ray is not None:
             run_ray(todo, ray, workers, record, clock.mark_ready)
-        elif workers == 1 or len(todo) <= 1:
-            run_serial(todo, record, clock.mark_ready)
-        else:
-            run_pool(todo, min(workers, len(todo)), record, clock.mark_ready)
+        elif todo:  # even one worker is a process of its own: a policy's crash costs only
+            # its episode (sys.exit, a segfault), and a hung one its time limit
+            run_pool(todo, min(workers, len(todo)), record, clock.mark_ready, timeout_s)
 
 
 def _report(lines: list[dict[str, object]], policy: str, out_dir: Path, clock: SweepClock) -> None:
