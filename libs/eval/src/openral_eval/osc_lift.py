@@ -46,6 +46,9 @@ class OscLiftConfig:
 class OscLift:
     """The four-phase lift of the module doc; one instance per episode."""
 
+    config_type = OscLiftConfig
+    """Its parameters (``--param key=value``)."""
+
     needs_privileged = True
     """It reads the task state (only an evaluation episode gives it)."""
     required_slots: tuple[str, ...] = ()

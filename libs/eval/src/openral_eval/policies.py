@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 from openral_eval.osc_lift import OscLift, OscLiftConfig
@@ -22,6 +23,7 @@ from openral_eval.policy import (
     parse_config,
     parse_params,
 )
+from openral_eval.policy_source import build, is_reference, load_class
 from openral_eval.scripted_lift import LiftConfig, ScriptedLift
 from openral_eval.wave import WaveConfig, WavePolicy
 
@@ -62,14 +64,16 @@ loads a :class:`PolicyEntry`."""
 
 def make_policy(name: str, params: Mapping[str, str] | None = None) -> PolicyAdapter:
     """Build policy ``name`` from string parameters (its config's fields): a built-in one,
-    else one an installed package registers under :data:`ENTRY_POINT_GROUP`.
+    a class named by ``file.py:Class`` or ``package.module:Class``
+    (:mod:`openral_eval.policy_source`), else one an installed package registers under
+    :data:`ENTRY_POINT_GROUP`.
 
     Raises:
         PolicyConfigError: An unknown name (the message lists what there is), a registered
             entry point that does not load a PolicyEntry, a bad parameter, or a policy that
             does not declare what it needs (``required_slots``, ``needs_privileged``).
     """
-    entry = POLICIES.get(name) or _registered(name)
+    entry = POLICIES.get(name) or (_referenced(name) if is_reference(name) else _registered(name))
     policy: object = entry.build(parse_config(entry.config_type, params or {}, name))
     if not isinstance(policy, PolicyAdapter):
         wanted = ("required_slots", "needs_privileged", "act")
@@ -79,6 +83,12 @@ def make_policy(name: str, params: Mapping[str, str] | None = None) -> PolicyAda
             "declares the camera slots and the privileged state it needs"
         )
     return policy
+
+
+def _referenced(reference: str) -> PolicyEntry:
+    """The entry of a class named by ``file.py:Class`` or ``module:Class``."""
+    cls, config_type = load_class(reference)
+    return PolicyEntry(config_type, partial(build, cls))
 
 
 def _registered(name: str) -> PolicyEntry:

@@ -59,6 +59,9 @@ class LiftConfig:
 class ScriptedLift:
     """The four-phase lift of the module doc; one instance per episode."""
 
+    config_type = LiftConfig
+    """Its parameters (``--param key=value``)."""
+
     needs_privileged = True
     """It reads the simulation (only an evaluation episode on a native scene gives it)."""
     required_slots: tuple[str, ...] = ()

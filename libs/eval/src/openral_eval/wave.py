@@ -37,6 +37,9 @@ class WavePolicy:
     ``required_slots``, so a camera-less graph fails as a real VLA would.
     """
 
+    config_type = WaveConfig
+    """Its parameters (``--param key=value``)."""
+
     needs_privileged = False
     """It reads only the action spec and the clock."""
 
