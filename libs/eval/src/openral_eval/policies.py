@@ -34,8 +34,10 @@ __all__ = [
     "PolicyAdapter",
     "PolicyConfigError",
     "PolicyEntry",
+    "PolicyListing",
     "WaveConfig",
     "WavePolicy",
+    "available_policies",
     "make_policy",
     "parse_params",
 ]
@@ -112,3 +114,41 @@ def _registered(name: str) -> PolicyEntry:
             f"policy {name!r}: {where} is a {type(entry).__name__}, not a PolicyEntry"
         )
     return entry
+
+
+@dataclass(frozen=True)
+class PolicyListing:
+    """One policy that can be built by name: where it comes from and its parameters."""
+
+    name: str
+    source: str
+    """``built-in``, or the distribution and entry point that registers it."""
+    parameters: tuple[tuple[str, str], ...]
+    """(name, default as typed on the command line) of each ``-p`` parameter."""
+    problem: str = ""
+    """Why a registered policy cannot be built (its entry point does not load), else ''."""
+
+
+def available_policies() -> list[PolicyListing]:
+    """Every policy buildable by name: the built-in ones, then those installed packages
+    register under :data:`ENTRY_POINT_GROUP`, by name."""
+    from importlib.metadata import entry_points
+
+    listings = [PolicyListing(name, "built-in", _defaults(e)) for name, e in POLICIES.items()]
+    for point in sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda p: p.name):
+        source = f"{point.dist.name if point.dist else '?'} ({point.value})"
+        try:
+            listings.append(PolicyListing(point.name, source, _defaults(_registered(point.name))))
+        except PolicyConfigError as error:
+            listings.append(PolicyListing(point.name, source, (), str(error)))
+    return listings
+
+
+def _defaults(entry: PolicyEntry) -> tuple[tuple[str, str], ...]:
+    """Each config field and its default, written as ``-p`` would take it."""
+    import dataclasses
+
+    def text(value: object) -> str:
+        return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
+
+    return tuple((f.name, text(f.default)) for f in dataclasses.fields(entry.config_type))

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from openral_cli.commands.policies import policies
 from openral_cli.commands.sweep import sweep
 from openral_cli.console import out, progress
 from openral_cli.help_text import command_group
@@ -35,6 +36,7 @@ if TYPE_CHECKING:
 
 app = command_group("Run simulated scenes, or sweep a policy over scenes and seeds.")
 app.command("sweep")(sweep)
+app.command("policies")(policies)
 
 SWAY_RAD = 0.15
 """Amplitude of the demo motion around the start pose."""
