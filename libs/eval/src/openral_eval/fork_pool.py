@@ -12,8 +12,10 @@ own and runs one episode at a time:
   state a fork cannot carry (a GL context: the rasteriser's threads are not forked, so a
   child's first render waits for them forever), from a fresh server process (start method
   ``forkserver``), so they build what they need themselves;
-- a worker still on one episode after ``timeout_s`` of wall time (a policy that hangs) is
-  killed and replaced; that episode is given up at once (it would hang again);
+- a new worker reports when it is up, and an episode's time starts when it is handed to
+  a worker that is up; a worker still on one episode after ``timeout_s`` of wall time (a
+  policy that hangs) is killed and replaced; that episode is given up at once (it would
+  hang again);
 - they ignore Ctrl-C (this process decides when they stop) and are killed when their
   parent dies, even by ``SIGKILL`` (a ``forkserver`` exits when this process does).
 """
@@ -34,11 +36,21 @@ from multiprocessing.context import ForkContext, ForkServerContext
 from multiprocessing.process import BaseProcess
 from typing import Literal
 
+from openral_core.errors import OpenralError
+
 from openral_eval.episode import EpisodeResult, EpisodeSpec
 
 Run = Callable[[EpisodeSpec], EpisodeResult]
 StartMethod = Literal["fork", "forkserver"]
 _PR_SET_PDEATHSIG = 1
+READY = "ready"
+"""What a worker sends once it is up, before its first episode."""
+START_TIMEOUT_S = 120.0
+"""Longest a new worker may take to be up [s]."""
+
+
+class WorkerStartError(OpenralError):
+    """A worker process of the pool could not start."""
 
 
 GiveUp = Callable[[EpisodeSpec], EpisodeResult]
@@ -62,10 +74,28 @@ def _serve(run: Run, pipe: Connection, inherited: Sequence[Connection]) -> None:
     for other in inherited:  # the parent's ends, so that a parent's death closes our pipe
         other.close()
     try:
+        pipe.send(READY)  # an episode's time starts once a worker is up, not while it starts
         while (spec := pipe.recv()) is not None:
             pipe.send(run(spec))
     except (EOFError, BrokenPipeError):
         return
+
+
+def _await_ready(worker: _Worker) -> None:
+    """Wait for a new worker's :data:`READY` (a fork: milliseconds; a ``forkserver``
+    child: its imports, a second or more on a loaded machine).
+
+    Raises:
+        WorkerStartError: It died or stayed silent for :data:`START_TIMEOUT_S`.
+    """
+    try:
+        if worker.pipe.poll(START_TIMEOUT_S) and worker.pipe.recv() == READY:
+            return
+        why = f"did not start within {START_TIMEOUT_S:g} s"
+    except (EOFError, OSError):
+        why = f"died while starting (exit code {worker.process.exitcode})"
+    worker.process.kill()
+    raise WorkerStartError(f"a sweep worker process {why}")
 
 
 def _hand_out(worker: _Worker, queue: deque[EpisodeSpec]) -> None:
@@ -103,6 +133,8 @@ class ForkPool:
         self._workers: list[_Worker] = []
         for _ in range(workers):
             self._workers.append(self._fork())
+        for worker in self._workers:
+            _await_ready(worker)
 
     def _fork(self) -> _Worker:
         mine, theirs = self._context.Pipe()
@@ -169,7 +201,8 @@ class ForkPool:
         assert spec is not None
         worker.pipe.close()
         worker.process.join()
-        self._workers[self._workers.index(worker)] = self._fork()
+        self._workers[self._workers.index(worker)] = replacement = self._fork()
+        _await_ready(replacement)
         attempts[spec] += 1
         if attempts[spec] > self._retries:
             on_result(give_up(spec))
