@@ -14,6 +14,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+from openral_eval import fork_pool
 from openral_eval.episode import EpisodeResult, EpisodeSpec
 from openral_eval.fork_pool import ForkPool
 
@@ -25,6 +26,7 @@ TIMEOUT_S = 2.0
 DRIVER = """
 import time
 from openral_eval.episode import EpisodeSpec
+from openral_eval import fork_pool
 from openral_eval.fork_pool import ForkPool
 
 def slow(spec):
@@ -93,3 +95,21 @@ def test_a_hung_an_exiting_and_a_crashing_policy_each_cost_only_their_episode(
 def test_a_time_limit_must_be_positive() -> None:
     with pytest.raises(ValueError, match="time limit must be positive"):
         ForkPool(_hostile, 1, retries=0, timeout_s=0.0)
+
+
+def _dies_at_start(run: object, pipe: object, inherited: object) -> None:
+    os._exit(7)
+
+
+def _silent_at_start(run: object, pipe: object, inherited: object) -> None:
+    time.sleep(30)
+
+
+def test_a_worker_that_cannot_start_is_one_error(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(fork_pool, "_serve", _dies_at_start)
+    with pytest.raises(fork_pool.WorkerStartError, match=r"died while starting \(exit code 7\)"):
+        ForkPool(_hostile, 1, retries=0)
+    monkeypatch.setattr(fork_pool, "_serve", _silent_at_start)
+    monkeypatch.setattr(fork_pool, "START_TIMEOUT_S", 0.5)
+    with pytest.raises(fork_pool.WorkerStartError, match=r"did not start within 0\.5 s"):
+        ForkPool(_hostile, 1, retries=0)

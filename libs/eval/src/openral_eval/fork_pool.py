@@ -93,8 +93,10 @@ def _await_ready(worker: _Worker) -> None:
             return
         why = f"did not start within {START_TIMEOUT_S:g} s"
     except (EOFError, OSError):
+        worker.process.join(START_TIMEOUT_S)
         why = f"died while starting (exit code {worker.process.exitcode})"
     worker.process.kill()
+    worker.pipe.close()
     raise WorkerStartError(f"a sweep worker process {why}")
 
 
