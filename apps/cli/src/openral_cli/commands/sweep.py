@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 import os
 import time
+from collections import Counter
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -58,7 +59,7 @@ def parse_seeds(text: str) -> list[int]:
         ) from None
     if min(seeds) < 0:
         raise typer.BadParameter(f"{text!r} gives a negative seed", param_hint="--seeds")
-    repeated = sorted({seed for seed in seeds if seeds.count(seed) > 1})
+    repeated = sorted(seed for seed, count in Counter(seeds).items() if count > 1)
     if repeated:
         message = f"{text!r} gives seed {repeated[0]} more than once; each seed runs once"
         raise typer.BadParameter(message, param_hint="--seeds")
