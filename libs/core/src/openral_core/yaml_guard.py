@@ -31,7 +31,7 @@ import stat
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import yaml
 from yaml.error import MarkedYAMLError, YAMLError
@@ -193,6 +193,27 @@ def _position(event: Event) -> tuple[int, int]:
     return (mark.line + 1, mark.column + 1) if mark is not None else (1, 1)
 
 
+class MarkedError(Protocol):
+    """A YAML syntax error with where it was found: PyYAML's and ruamel's alike."""
+
+    problem: str | None
+    context: str | None
+
+    @property
+    def problem_mark(self) -> Any: ...
+
+    @property
+    def context_mark(self) -> Any: ...
+
+
+def syntax_issue(file: Path, error: MarkedError) -> Issue:
+    """The located issue of a YAML syntax error (PyYAML's or ruamel's; 0-based marks)."""
+    mark = error.problem_mark or error.context_mark
+    line, column = (mark.line + 1, mark.column + 1) if mark else (1, 1)
+    problem = error.problem or error.context or "invalid YAML"
+    return Issue(file, line, column, "", f"invalid YAML: {problem}")
+
+
 def scan_events(file: Path, text: str) -> None:
     """Check the event stream of ``text`` against the limits of the module docstring.
 
@@ -207,10 +228,7 @@ def scan_events(file: Path, text: str) -> None:
                 break
         _check_alias_ratio(scan)
     except MarkedYAMLError as error:
-        mark = error.problem_mark or error.context_mark
-        line, column = (mark.line + 1, mark.column + 1) if mark else (1, 1)
-        problem = error.problem or error.context or "invalid YAML"
-        scan.issues.append(Issue(file, line, column, "", f"invalid YAML: {problem}"))
+        scan.issues.append(syntax_issue(file, error))
     except YAMLError as error:  # reader-level problems the text checks did not foresee
         scan.issues.append(Issue(file, 1, 1, "", f"invalid YAML: {error}"))
     if scan.issues:

@@ -31,7 +31,7 @@ from ruamel.yaml.comments import CommentedMap, CommentedSeq
 from ruamel.yaml.error import MarkedYAMLError, YAMLError
 
 from openral_core.errors import Issue, ManifestError, PathKey, format_field
-from openral_core.yaml_guard import read_text, scan_events
+from openral_core.yaml_guard import read_text, scan_events, syntax_issue
 
 __all__ = ["LocatedDocument", "PathKey", "format_field", "load_located"]
 
@@ -90,10 +90,7 @@ def _parse(file: Path, text: str) -> LocatedDocument:
     try:
         raw = YAML(typ="rt").load(text)
     except MarkedYAMLError as error:  # YAML 1.2 that libyaml's 1.1 parser let through
-        mark = error.problem_mark or error.context_mark
-        line, column = (mark.line + 1, mark.column + 1) if mark else (1, 1)
-        issue = Issue(file, line, column, "", f"invalid YAML: {error.problem or error.context}")
-        raise ManifestError(file, [issue]) from None
+        raise ManifestError(file, [syntax_issue(file, error)]) from None
     except (YAMLError, ValueError, RecursionError) as error:  # the scan should prevent these
         issue = Issue(file, 1, 1, "", f"cannot be read as YAML ({type(error).__name__})")
         raise ManifestError(file, [issue]) from None
