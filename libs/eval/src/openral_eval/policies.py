@@ -13,9 +13,9 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import partial
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from openral_eval.osc_lift import OscLift, OscLiftConfig
+from openral_eval.osc_lift import OscLift
 from openral_eval.policy import (
     Observation,
     PolicyAdapter,
@@ -24,8 +24,11 @@ from openral_eval.policy import (
     parse_params,
 )
 from openral_eval.policy_source import build, is_reference, load_class
-from openral_eval.scripted_lift import LiftConfig, ScriptedLift
+from openral_eval.scripted_lift import ScriptedLift
 from openral_eval.wave import WaveConfig, WavePolicy
+
+if TYPE_CHECKING:
+    from importlib.metadata import EntryPoint
 
 __all__ = [
     "ENTRY_POINT_GROUP",
@@ -52,11 +55,11 @@ class PolicyEntry:
 
 
 POLICIES: dict[str, PolicyEntry] = {
-    "wave": PolicyEntry(WaveConfig, WavePolicy),
-    "scripted_lift": PolicyEntry(LiftConfig, ScriptedLift),
-    "osc_lift": PolicyEntry(OscLiftConfig, OscLift),
+    name: PolicyEntry(cls.config_type, cls)
+    for name, cls in (("wave", WavePolicy), ("scripted_lift", ScriptedLift), ("osc_lift", OscLift))
 }
-"""Built-in policies by name."""
+"""Built-in policies by name (each class declares its config, as a class named by
+``file.py:Class`` does)."""
 
 
 ENTRY_POINT_GROUP = "openral.policies"
@@ -102,16 +105,21 @@ def _registered(name: str) -> PolicyEntry:
     if point is None:
         names = ", ".join([*POLICIES, *sorted(found)])
         raise PolicyConfigError(f"unknown policy {name!r}; available: {names}")
+    return _load(point)
+
+
+def _load(point: EntryPoint) -> PolicyEntry:
+    """The PolicyEntry entry point ``point`` loads (a plug-in's failure in one line)."""
     where = f"entry point {point.value!r} of {point.dist.name if point.dist else '?'}"
     try:
         entry = point.load()
     except Exception as error:  # a broken plug-in is its package's fault, said in one line
         raise PolicyConfigError(
-            f"policy {name!r}: {where} does not load ({type(error).__name__}: {error})"
+            f"policy {point.name!r}: {where} does not load ({type(error).__name__}: {error})"
         ) from None
     if not isinstance(entry, PolicyEntry):
         raise PolicyConfigError(
-            f"policy {name!r}: {where} is a {type(entry).__name__}, not a PolicyEntry"
+            f"policy {point.name!r}: {where} is a {type(entry).__name__}, not a PolicyEntry"
         )
     return entry
 
@@ -138,7 +146,7 @@ def available_policies() -> list[PolicyListing]:
     for point in sorted(entry_points(group=ENTRY_POINT_GROUP), key=lambda p: p.name):
         source = f"{point.dist.name if point.dist else '?'} ({point.value})"
         try:
-            listings.append(PolicyListing(point.name, source, _defaults(_registered(point.name))))
+            listings.append(PolicyListing(point.name, source, _defaults(_load(point))))
         except PolicyConfigError as error:
             listings.append(PolicyListing(point.name, source, (), str(error)))
     return listings
