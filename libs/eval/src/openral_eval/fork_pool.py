@@ -169,9 +169,9 @@ class ForkPool:
             for worker in busy:
                 if not worker.pipe.poll():
                     if worker.spec and time.monotonic() - worker.started > self._timeout_s:
-                        worker.process.kill()
-                        attempts[worker.spec] = self._retries  # no second try: it hangs again
-                        self._replace(worker, queue, attempts, on_result, timed_out or died)
+                        worker.process.kill()  # no second try: it would hang again
+                        give_up = timed_out or died
+                        self._replace(worker, queue, attempts, on_result, give_up, retry=False)
                     continue
                 try:
                     result = worker.pipe.recv()
@@ -197,8 +197,11 @@ class ForkPool:
         attempts: dict[EpisodeSpec, int],
         on_result: Callable[[EpisodeResult], None],
         give_up: GiveUp,
+        *,
+        retry: bool = True,
     ) -> None:
-        """Fork a new worker in the dead one's place; try its episode again or give it up."""
+        """Fork a new worker in the dead one's place; try its episode again (at most
+        ``retries`` times, never when ``retry`` is False) or give it up."""
         spec = worker.spec
         assert spec is not None
         worker.pipe.close()
@@ -206,7 +209,7 @@ class ForkPool:
         self._workers[self._workers.index(worker)] = replacement = self._fork()
         _await_ready(replacement)
         attempts[spec] += 1
-        if attempts[spec] > self._retries:
+        if not retry or attempts[spec] > self._retries:
             on_result(give_up(spec))
         else:
             queue.appendleft(spec)
