@@ -1,0 +1,270 @@
+"""A gymnasium env for every scene file: the HAL contract, in the API trainers already use.
+
+``make_env("robots/franka_panda/scenes/tabletop.yaml", seed=0)`` (or
+``gymnasium.make("openral/Scene-v0", config={"scene": ...})``) builds the scene's HAL with
+:func:`~openral_hal.factory.build_hal`, exactly as ``deploy sim`` and ``sim sweep`` do, and
+wraps it:
+
+- the observation space is :class:`~openral_eval.env_observation.ObservationLayout`'s
+  ``Dict`` (joints in manifest units, every sensor at its own rate);
+- the action space is the scene's action contract in the chosen mode: in
+  ``joint_position``, one value per action slot (a native scene: per manifest joint, a
+  target in manifest units within the manifest's limits, grippers in their write mode;
+  robosuite: its controller's own action within its ``action_spec``), then, on a mobile
+  base, the base twist ``vx, vy, wz`` within the manifest's velocity limits;
+- ``reset(seed=s)`` draws the scene's randomisation from ``s`` (no seed: one drawn from the
+  env's generator, so a seeded env's episodes are reproducible);
+- ``step`` returns the scene's reward; ``terminated`` when the scene's own success check
+  holds or the task ends it, ``truncated`` at the scene's horizon or ``max_steps``; ``info``
+  carries ``success``, ``steps`` and ``sim_time_s``.
+
+An action outside the space (wrong shape, NaN, a value past its slot's bounds) raises
+:class:`~openral_mujoco.errors.ActionRejected` naming the slot, before anything moves.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, fields, replace
+from enum import StrEnum
+from pathlib import Path
+from typing import Any, SupportsFloat, cast
+
+import gymnasium
+import numpy as np
+import numpy.typing as npt
+from gymnasium import spaces
+from openral_core.loaded import LoadedRobot
+from openral_core.loader import load_scene
+from openral_hal.factory import HalMode, build_hal
+from openral_hal.sim_attached import SimAttachedHAL
+from openral_mujoco.action import Action, BaseTwist, validated_action
+from openral_mujoco.errors import ActionRejected
+from openral_sim.action_bounds import action_bounds
+from openral_sim.rollout import SceneRollout
+from openral_sim.scene import scene_robot
+from openral_sim.state_sensors import state_sensors_of
+
+from openral_eval.env_observation import EnvObservation, ObservationLayout
+
+ENV_ID = "openral/Scene-v0"
+"""The id :func:`gymnasium.make` knows the scene env by once this module is imported."""
+
+BASE_SLOTS = ("base_vx_m_s", "base_vy_m_s", "base_wz_rad_s")
+"""Names of a mobile base's action slots, after the joints."""
+
+
+class ActionMode(StrEnum):
+    """What an env action means."""
+
+    JOINT_POSITION = "joint_position"
+    """One target per action slot in manifest units (see the module doc)."""
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """Everything a scene env is built from."""
+
+    scene: str
+    """The scene file (``robots/<id>/scenes/<name>.yaml``)."""
+    action_mode: ActionMode = ActionMode.JOINT_POSITION
+    seed: int | None = None
+    """Seeds the env's generator (the seeds of resets without one); None: from the OS."""
+    privileged: bool = False
+    """Add the scene's task state (object poses) under ``privileged``."""
+    sensors: bool = True
+    """Render cameras, depth and lidar (False: joints, state sensors and base only)."""
+    max_steps: int | None = None
+    """Truncate after this many steps (None: the scene's horizon, if any)."""
+
+    @classmethod
+    def parse(cls, config: EnvConfig | Mapping[str, object]) -> EnvConfig:
+        """``config`` as an :class:`EnvConfig` (a mapping: by field name).
+
+        Raises:
+            ValueError: An unknown key, an unknown action mode, or a missing scene.
+        """
+        if isinstance(config, EnvConfig):
+            return replace(config, action_mode=_mode(config.action_mode))
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(config) - known)
+        if unknown:
+            raise ValueError(f"unknown env config keys {unknown}; valid: {sorted(known)}")
+        if "scene" not in config:
+            raise ValueError("env config needs 'scene': a scene file")
+        built = cls(**config)  # type: ignore[arg-type]
+        return replace(built, action_mode=_mode(built.action_mode))
+
+
+def _mode(value: object) -> ActionMode:
+    try:
+        return ActionMode(str(value) if isinstance(value, str) else repr(value))
+    except ValueError:
+        valid = ", ".join(m.value for m in ActionMode)
+        raise ValueError(f"unknown action mode {value!r}; valid: {valid}") from None
+
+
+class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
+    """One scene as a gymnasium env (see the module doc)."""
+
+    metadata = {"render_modes": ["rgb_array"]}  # noqa: RUF012 (gymnasium's own convention)
+
+    def __init__(
+        self,
+        config: EnvConfig | Mapping[str, object],
+        *,
+        render_mode: str | None = None,
+        hal: tuple[SimAttachedHAL, LoadedRobot] | None = None,
+    ) -> None:
+        """Build the scene's HAL (or use ``hal``, which the env then does not close) and
+        lay out the spaces from its first observation.
+
+        Raises:
+            ValueError: A bad config or render mode. ManifestError: A bad scene file.
+        """
+        self.config = EnvConfig.parse(config)
+        if render_mode not in (None, "rgb_array"):
+            raise ValueError(f"unknown render mode {render_mode!r}; valid: rgb_array")
+        self.render_mode = render_mode
+        self._owns_hal = hal is None
+        self.hal, self.robot = hal if hal is not None else _build(self.config.scene)
+        self._choose_sensors()
+        self.hal.env_reset_seed = 0
+        self.hal.release_estop()
+        if self.hal.connected:
+            self.hal.reset()
+        else:
+            self.hal.connect()
+        self.layout = ObservationLayout(
+            self.robot,
+            self.hal.last_observation(),
+            self.hal.read_state(),
+            privileged=self.config.privileged,
+        )
+        self.observation_space = cast(spaces.Space[EnvObservation], self.layout.space)
+        self._base = self.hal.base is not None
+        self.action_names = self.hal.action_names + (BASE_SLOTS if self._base else ())
+        """One name per action value."""
+        low, high = self._bounds()
+        self.box = spaces.Box(low, high, dtype=np.float64)
+        """The action space, typed as what it is."""
+        self.action_space = self.box
+        self.steps = 0
+        self._limit = self.config.max_steps or _horizon(self.hal)
+        if self.config.seed is not None:
+            self.action_space.seed(self.config.seed)
+            super().reset(seed=self.config.seed)
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[EnvObservation, dict[str, Any]]:
+        """A new episode: the scene's randomisation drawn from ``seed`` (see the module
+        doc); returns the first observation and ``info``."""
+        super().reset(seed=seed)
+        scene_seed = seed if seed is not None else int(self.np_random.integers(2**31 - 1))
+        self.hal.env_reset_seed = scene_seed
+        self.hal.release_estop()
+        self.hal.reset()
+        self.layout.reset()
+        self.steps = 0
+        obs = self._observe()
+        return obs, {"seed": scene_seed, **self._info(success=False)}
+
+    def step(
+        self, action: npt.NDArray[np.float64]
+    ) -> tuple[EnvObservation, SupportsFloat, bool, bool, dict[str, Any]]:
+        """One control period with ``action`` (see the module doc).
+
+        Raises:
+            ActionRejected: ``action`` is outside the action space; nothing moved.
+        """
+        values = self.checked(action)
+        width = self.hal.action_dim
+        if self._base:
+            vx, vy, wz = (float(v) for v in values[width:])
+            names = self.hal.action_names
+            slots = dict(zip(names, values[:width].tolist(), strict=True))
+            self.hal.send_action(Action(slots=slots, base=BaseTwist(vx, vy, wz)))
+        else:
+            self.hal.send_action(values)
+        self.steps += 1
+        outcome = self.hal.last_outcome
+        terminated = outcome.success or outcome.terminated
+        truncated = not terminated and (
+            outcome.truncated or (self._limit is not None and self.steps >= self._limit)
+        )
+        obs = self._observe()
+        info = self._info(success=outcome.success)
+        return obs, float(outcome.reward), terminated, truncated, info
+
+    def checked(self, action: object) -> npt.NDArray[np.float64]:
+        """``action`` as float64 values inside the action space, or :class:`ActionRejected`
+        naming the first bad slot."""
+        values = validated_action(action, self.action_names)
+        space = self.box
+        bad = np.flatnonzero((values < space.low) | (values > space.high))
+        if bad.size:
+            i = int(bad[0])
+            raise ActionRejected(
+                f"action[{i}] ({self.action_names[i]}) is {values[i]:g}; expected within "
+                f"[{space.low[i]:g}, {space.high[i]:g}] ({self.config.action_mode.value} mode)"
+            )
+        return values
+
+    def render(self) -> npt.NDArray[np.uint8] | None:
+        """The latest frame of the scene's first camera (None: no camera, or no render mode)."""
+        if self.render_mode is None:
+            return None
+        frames = self.hal.read_images()
+        return next(iter(frames.values()), None)
+
+    def close(self) -> None:
+        """Close the scene (an env given a HAL leaves it open for its owner)."""
+        if self._owns_hal:
+            self.hal.disconnect()
+
+    def _observe(self) -> EnvObservation:
+        return self.layout.observe(self.hal.last_observation(), self.hal.read_state())
+
+    def _info(self, *, success: bool) -> dict[str, Any]:
+        sim_time = self.hal.last_observation().time_s
+        return {"success": success, "steps": self.steps, "sim_time_s": sim_time}
+
+    def _choose_sensors(self) -> None:
+        """Render every sensor, or (``sensors=False``) only the state sensors."""
+        scene = self.hal.env if isinstance(self.hal.env, SceneRollout) else None
+        if scene is None:
+            return
+        states = {sensor.name for _, sensor in state_sensors_of(self.robot.description)}
+        scene.observed = None if self.config.sensors else frozenset(states)
+        scene.render_observations = True
+
+    def _bounds(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        low, high = action_bounds(self.hal.env, self.robot, self.hal.action_dim)
+        base = self.robot.tables.mobile_base
+        if self._base and base is not None:
+            top = np.array([base.max_linear_velocity_m_s] * 2 + [base.max_angular_velocity_rad_s])
+            low, high = np.concatenate([low, -top]), np.concatenate([high, top])
+        return low, high
+
+
+def _build(scene_file: str) -> tuple[SimAttachedHAL, LoadedRobot]:
+    """The HAL of ``scene_file`` (not yet connected) and its robot."""
+    scene = load_scene(Path(scene_file))
+    robot = scene_robot(scene)
+    hal = build_hal(robot, mode=HalMode.SIM, scene=scene)
+    if not isinstance(hal, SimAttachedHAL):  # build_hal attaches every scene
+        raise TypeError(f"build_hal gave a {type(hal).__name__} for scene {scene_file}")
+    return hal, robot
+
+
+def _horizon(hal: SimAttachedHAL) -> int | None:
+    return hal.env.horizon if isinstance(hal.env, SceneRollout) else None
+
+
+def make_env(scene: str | Path, **config: object) -> SceneEnv:
+    """The env of ``scene``; ``config``: the other :class:`EnvConfig` fields."""
+    return SceneEnv({"scene": str(scene), **config})
+
+
+gymnasium.register(id=ENV_ID, entry_point=f"{__name__}:SceneEnv")

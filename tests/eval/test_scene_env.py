@@ -1,0 +1,153 @@
+"""The gymnasium env of a scene file: spaces from the manifest, seeded resets, refused bad
+actions, gymnasium's own checker, and a vector env that matches single envs."""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from collections.abc import Iterator
+from pathlib import Path
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+from openral_eval.scene_env import ENV_ID, SceneEnv, make_env
+from openral_mujoco.errors import ActionRejected
+
+from tests.conftest import ROBOTS
+
+TABLETOP = ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml"
+SCENES = sorted(ROBOTS.glob("*/scenes/*.yaml"))
+
+
+@pytest.fixture(scope="module")
+def panda() -> Iterator[SceneEnv]:
+    env = make_env(TABLETOP, seed=0, privileged=True)
+    yield env
+    env.close()
+
+
+def _digest(env: gymnasium.Env, actions: list[np.ndarray], seed: int) -> str:  # type: ignore[type-arg]
+    obs, _ = env.reset(seed=seed)
+    digest = hashlib.sha256(obs["joint_positions"].tobytes())
+    for action in actions:
+        obs, *_ = env.step(action)
+        digest.update(obs["joint_positions"].tobytes())
+    return digest.hexdigest()
+
+
+def test_spaces_follow_the_manifest(panda: SceneEnv) -> None:
+    joints = [j.name for j in panda.robot.description.joints]
+    space = panda.layout.space
+    assert space["joint_positions"].shape == (len(joints),)
+    assert space["joint_velocities"].shape == (len(joints),)
+    assert panda.action_names == tuple(joints)
+    first = panda.robot.description.joints[0]
+    assert panda.box.low[0] == first.position_limits[0]
+    assert panda.box.high[0] == first.position_limits[1]
+    cameras = [s.name for s in panda.robot.description.sensors if s.kind == "rgb"]
+    assert sorted(space["cameras"].keys()) == sorted(cameras)
+    slots = {slot.slot for slot in panda.robot.tables.vla_slots}
+    assert set(space["camera_slots"].keys()) == slots
+    obs, info = panda.reset(seed=3)
+    assert panda.observation_space.contains(obs)
+    assert "red_cube_pos" in obs["privileged"]
+    assert info["seed"] == 3 and info["success"] is False
+
+
+def test_seed_draws_the_randomisation_and_repeats(panda: SceneEnv) -> None:
+    first, _ = panda.reset(seed=1)
+    again, _ = panda.reset(seed=1)
+    other, _ = panda.reset(seed=2)
+    np.testing.assert_array_equal(
+        first["privileged"]["red_cube_pos"], again["privileged"]["red_cube_pos"]
+    )
+    assert not np.array_equal(
+        first["privileged"]["red_cube_pos"], other["privileged"]["red_cube_pos"]
+    )
+
+
+@pytest.mark.parametrize(
+    ("edit", "expected"),
+    [
+        (lambda a: a[:-1], "expected 8"),
+        (lambda a: np.where(np.arange(a.size) == 2, np.nan, a), "action[2] (panda_joint3) is nan"),
+        (lambda a: np.where(np.arange(a.size) == 0, 9.0, a), "action[0] (panda_joint1) is 9; "),
+        (lambda a: [*a.tolist()[:-1], "x"], "is a str"),
+    ],
+)
+def test_a_bad_action_is_refused_naming_its_slot_and_nothing_moves(
+    panda: SceneEnv, edit: object, expected: str
+) -> None:
+    panda.reset(seed=0)
+    good = panda.hal.hold_action()
+    panda.step(good)
+    before = panda.hal.read_state()
+    with pytest.raises(ActionRejected, match=re.escape(expected)):
+        panda.step(edit(good))  # type: ignore[operator]
+    after = panda.hal.read_state()
+    assert after.sim_time_s == before.sim_time_s
+    np.testing.assert_array_equal(after.positions, before.positions)
+    assert panda.steps == 1
+
+
+def test_an_unknown_mode_or_key_is_one_clear_error() -> None:
+    with pytest.raises(ValueError, match="unknown action mode 'ee_fly'; valid: joint_position"):
+        make_env(TABLETOP, action_mode="ee_fly")
+    with pytest.raises(ValueError, match=r"unknown env config keys \['sede'\]"):
+        make_env(TABLETOP, sede=1)
+
+
+def test_max_steps_truncates(panda: SceneEnv) -> None:
+    env = SceneEnv({"scene": str(TABLETOP), "max_steps": 2}, hal=(panda.hal, panda.robot))
+    env.reset(seed=0)
+    hold = panda.hal.hold_action()
+    assert env.step(hold)[3] is False
+    assert env.step(hold)[3] is True
+
+
+def test_gymnasium_make_builds_it_by_id() -> None:
+    env = gymnasium.make(ENV_ID, config={"scene": str(TABLETOP), "sensors": False})
+    try:
+        obs, _ = env.reset(seed=0)
+        assert "cameras" not in obs and obs["joint_positions"].shape == (8,)
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("scene", SCENES, ids=lambda p: f"{p.parent.parent.name}/{p.stem}")
+def test_gymnasium_check_env_passes(scene: Path) -> None:
+    env = make_env(scene, seed=0)
+    try:
+        check_env(env, skip_render_check=True)
+        obs, _ = env.reset(seed=0)
+        assert env.observation_space.contains(obs)
+    finally:
+        env.close()
+
+
+def test_a_vector_env_matches_single_envs_step_for_step() -> None:
+    config = {"scene": str(TABLETOP), "sensors": False}
+    single = make_env(TABLETOP, sensors=False, seed=0)
+    rng = np.random.default_rng(7)
+    space = single.box
+    hold = single.hal.hold_action()
+    actions = [
+        np.clip(hold + rng.normal(0, 0.05, hold.shape), space.low, space.high) for _ in range(20)
+    ]
+    expected = [_digest(single, actions, seed) for seed in (11, 12)]
+    single.close()
+    vector = gymnasium.vector.AsyncVectorEnv(
+        [lambda: gymnasium.make(ENV_ID, config=config)] * 2, context="fork"
+    )
+    try:
+        obs, _ = vector.reset(seed=[11, 12])
+        digests = [hashlib.sha256(obs["joint_positions"][i].tobytes()) for i in range(2)]
+        for action in actions:
+            obs, *_ = vector.step(np.stack([action, action]))
+            for i in range(2):
+                digests[i].update(obs["joint_positions"][i].tobytes())
+    finally:
+        vector.close()
+    assert [d.hexdigest() for d in digests] == expected
