@@ -7,10 +7,12 @@ policy that observes none makes the scene render nothing.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import ClassVar
 
 import numpy as np
-from openral_eval.episode import EpisodeSpec, run_episode
+import pytest
+from openral_eval.episode import EpisodeSpec, close_scenes, run_episode
 from openral_eval.policies import POLICIES, PolicyEntry
 from openral_eval.policy import Observation
 from openral_eval.wave import WaveConfig
@@ -18,6 +20,13 @@ from openral_eval.wave import WaveConfig
 from tests.conftest import ROBOTS
 
 SCENE = str(ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml")
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _scenes_closed() -> Iterator[None]:
+    """This process's episode scenes are freed while EGL is still up."""
+    yield
+    close_scenes()
 
 
 class FrameLog:

@@ -4,7 +4,9 @@ An episode is a pure function of its :class:`EpisodeSpec` (scene file, seed, pol
 parameters, step limit): :func:`run_episode` resets the scene with the seed (its declared
 randomisation), then, once per control step, builds the policy's observation, takes its
 action and hands it to the HAL :func:`~openral_hal.factory.build_hal` attached to the
-scene, exactly the contract ``deploy sim`` drives (manifest units, limits, the E-stop).
+scene, exactly the contract ``deploy sim`` drives (manifest units, limits, the E-stop),
+through the scene's gymnasium env (:class:`~openral_eval.scene_env.SceneEnv`, the one
+``make_env`` gives trainers): the same reset, action check and end of episode.
 It ends when the scene reports success (the step's :class:`~openral_sim.observation.Outcome`:
 a native scene's ``success`` predicates, robosuite's own check), when the scene ends the
 episode (its horizon), or after ``steps`` steps.
@@ -43,6 +45,7 @@ from openral_sim.sensor_schedule import sensor_rates
 from openral_eval.policies import make_policy
 from openral_eval.policy import Observation, PolicyAdapter
 from openral_eval.privileged import Pose, Privileged, PrivilegedGripper
+from openral_eval.scene_env import EnvConfig, SceneEnv
 from openral_eval.video import VideoWriter
 
 DEFAULT_STEPS = 300
@@ -99,6 +102,8 @@ class EpisodeResult:
 
 _HALS: dict[str, tuple[SimAttachedHAL, LoadedRobot]] = {}
 """This process's scenes (attached HALs) by file, built on first use."""
+_ENVS: dict[tuple[str, tuple[str, ...], int], SceneEnv] = {}
+"""This process's envs on those HALs, by scene, rendered sensors and step limit."""
 
 
 def scene_for(path: str) -> tuple[SimAttachedHAL, LoadedRobot]:
@@ -119,6 +124,7 @@ def scene_for(path: str) -> tuple[SimAttachedHAL, LoadedRobot]:
 def close_scenes() -> None:
     """Disconnect this process's scenes (their renderers' GL contexts are freed while the
     display still exists, not at the interpreter's teardown)."""
+    _ENVS.clear()
     while _HALS:
         _, (hal, _) = _HALS.popitem()
         hal.disconnect()
@@ -167,29 +173,39 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> _Run:
     inputs = _Inputs(hal, robot, policy)
     camera = inputs.video_camera(spec.video)
     video = VideoWriter.for_camera(spec.video, camera, _frame_rate_hz(hal, robot, camera))
-    inputs.observe(camera)
-    hal.env_reset_seed = spec.seed
-    hal.release_estop()
-    hal.connect()  # a new episode: the scene reset with the seed
-    limit = spec.steps or _horizon(hal) or DEFAULT_STEPS
+    env = env_for(spec, inputs.sensors(camera))
+    env.reset(seed=spec.seed)
     run, started = _Run(frames=len(hal.last_observation().images)), hal.read_state().sim_time_s
     try:
-        while run.steps < limit and not run.success:
+        done = False
+        while not done:
             state = hal.read_state()
             digest.update(state.positions.tobytes())
             video.add(hal.last_observation())
-            hal.send_action(policy.act(inputs.observation(state.positions, run.steps)))
+            action = policy.act(inputs.observation(state.positions, run.steps))
+            _, _, terminated, truncated, info = env.step(env.clipped(action))
             run.steps += 1
             run.frames += len(hal.last_observation().images)
-            run.success = hal.last_outcome.success
-            if hal.episode_done and not run.success:
-                break
+            run.success = bool(info["success"])
+            done = terminated or truncated
         video.add(hal.last_observation())
     finally:
         video.close()
     digest.update(hal.read_state().positions.tobytes())
     run.sim_time_s = float(hal.read_state().sim_time_s or 0.0) - float(started or 0.0)
     return run
+
+
+def env_for(spec: EpisodeSpec, sensors: tuple[str, ...]) -> SceneEnv:
+    """The gymnasium env an episode steps (the one :func:`~openral_eval.make_env` gives, on
+    this process's HAL of the scene): ``sensors`` rendered, truncated at the step limit."""
+    hal, robot = scene_for(spec.scene)
+    limit = spec.steps or _horizon(hal) or DEFAULT_STEPS
+    config = EnvConfig(spec.scene, sensors=sensors, max_steps=limit)
+    key = (spec.scene, sensors, limit)
+    if key not in _ENVS:
+        _ENVS[key] = SceneEnv(config, hal=(hal, robot))
+    return _ENVS[key]
 
 
 def _frame_rate_hz(hal: SimAttachedHAL, robot: LoadedRobot, camera: str | None) -> float:
@@ -226,12 +242,10 @@ class _Inputs:
         names = self.hal.env.camera_names
         return names[0] if path is not None and names else None
 
-    def observe(self, video_camera: str | None) -> None:
-        """Render only the cameras the policy and the video read (a native scene)."""
-        if self.scene is not None:
-            wanted = {*self.slots.values(), *([video_camera] if video_camera else [])}
-            self.scene.observed = frozenset(wanted)
-            self.scene.render_observations = True
+    def sensors(self, video_camera: str | None) -> tuple[str, ...]:
+        """The only cameras to render: those the policy and the video read."""
+        wanted = {*self.slots.values(), *([video_camera] if video_camera else [])}
+        return tuple(sorted(wanted))
 
     def observation(self, positions: np.ndarray, step: int) -> Observation:
         hal = self.hal

@@ -72,8 +72,9 @@ class EnvConfig:
     """Seeds the env's generator (the seeds of resets without one); None: from the OS."""
     privileged: bool = False
     """Add the scene's task state (object poses) under ``privileged``."""
-    sensors: bool = True
-    """Render cameras, depth and lidar (False: joints, state sensors and base only)."""
+    sensors: bool | tuple[str, ...] = True
+    """Which cameras, depth sensors and lidars the observation carries: True all, False
+    none, or these by manifest name (state sensors, joints and the base are always in)."""
     max_steps: int | None = None
     """Truncate after this many steps (None: the scene's horizon, if any)."""
 
@@ -128,6 +129,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         self.render_mode = render_mode
         self._owns_hal = hal is None
         self.hal, self.robot = hal if hal is not None else _build(self.config.scene)
+        self._observed = self._chosen_sensors()
         self._choose_sensors()
         self.hal.env_reset_seed = 0
         self.hal.release_estop()
@@ -164,6 +166,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         scene_seed = seed if seed is not None else int(self.np_random.integers(2**31 - 1))
         self.hal.env_reset_seed = scene_seed
         self.hal.release_estop()
+        self._choose_sensors()
         self.hal.reset()
         self.layout.reset()
         self.steps = 0
@@ -211,6 +214,17 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
             )
         return values
 
+    def clipped(self, action: object) -> npt.NDArray[np.float64]:
+        """``action`` clamped onto the action space, as ``deploy sim`` clamps a command
+        onto the manifest's limits (an evaluation episode drives a policy by that contract;
+        :meth:`step` itself refuses what is outside).
+
+        Raises:
+            ActionRejected: Wrong type or width, or a non-finite value.
+        """
+        values = validated_action(action, self.action_names)
+        return np.clip(values, self.box.low, self.box.high)
+
     def render(self) -> npt.NDArray[np.uint8] | None:
         """The latest frame of the scene's first camera (None: no camera, or no render mode)."""
         if self.render_mode is None:
@@ -230,14 +244,33 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         sim_time = self.hal.last_observation().time_s
         return {"success": success, "steps": self.steps, "sim_time_s": sim_time}
 
-    def _choose_sensors(self) -> None:
-        """Render every sensor, or (``sensors=False``) only the state sensors."""
-        scene = self.hal.env if isinstance(self.hal.env, SceneRollout) else None
-        if scene is None:
-            return
+    def _chosen_sensors(self) -> frozenset[str] | None:
+        """The sensors the config asks for (None: all); unknown names are refused.
+
+        Raises:
+            ValueError: A name that is no sensor of the manifest.
+        """
+        chosen = self.config.sensors
+        if chosen is True:
+            return None
+        names = () if chosen is False else tuple(chosen)
+        known = {sensor.name for sensor in self.robot.description.sensors}
+        unknown = sorted(set(names) - known)
+        if unknown:
+            raise ValueError(
+                f"env config sensors {unknown} are not sensors of {self.robot.name}; "
+                f"valid: {sorted(known)}"
+            )
         states = {sensor.name for _, sensor in state_sensors_of(self.robot.description)}
-        scene.observed = None if self.config.sensors else frozenset(states)
-        scene.render_observations = True
+        return frozenset(names) | states
+
+    def _choose_sensors(self) -> None:
+        """Let a native scene render the chosen sensors into its observations (a HAL
+        shared with another env may have been told otherwise)."""
+        scene = self.hal.env if isinstance(self.hal.env, SceneRollout) else None
+        if scene is not None:
+            scene.observed = self._observed
+            scene.render_observations = True
 
     def _bounds(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         low, high = action_bounds(self.hal.env, self.robot, self.hal.action_dim)
