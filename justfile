@@ -69,6 +69,10 @@ layers:
 # The static checks CI runs after the tests: lint, types, import layers, generated-tree drift.
 check: lint typecheck layers schema-check
 
+# The gymnasium env's step against the scene's own, and a vector env of 2 against one env.
+bench-env *ARGS:
+    python -m benchmarks.env_step {{ARGS}}
+
 # HAL overhead per robot against a raw mj_step loop; writes benchmarks/results/hal_step.json.
 bench-hal *ARGS:
     python -m benchmarks.hal_step {{ARGS}}

@@ -7,12 +7,17 @@ import hashlib
 import re
 from collections.abc import Iterator
 from pathlib import Path
+from typing import ClassVar
 
 import gymnasium
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
+from openral_eval.episode import EpisodeSpec, close_scenes, run_episode
+from openral_eval.policies import POLICIES, PolicyEntry
+from openral_eval.policy import Observation
 from openral_eval.scene_env import ENV_ID, SceneEnv, make_env
+from openral_eval.wave import WaveConfig
 from openral_mujoco.errors import ActionRejected
 
 from tests.conftest import ROBOTS
@@ -151,3 +156,42 @@ def test_a_vector_env_matches_single_envs_step_for_step() -> None:
     finally:
         vector.close()
     assert [d.hexdigest() for d in digests] == expected
+
+
+class _Recorder:
+    """Hold plus seeded noise on every slot (clamped by the episode), remembering each action."""
+
+    required_slots = ()
+    needs_privileged = False
+    actions: ClassVar[list[np.ndarray]] = []
+
+    def __init__(self, config: WaveConfig) -> None:
+        _Recorder.actions = []
+        self.rng = np.random.default_rng(5)
+
+    def act(self, obs: Observation) -> np.ndarray:
+        hold = obs["action_spec"][1]
+        action = hold + self.rng.normal(0.0, 0.05, hold.shape)
+        _Recorder.actions.append(action)
+        return action
+
+
+def test_a_sweep_episode_is_the_env_stepped_with_the_same_actions(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setitem(POLICIES, "recorder", PolicyEntry(WaveConfig, _Recorder))
+    try:
+        result = run_episode(EpisodeSpec(str(TABLETOP), 4, "recorder", (), 15))
+    finally:
+        close_scenes()
+    assert result.error is None and result.steps == 15
+    env = make_env(TABLETOP, sensors=False)
+    try:
+        obs, _ = env.reset(seed=4)
+        digest = hashlib.sha256(obs["joint_positions"].tobytes())
+        for action in _Recorder.actions:
+            obs, *_ = env.step(np.clip(action, env.box.low, env.box.high))
+            digest.update(obs["joint_positions"].tobytes())
+    finally:
+        env.close()
+    assert digest.hexdigest() == result.trajectory_sha256

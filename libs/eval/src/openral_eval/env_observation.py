@@ -54,13 +54,16 @@ def _depth_image(depth_m: npt.NDArray[np.floating]) -> npt.NDArray[np.float32]:
     return np.nan_to_num(depth_m.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
 
 
+_FIELDS: dict[type, tuple[str, ...]] = {}
+"""Vector fields of each reading type (its time stamp is the observation's)."""
+
+
 def _reading(reading: Reading) -> dict[str, npt.NDArray[np.float64]]:
-    """A state-sensor reading's vector fields (its time stamp is the observation's)."""
-    return {
-        f.name: np.asarray(getattr(reading, f.name), dtype=np.float64)
-        for f in fields(reading)
-        if f.name != "sim_time_s"
-    }
+    """A state-sensor reading's vector fields."""
+    kind = type(reading)
+    if kind not in _FIELDS:
+        _FIELDS[kind] = tuple(f.name for f in fields(reading) if f.name != "sim_time_s")
+    return {name: np.asarray(getattr(reading, name), dtype=np.float64) for name in _FIELDS[kind]}
 
 
 class ObservationLayout:

@@ -16,7 +16,7 @@ wraps it:
   env's generator, so a seeded env's episodes are reproducible);
 - ``step`` returns the scene's reward; ``terminated`` when the scene's own success check
   holds or the task ends it, ``truncated`` at the scene's horizon or ``max_steps``; ``info``
-  carries ``success``, ``steps`` and ``sim_time_s``.
+  carries ``success`` (and, from ``reset``, the scene's ``seed``).
 
 An action outside the space (wrong shape, NaN, a value past its slot's bounds) raises
 :class:`~openral_mujoco.errors.ActionRejected` naming the slot, before anything moves.
@@ -205,9 +205,9 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         naming the first bad slot."""
         values = validated_action(action, self.action_names)
         space = self.box
-        bad = np.flatnonzero((values < space.low) | (values > space.high))
-        if bad.size:
-            i = int(bad[0])
+        outside = (values < space.low) | (values > space.high)
+        if outside.any():
+            i = int(np.argmax(outside))
             raise ActionRejected(
                 f"action[{i}] ({self.action_names[i]}) is {values[i]:g}; expected within "
                 f"[{space.low[i]:g}, {space.high[i]:g}] ({self.config.action_mode.value} mode)"
@@ -238,11 +238,14 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
             self.hal.disconnect()
 
     def _observe(self) -> EnvObservation:
-        return self.layout.observe(self.hal.last_observation(), self.hal.read_state())
+        obs = self.hal.last_observation()  # a native scene's carries the HAL's joint sample
+        return self.layout.observe(obs, obs.joints or self.hal.read_state())
 
-    def _info(self, *, success: bool) -> dict[str, Any]:
-        sim_time = self.hal.last_observation().time_s
-        return {"success": success, "steps": self.steps, "sim_time_s": sim_time}
+    @staticmethod
+    def _info(*, success: bool) -> dict[str, Any]:
+        """Only what a trainer needs each step (a vector env merges every key of every env
+        on every step: each costs its share of the step)."""
+        return {"success": success}
 
     def _chosen_sensors(self) -> frozenset[str] | None:
         """The sensors the config asks for (None: all); unknown names are refused.

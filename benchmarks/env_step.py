@@ -1,0 +1,177 @@
+"""The gymnasium env's cost: its step against the native scene's own step, and a vector env
+of 2 against one env.
+
+On franka_panda's tabletop (20 Hz control): the scene's own ``step(hold)`` on the rollout
+the env wraps, against ``SceneEnv.step(hold)`` (the action check, the HAL, the Dict
+observation), both with cameras off and with both cameras on, interleaved, best of
+``--repeats``. Then ``gymnasium.vector.AsyncVectorEnv`` of 2 (cameras off, one process per
+env) against one env in this process: env steps per second summed over the envs, beside
+the ratio gymnasium's own inter-process steps allow for an env that only burns the same
+time per step (the ceiling: pipes, pickling and the merging of ``info``). Run with
+``just bench-env``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from collections.abc import Callable
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import gymnasium
+import numpy as np
+from openral_core.paths import repo_root
+from openral_eval.scene_env import ENV_ID, SceneEnv, make_env
+from openral_sim.rollout import SceneRollout
+from rich.console import Console
+from rich.table import Table
+
+from benchmarks.results_file import write_results
+
+SCENE = str(repo_root() / "robots" / "franka_panda" / "scenes" / "tabletop.yaml")
+MAX_OVERHEAD = 0.05
+"""Env step time over the scene's own step time, minus 1, at most."""
+MIN_VECTOR_SPEEDUP = 1.7
+"""Env steps/s of a vector env of 2 over one env, at least."""
+
+
+def rate(step: Callable[[], object], steps: int) -> float:
+    """Calls of ``step`` per second."""
+    start = time.perf_counter()
+    for _ in range(steps):
+        step()
+    return steps / (time.perf_counter() - start)
+
+
+def step_rates(env: SceneEnv, steps: int, repeats: int) -> tuple[float, float]:
+    """(scene steps/s, env steps/s), best of ``repeats`` interleaved runs."""
+    scene = env.hal.env
+    if not isinstance(scene, SceneRollout):
+        raise TypeError("the tabletop is a native scene")
+    hold = env.hal.hold_action()
+    env.reset(seed=0)
+    best_scene = best_env = 0.0
+    for _ in range(repeats):
+        best_scene = max(best_scene, rate(lambda: scene.step(hold), steps))
+        best_env = max(best_env, rate(lambda: env.step(hold), steps))
+    return best_scene, best_env
+
+
+class BusyEnv(gymnasium.Env[dict[str, np.ndarray], np.ndarray]):
+    """gymnasium's own ceiling: an env that only keeps a core busy for ``cost_s`` per step
+    and returns observations like the scene env's (cameras off)."""
+
+    def __init__(self, cost_s: float, like: SceneEnv) -> None:
+        self.cost_s = cost_s
+        self.observation_space = like.layout.space
+        self.action_space = like.box
+        self.obs, _ = like.reset(seed=0)
+
+    def reset(self, *, seed: int | None = None, options: object = None) -> tuple[object, dict]:
+        super().reset(seed=seed)
+        return self.obs, {"seed": 0, "success": False}
+
+    def step(self, action: np.ndarray) -> tuple[object, float, bool, bool, dict]:
+        end = time.perf_counter() + self.cost_s
+        while time.perf_counter() < end:
+            pass
+        return self.obs, 0.0, False, False, {"success": False}
+
+
+def ceiling(cost_s: float, steps: int, repeats: int) -> float:
+    """What an AsyncVectorEnv of 2 gains over one env when a step costs ``cost_s`` [s] and
+    does nothing else: the ratio gymnasium's inter-process steps allow here."""
+    like = make_env(SCENE, sensors=False)
+    envs = [BusyEnv(cost_s, like) for _ in range(3)]
+    like.close()
+    vector = gymnasium.vector.AsyncVectorEnv([lambda: envs[1], lambda: envs[2]])
+    try:
+        vector.reset(seed=[0, 1])
+        action = envs[0].action_space.sample()
+        both = np.stack([action] * 2)
+        one = max(rate(lambda: envs[0].step(action), steps) for _ in range(repeats))
+        two = max(2 * rate(lambda: vector.step(both), steps) for _ in range(repeats))
+        return two / one
+    finally:
+        vector.close()
+
+
+def vector_speedup(steps: int, repeats: int) -> tuple[float, float]:
+    """(one env's steps/s, an AsyncVectorEnv of 2's env steps/s), cameras off, best of
+    ``repeats`` runs of each, interleaved (the machine's load changes both alike)."""
+    config = {"scene": SCENE, "sensors": False}
+    vector = gymnasium.vector.AsyncVectorEnv([lambda: gymnasium.make(ENV_ID, config=config)] * 2)
+    single = make_env(SCENE, sensors=False)
+    try:
+        vector.reset(seed=[0, 1])
+        single.reset(seed=0)
+        hold = single.hal.hold_action()
+        both = np.stack([hold] * 2)
+        best_one = best_two = 0.0
+        for _ in range(repeats):
+            best_one = max(best_one, rate(lambda: single.step(hold), steps))
+            best_two = max(best_two, 2 * rate(lambda: vector.step(both), steps))
+        return best_one, best_two
+    finally:
+        vector.close()
+        single.close()
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--steps", type=int, default=400, help="timed steps per run")
+    parser.add_argument("--repeats", type=int, default=5, help="interleaved runs")
+    args = parser.parse_args()
+    console = Console()
+    rates: dict[str, tuple[float, float]] = {}
+    with console.status("measuring the env step"):
+        for label, sensors in (("cameras off", False), ("2 cameras on", True)):
+            env = make_env(SCENE, sensors=sensors)
+            steps = args.steps if sensors is False else args.steps // 4
+            rates[label] = step_rates(env, steps, args.repeats)
+            env.close()
+    with console.status("measuring a vector env of 2"):
+        one, two = vector_speedup(args.steps, args.repeats)
+        bound = ceiling(1.0 / one, args.steps, args.repeats)
+    table = Table(title=f"franka_panda tabletop, 20 Hz control (best of {args.repeats})")
+    for column in ("case", "scene steps/s", "env steps/s", "env overhead"):
+        table.add_column(column, justify="left" if column == "case" else "right")
+    overheads = {}
+    for label, (scene_rate, env_rate) in rates.items():
+        overheads[label] = scene_rate / env_rate - 1.0
+        colour = "green" if overheads[label] <= MAX_OVERHEAD else "red"
+        table.add_row(
+            label, f"{scene_rate:.0f}", f"{env_rate:.0f}", f"[{colour}]{overheads[label]:+.1%}[/]"
+        )
+    speedup = two / one
+    colour = "green" if speedup >= MIN_VECTOR_SPEEDUP else "red"
+    table.add_row("one env, cameras off", "", f"{one:.0f}", "1.00x")
+    table.add_row(
+        "AsyncVectorEnv x2, cameras off", "", f"{two:.0f}", f"[{colour}]{speedup:.2f}x[/]"
+    )
+    table.add_row(f"gymnasium's ceiling at {1e3 / one:.2f} ms per step", "", "", f"{bound:.2f}x")
+    console.print(table)
+    path = write_results(
+        "env_step",
+        {
+            "steps": args.steps,
+            "repeats": args.repeats,
+            "rates": {k: {"scene": s, "env": e} for k, (s, e) in rates.items()},
+            "overhead": overheads,
+            "one_env_steps_per_s": one,
+            "vector_2_steps_per_s": two,
+            "vector_speedup": speedup,
+            "vector_ceiling_same_step_cost": bound,
+        },
+    )
+    console.print(
+        f"targets: env overhead ≤ {MAX_OVERHEAD:.0%}, vector of 2 ≥ {MIN_VECTOR_SPEEDUP}x one env."
+        f" Written to {path}."
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
