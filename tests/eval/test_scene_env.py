@@ -98,7 +98,9 @@ def test_a_bad_action_is_refused_naming_its_slot_and_nothing_moves(
 
 
 def test_an_unknown_mode_or_key_is_one_clear_error() -> None:
-    with pytest.raises(ValueError, match="unknown action mode 'ee_fly'; valid: joint_position"):
+    with pytest.raises(
+        ValueError, match="unknown action mode 'ee_fly'; valid: joint_position, ee_delta_pose"
+    ):
         make_env(TABLETOP, action_mode="ee_fly")
     with pytest.raises(ValueError, match=r"unknown env config keys \['sede'\]"):
         make_env(TABLETOP, sede=1)

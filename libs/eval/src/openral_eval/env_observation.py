@@ -9,6 +9,9 @@ key                       value                                                 
 ``joint_positions``       every manifest joint, manifest order (grippers per their  rad, m
                           read mode)
 ``joint_velocities``      the same joints                                           rad/s, m/s
+``tcp_pose``              the tool centre point in the base frame: x, y, z, then    m
+                          the quaternion w, x, y, z (a robot with a ``tcp_body``,
+                          in a native scene)
 ``cameras/<sensor>``      latest RGB frame, H x W x 3 uint8, top row first
 ``camera_slots/<slot>``   the same frame under its VLA slot (``camera1`` ...)
 ``depth/<sensor>``        latest depth image, H x W float32; 0 where no return      m
@@ -76,6 +79,7 @@ class ObservationLayout:
         joints: JointStateSample,
         *,
         privileged: bool,
+        tcp_pose: npt.NDArray[np.float64] | None = None,
     ) -> None:
         """Lay out the space from ``first``, an observation with every sensor's frame, and
         the HAL's joint sample of the same instant."""
@@ -83,7 +87,7 @@ class ObservationLayout:
         self.slots = {sensor: slot for sensor, slot in slots.items() if sensor in first.images}
         self.privileged = privileged
         self._latest: EnvObservation = {}
-        self.space = spaces.Dict(self._spaces(self.observe(first, joints)))
+        self.space = spaces.Dict(self._spaces(self.observe(first, joints, tcp_pose)))
 
     def _spaces(self, obs: EnvObservation, low: float = -_INF) -> dict[str, spaces.Space[object]]:
         """The space of an observation like ``obs`` (values no lower than ``low``)."""
@@ -99,13 +103,21 @@ class ObservationLayout:
         """Forget the latest frames (a new episode's first observation brings them all)."""
         self._latest = {}
 
-    def observe(self, obs: SceneObservation, joints: JointStateSample) -> EnvObservation:
-        """The env observation of the scene's ``obs`` (latest frame of each sensor) and the
-        HAL's ``joints`` (manifest order and units; a robosuite scene's read by name)."""
+    def observe(
+        self,
+        obs: SceneObservation,
+        joints: JointStateSample,
+        tcp_pose: npt.NDArray[np.float64] | None = None,
+    ) -> EnvObservation:
+        """The env observation of the scene's ``obs`` (latest frame of each sensor), the
+        HAL's ``joints`` (manifest order and units; a robosuite scene's read by name) and
+        the TCP's pose (base frame), when the robot has one here."""
         out: EnvObservation = {
             "joint_positions": np.array(joints.positions, dtype=np.float64),
             "joint_velocities": np.array(joints.velocities, dtype=np.float64),
         }
+        if tcp_pose is not None:
+            out["tcp_pose"] = tcp_pose
         self._keep("cameras", dict(obs.images))
         self._keep("depth", {n: _depth_image(f.depth_m) for n, f in obs.depth.items()})
         self._keep("lidar", {n: scan.ranges for n, scan in obs.scans.items()})

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, fields, replace
-from enum import StrEnum
 from pathlib import Path
 from typing import Any, SupportsFloat, cast
 
@@ -38,27 +37,18 @@ from openral_core.loaded import LoadedRobot
 from openral_core.loader import load_scene
 from openral_hal.factory import HalMode, build_hal
 from openral_hal.sim_attached import SimAttachedHAL
-from openral_mujoco.action import Action, BaseTwist, validated_action
+from openral_mujoco.action import validated_action
 from openral_mujoco.errors import ActionRejected
-from openral_sim.action_bounds import action_bounds
+from openral_sim.ee_modes import pose_vector
 from openral_sim.rollout import SceneRollout
 from openral_sim.scene import scene_robot
 from openral_sim.state_sensors import state_sensors_of
 
+from openral_eval.env_actions import ActionContract, ActionMode, end_effector
 from openral_eval.env_observation import EnvObservation, ObservationLayout
 
 ENV_ID = "openral/Scene-v0"
 """The id :func:`gymnasium.make` knows the scene env by once this module is imported."""
-
-BASE_SLOTS = ("base_vx_m_s", "base_vy_m_s", "base_wz_rad_s")
-"""Names of a mobile base's action slots, after the joints."""
-
-
-class ActionMode(StrEnum):
-    """What an env action means."""
-
-    JOINT_POSITION = "joint_position"
-    """One target per action slot in manifest units (see the module doc)."""
 
 
 @dataclass(frozen=True)
@@ -77,6 +67,8 @@ class EnvConfig:
     none, or these by manifest name (state sensors, joints and the base are always in)."""
     max_steps: int | None = None
     """Truncate after this many steps (None: the scene's horizon, if any)."""
+    ee_preset: str = "robosuite"
+    """The scale and gripper sign of ``ee_delta_pose``: ``robosuite`` or ``maniskill``."""
 
     @classmethod
     def parse(cls, config: EnvConfig | Mapping[str, object]) -> EnvConfig:
@@ -137,17 +129,21 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
             self.hal.reset()
         else:
             self.hal.connect()
+        self._ee = end_effector(self.hal, self.robot)
         self.layout = ObservationLayout(
             self.robot,
             self.hal.last_observation(),
             self.hal.read_state(),
             privileged=self.config.privileged,
+            tcp_pose=self._tcp_pose(),
         )
         self.observation_space = cast(spaces.Space[EnvObservation], self.layout.space)
-        self._base = self.hal.base is not None
-        self.action_names = self.hal.action_names + (BASE_SLOTS if self._base else ())
+        self.actions = ActionContract(
+            self.hal, self.robot, self.config.action_mode, self._ee, self.config.ee_preset
+        )
+        self.action_names = self.actions.names
         """One name per action value."""
-        low, high = self._bounds()
+        low, high = self.actions.bounds()
         self.box = spaces.Box(low, high, dtype=np.float64)
         """The action space, typed as what it is."""
         self.action_space = self.box
@@ -168,6 +164,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         self.hal.release_estop()
         self._choose_sensors()
         self.hal.reset()
+        self.actions.reset()
         self.layout.reset()
         self.steps = 0
         obs = self._observe()
@@ -181,15 +178,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         Raises:
             ActionRejected: ``action`` is outside the action space; nothing moved.
         """
-        values = self.checked(action)
-        width = self.hal.action_dim
-        if self._base:
-            vx, vy, wz = (float(v) for v in values[width:])
-            names = self.hal.action_names
-            slots = dict(zip(names, values[:width].tolist(), strict=True))
-            self.hal.send_action(Action(slots=slots, base=BaseTwist(vx, vy, wz)))
-        else:
-            self.hal.send_action(values)
+        self.actions.apply(self.checked(action))
         self.steps += 1
         outcome = self.hal.last_outcome
         terminated = outcome.success or outcome.terminated
@@ -210,7 +199,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
             i = int(np.argmax(outside))
             raise ActionRejected(
                 f"action[{i}] ({self.action_names[i]}) is {values[i]:g}; expected within "
-                f"[{space.low[i]:g}, {space.high[i]:g}] ({self.config.action_mode.value} mode)"
+                f"[{space.low[i]:g}, {space.high[i]:g}] ({self.actions.mode.value} mode)"
             )
         return values
 
@@ -239,7 +228,14 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
 
     def _observe(self) -> EnvObservation:
         obs = self.hal.last_observation()  # a native scene's carries the HAL's joint sample
-        return self.layout.observe(obs, obs.joints or self.hal.read_state())
+        return self.layout.observe(obs, obs.joints or self.hal.read_state(), self._tcp_pose())
+
+    def _tcp_pose(self) -> npt.NDArray[np.float64] | None:
+        """The measured TCP pose in the base frame (None: no TCP here)."""
+        if self._ee is None:
+            return None
+        handles = self.hal.mujoco_handles()
+        return None if handles is None else pose_vector(self._ee.tcp_pose(handles[1]))
 
     @staticmethod
     def _info(*, success: bool) -> dict[str, Any]:
@@ -274,14 +270,6 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         if scene is not None:
             scene.observed = self._observed
             scene.render_observations = True
-
-    def _bounds(self) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-        low, high = action_bounds(self.hal.env, self.robot, self.hal.action_dim)
-        base = self.robot.tables.mobile_base
-        if self._base and base is not None:
-            top = np.array([base.max_linear_velocity_m_s] * 2 + [base.max_angular_velocity_rad_s])
-            low, high = np.concatenate([low, -top]), np.concatenate([high, top])
-        return low, high
 
 
 def _build(scene_file: str) -> tuple[SimAttachedHAL, LoadedRobot]:

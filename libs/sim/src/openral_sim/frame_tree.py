@@ -139,7 +139,7 @@ class FrameTree:
         count = len(self.frames)
         positions, quats = np.zeros((count, 3)), np.zeros((count, 4))
         quats[0, 0] = 1.0
-        base = self._base_pose(data)
+        base = self.base_pose(data)
         positions[self._base_row], quats[self._base_row] = base
         if self._odom_row is not None and self.base is not None:
             x, y, heading = self.base.origin
@@ -164,8 +164,9 @@ class FrameTree:
         self._base_row = 1
         return [Frame(tree.base, names.world, tree.kind is BaseKind.FIXED)]
 
-    def _base_pose(self, data: mujoco.MjData) -> tuple[FloatArray, FloatArray]:
-        """The base frame's world pose: the root body's, less its origin in the base frame."""
+    def base_pose(self, data: mujoco.MjData) -> tuple[FloatArray, FloatArray]:
+        """The base frame's world pose (position [m], quaternion w, x, y, z): the root
+        body's, less its origin in the base frame."""
         position, inverse = self._origin
         root = self.tree.root
         world, offset = np.empty(4), np.empty(3)

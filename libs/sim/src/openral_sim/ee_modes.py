@@ -1,0 +1,113 @@
+"""End-effector action modes: what an end-effector action means, in one place.
+
+Both modes move the tool centre point (:mod:`openral_sim.end_effector`) in the robot's base
+frame and set the first gripper; the arm's joint targets then come from the one IK, and the
+whole joint action passes the manifest's limits and the E-stop like any other.
+
+- ``ee_delta_pose``: 7 values in [-1, 1]: translation x, y, z, then a rotation as an axis
+  times an angle (rx, ry, rz), both in the base frame and scaled by the preset's full scale
+  per control step, then the gripper in the preset's sign. Presets: ``robosuite`` (its
+  OSC_POSE: 0.05 m and 0.5 rad per step, -1 opens, +1 closes) and ``maniskill`` (its
+  pd_ee_delta_pose: 0.1 m and 0.1 rad per step, -1 closes, +1 opens). The deltas add up in
+  a reference pose that starts where the TCP is at reset and follows where the IK's step got
+  when the limits stop it short, so a target out of reach does not wind up.
+- ``ee_pose``: 8 values: the TCP's position [m] and orientation (w, x, y, z; normalised
+  here) in the base frame, then the gripper in manifest units (0 closed, 1 open).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mink
+import mujoco
+import numpy as np
+from openral_mujoco.state import FloatArray
+
+from openral_sim.end_effector import EndEffector
+from openral_sim.frame_tree import FrameTree
+
+DELTA_WIDTH = 7
+POSE_WIDTH = 8
+_SNAP_M = 1e-3
+"""A step that ends farther than this from the reference [m] moves the reference there."""
+
+
+@dataclass(frozen=True)
+class DeltaPreset:
+    """The scale and gripper sign of one ``ee_delta_pose`` convention."""
+
+    translation_m: float
+    """Full-scale translation per control step [m]."""
+    rotation_rad: float
+    """Full-scale rotation per control step [rad]."""
+    closes: float
+    """The gripper value that closes it (+1 or -1)."""
+
+    def gripper(self, value: float) -> float:
+        """The normalised gripper command (0 closed, 1 open) of a value in [-1, 1]."""
+        return (1.0 - value * self.closes) / 2.0
+
+
+PRESETS = {
+    "robosuite": DeltaPreset(translation_m=0.05, rotation_rad=0.5, closes=1.0),
+    "maniskill": DeltaPreset(translation_m=0.1, rotation_rad=0.1, closes=-1.0),
+}
+"""The ``ee_delta_pose`` presets by name."""
+
+
+class EeCommand:
+    """Turns end-effector actions into arm joint targets and a gripper command."""
+
+    def __init__(self, ee: EndEffector, frames: FrameTree, dt: float) -> None:
+        self.ee, self.frames, self.dt = ee, frames, dt
+        self.reference = mink.SE3.identity()
+        """The TCP pose the deltas add up in (base frame)."""
+
+    def base(self, data: mujoco.MjData) -> mink.SE3:
+        """The base frame's pose in the world."""
+        position, quat = self.frames.base_pose(data)
+        return mink.SE3.from_rotation_and_translation(mink.SO3(quat), position)
+
+    def tcp_pose(self, data: mujoco.MjData) -> mink.SE3:
+        """The TCP's pose in the base frame."""
+        return self.base(data).inverse().multiply(self.ee.world_pose(data))
+
+    def reset(self, data: mujoco.MjData, commanded: FloatArray) -> None:
+        """Start the reference where the arm's ``commanded`` targets put the TCP (where
+        the servos are taking it, not where gravity holds it a little below)."""
+        world = self.ee.commanded_pose(data, commanded)
+        self.reference = self.base(data).inverse().multiply(world)
+
+    def delta(
+        self, data: mujoco.MjData, commanded: FloatArray, action: FloatArray, preset: DeltaPreset
+    ) -> tuple[FloatArray, float]:
+        """(arm joint targets, gripper command) of one ``ee_delta_pose`` action."""
+        translation = self.reference.translation() + action[:3] * preset.translation_m
+        turn = mink.SO3.exp(action[3:6] * preset.rotation_rad)
+        rotation = turn.multiply(self.reference.rotation())
+        self.reference = mink.SE3.from_rotation_and_translation(rotation, translation)
+        return self._solve(data, commanded), preset.gripper(float(action[6]))
+
+    def absolute(
+        self, data: mujoco.MjData, commanded: FloatArray, action: FloatArray
+    ) -> tuple[FloatArray, float]:
+        """(arm joint targets, gripper command) of one ``ee_pose`` action."""
+        quat = action[3:7] / np.linalg.norm(action[3:7])
+        self.reference = mink.SE3.from_rotation_and_translation(mink.SO3(quat), action[:3])
+        return self._solve(data, commanded), float(action[7])
+
+    def _solve(self, data: mujoco.MjData, commanded: FloatArray) -> FloatArray:
+        """One IK step towards the reference; where the limits stopped it short, the
+        reference comes back to where the step got (no wind-up at the workspace edge)."""
+        base = self.base(data)
+        targets = self.ee.joint_targets(data, commanded, base.multiply(self.reference), self.dt)
+        reached = base.inverse().multiply(self.ee.commanded_pose(data, targets))
+        if np.linalg.norm(reached.translation() - self.reference.translation()) > _SNAP_M:
+            self.reference = reached
+        return targets
+
+
+def pose_vector(pose: mink.SE3) -> FloatArray:
+    """Position [m] then quaternion (w, x, y, z) of ``pose``, 7 values."""
+    return np.concatenate([pose.translation(), pose.rotation().wxyz])

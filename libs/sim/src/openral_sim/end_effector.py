@@ -1,0 +1,160 @@
+"""The robot's tool centre point (TCP) in a native scene, and the one IK that moves it.
+
+The TCP is the manifest's first gripper's ``tcp_body`` with its ``tcp_offset_m`` (between
+the fingertips). Its pose is stated in the robot's base frame (the frame ``/tf`` calls the
+base: a mobile base's moving frame, else the robot's root): position [m] and orientation
+as a unit quaternion (w, x, y, z).
+
+:meth:`EndEffector.joint_targets` turns a TCP pose into arm joint targets by differential
+IK with mink on the scene's own model (the kinematics the robot really has there), solved
+by daqp as one quadratic programme per control tick:
+
+- a frame task on the TCP body (gain 1: the whole error in one control period);
+- the manifest's position limits of every arm joint (:class:`ArmPositionLimit`) and its
+  velocity limits (mink's ``VelocityLimit``) as inequalities;
+- every other degree of freedom (grippers, a mobile base, the scene's objects) frozen.
+
+A target out of reach is approached as far as those limits allow and no further: the
+solution is the best step inside them, never a step past a limit.
+"""
+
+from __future__ import annotations
+
+import mink
+import mujoco
+import numpy as np
+from mink.limits.limit import Constraint
+from openral_core.loaded import LoadedRobot
+from openral_core.models import LimitedJoint
+from openral_mujoco.errors import HalError
+from openral_mujoco.robot_addresses import RobotAddresses
+from openral_mujoco.state import FloatArray
+
+SOLVER = "daqp"
+"""The QP solver of every IK step."""
+_SPEED_SHARE = 0.8
+"""Share of a joint's velocity limit the IK may plan for (the rest: the servo's headroom)."""
+_POSITION_GAIN = 0.95
+"""Share of the distance to a position limit one step may close (mink's default)."""
+
+
+class ArmPositionLimit(mink.Limit):
+    """The manifest's position limits of the arm joints, as ``G dq <= h`` over every DOF."""
+
+    def __init__(
+        self, nv: int, qpos: list[int], dofs: list[int], low: FloatArray, high: FloatArray
+    ) -> None:
+        count = len(dofs)
+        self.qpos, self.low, self.high = np.array(qpos, dtype=np.intp), low, high
+        self.G = np.zeros((2 * count, nv))
+        self.G[np.arange(count), dofs] = 1.0
+        self.G[count + np.arange(count), dofs] = -1.0
+
+    def compute_qp_inequalities(self, configuration: mink.Configuration, dt: float) -> Constraint:
+        """Each arm joint may move at most :data:`_POSITION_GAIN` of the way to its limits."""
+        del dt
+        q = configuration.q[self.qpos]
+        upper = np.maximum(self.high - q, 0.0) * _POSITION_GAIN
+        lower = np.maximum(q - self.low, 0.0) * _POSITION_GAIN
+        return Constraint(G=self.G, h=np.concatenate([upper, lower]))
+
+
+class EndEffector:
+    """The TCP of one robot in one native scene's model (see the module doc)."""
+
+    def __init__(self, model: mujoco.MjModel, addresses: RobotAddresses, robot: LoadedRobot):
+        """Find the TCP body and set up the IK.
+
+        Raises:
+            HalError: The manifest declares no ``tcp_body`` on its first gripper, or the
+                scene's model has no such body.
+        """
+        wiring = robot.tables.hal_wiring
+        gripper = wiring.grippers[0] if wiring is not None and wiring.grippers else None
+        if gripper is None or gripper.tcp_body is None:
+            raise HalError(
+                f"{robot.name} has no tool centre point: end-effector actions need "
+                "sim.grippers[0].tcp_body (and tcp_offset_m) in its manifest"
+            )
+        self.body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, gripper.tcp_body)
+        if self.body < 0:
+            raise HalError(f"the scene's model has no body {gripper.tcp_body!r} (tcp_body)")
+        self.offset = np.asarray(gripper.tcp_offset_m, dtype=np.float64)
+        self.arm = addresses.arm_slots
+        self.configuration = mink.Configuration(model)
+        self.task = mink.FrameTask(
+            gripper.tcp_body, "body", position_cost=1.0, orientation_cost=1.0, gain=1.0
+        )
+        self._limits, self._frozen = self._constraints(model, addresses, robot)
+        self._arm_qpos = addresses.qpos[self.arm]
+
+    def _constraints(
+        self, model: mujoco.MjModel, addresses: RobotAddresses, robot: LoadedRobot
+    ) -> tuple[list[mink.Limit], list[mink.DofFreezingTask]]:
+        """The arm's position and velocity limits, and every other DOF frozen."""
+        joints = [robot.description.joints[int(i)] for i in self.arm]
+        low = np.array(
+            [j.position_limits[0] if isinstance(j, LimitedJoint) else -np.inf for j in joints]
+        )
+        high = np.array(
+            [j.position_limits[1] if isinstance(j, LimitedJoint) else np.inf for j in joints]
+        )
+        dofs = [int(d) for d in addresses.qvel[self.arm]]
+        positions = ArmPositionLimit(model.nv, list(addresses.qpos[self.arm]), dofs, low, high)
+        names = robot.tables.joint_name_map
+        speeds = {names[j.name]: _SPEED_SHARE * j.velocity_limit for j in joints}
+        frozen = [d for d in range(model.nv) if d not in set(dofs)]
+        freeze = [mink.DofFreezingTask(model, dof_indices=frozen)] if frozen else []
+        return [positions, mink.VelocityLimit(model, speeds)], freeze
+
+    def world_pose(self, data: mujoco.MjData) -> mink.SE3:
+        """The TCP's pose in the world frame as ``data`` holds it."""
+        rotation = data.xmat[self.body].reshape(3, 3)
+        position = data.xpos[self.body] + rotation @ self.offset
+        return mink.SE3.from_rotation_and_translation(
+            mink.SO3(np.array(data.xquat[self.body])), position
+        )
+
+    def commanded_pose(self, data: mujoco.MjData, commanded: FloatArray) -> mink.SE3:
+        """The TCP's world pose with the arm at its ``commanded`` targets (the rest of the
+        state from ``data``)."""
+        self._set(data, commanded)
+        flange = self.configuration.get_transform_frame_to_world(self.task.frame_name, "body")
+        return flange.multiply(mink.SE3.from_translation(self.offset))
+
+    def _set(self, data: mujoco.MjData, commanded: FloatArray) -> None:
+        q = np.array(data.qpos)
+        q[self._arm_qpos] = commanded
+        self.configuration.update(q)
+
+    def joint_targets(
+        self, data: mujoco.MjData, commanded: FloatArray, target_world: mink.SE3, dt: float
+    ) -> FloatArray:
+        """Arm joint targets (manifest order of the arm slots) one IK step from the arm's
+        ``commanded`` targets (the rest of the state from ``data``) towards the TCP pose
+        ``target_world``, over ``dt`` seconds.
+
+        Stepping from the commanded targets, not the measured joints, keeps the servo's
+        steady lag (gravity on a position servo) out of the IK's loop: the set points follow
+        the TCP path exactly and the arm follows them with a constant lag.
+
+        Raises:
+            HalError: The solver found no step (it reports why).
+        """
+        self._set(data, commanded)
+        flange = mink.SE3.from_translation(self.offset).inverse()
+        self.task.set_target(target_world.multiply(flange))
+        try:
+            velocity = mink.solve_ik(
+                self.configuration,
+                [self.task],
+                dt,
+                SOLVER,
+                damping=1e-6,
+                limits=self._limits,
+                constraints=self._frozen,
+            )
+        except mink.MinkError as error:
+            raise HalError(f"end-effector IK found no step: {error}") from error
+        q = self.configuration.integrate(velocity, dt)
+        return np.asarray(q[self._arm_qpos], dtype=np.float64)

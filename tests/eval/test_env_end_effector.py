@@ -1,0 +1,105 @@
+"""End-effector action modes of the env: the TCP moves as asked, inside every limit, and
+a target out of reach stops at the workspace edge."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+from openral_core.models import LimitedJoint
+from openral_eval.scene_env import SceneEnv, make_env
+
+from tests.conftest import ROBOTS
+
+TABLETOP = ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml"
+
+
+@pytest.fixture(scope="module")
+def panda() -> Iterator[SceneEnv]:
+    env = make_env(TABLETOP, action_mode="ee_delta_pose", sensors=False)
+    yield env
+    env.close()
+
+
+def _angle(q: np.ndarray, r: np.ndarray) -> float:
+    """Angle between two unit quaternions [rad]."""
+    return float(2 * np.arccos(min(1.0, abs(float(np.dot(q, r))))))
+
+
+def _limits(env: SceneEnv) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    arm = [j for j in env.robot.description.joints if isinstance(j, LimitedJoint)][:7]
+    low = np.array([j.position_limits[0] for j in arm])
+    high = np.array([j.position_limits[1] for j in arm])
+    speed = np.array([j.velocity_limit for j in arm])
+    return low, high, speed
+
+
+def test_deltas_move_the_tcp_a_centimetre_a_step_holding_its_orientation(panda: SceneEnv) -> None:
+    obs, _ = panda.reset(seed=0)
+    start = obs["tcp_pose"]
+    low, high, speed = _limits(panda)
+    previous, moves, turns = start[:3], [], []
+    for axis, sign in ((0, 1.0), (2, -1.0)):
+        action = np.zeros(7)
+        action[axis], action[6] = 0.2 * sign, -1.0  # 0.2 x 0.05 m = 1 cm a step; open
+        for _ in range(10):
+            obs, *_ = panda.step(action)
+            tcp = obs["tcp_pose"]
+            moves.append((tcp[:3] - previous) @ np.eye(3)[axis] * sign)
+            previous = tcp[:3]
+            turns.append(_angle(tcp[3:], start[3:]))
+            q, v = obs["joint_positions"][:7], obs["joint_velocities"][:7]
+            assert np.all(q >= low) and np.all(q <= high)
+            assert np.all(np.abs(v) <= speed)
+    assert np.all(np.abs(np.array(moves[1:]) - 0.01) <= 0.002), np.round(moves, 4)
+    assert max(turns) <= 0.02, max(turns)
+
+
+def test_a_pose_out_of_reach_stops_at_the_edge_and_does_not_wind_up() -> None:
+    env = make_env(TABLETOP, action_mode="ee_pose", sensors=False)
+    try:
+        obs, _ = env.reset(seed=0)
+        start = obs["tcp_pose"].copy()
+        low, high, speed = _limits(env)
+        far = np.concatenate([[1.5, 0.0, start[2]], start[3:], [1.0]])  # 1.5 m ahead
+        path = []
+        for _ in range(100):  # 5 s
+            obs, *_ = env.step(far)
+            q, v = obs["joint_positions"][:7], obs["joint_velocities"][:7]
+            assert np.all(q >= low) and np.all(q <= high)
+            assert np.all(np.abs(v) <= speed)
+            path.append(obs["tcp_pose"][:3].copy())
+        assert np.linalg.norm(path[-1] - path[-5]) < 0.002  # stopped
+        assert path[-1][0] > start[0] + 0.1  # having gone as far as it could
+        back = np.concatenate([start, [1.0]])
+        for _ in range(40):
+            obs, *_ = env.step(back)
+        assert np.linalg.norm(obs["tcp_pose"][:3] - start[:3]) < 0.01
+    finally:
+        env.close()
+
+
+def test_modes_the_scene_or_robot_cannot_take_are_one_clear_error() -> None:
+    with pytest.raises(ValueError, match="unknown ee preset 'libero'; valid: robosuite, maniskill"):
+        make_env(TABLETOP, action_mode="ee_delta_pose", ee_preset="libero")
+    robosuite = ROBOTS / "franka_panda" / "scenes" / "lift_robosuite.yaml"
+    with pytest.raises(ValueError, match="ee_pose needs a native scene"):
+        make_env(robosuite, action_mode="ee_pose")
+    ur5e = ROBOTS / "ur5e" / "scenes" / "tabletop.yaml"
+    with pytest.raises(ValueError, match=r"sim.grippers\[0\].tcp_body"):
+        make_env(ur5e, action_mode="ee_delta_pose")
+
+
+@pytest.mark.parametrize("mode", ["ee_delta_pose", "ee_pose"])
+@pytest.mark.parametrize("robot", ["franka_panda", "panda_mobile"])
+def test_gymnasium_check_env_passes_in_end_effector_modes(robot: str, mode: str) -> None:
+    from gymnasium.utils.env_checker import check_env
+
+    env = make_env(ROBOTS / robot / "scenes" / "tabletop.yaml", action_mode=mode, sensors=False)
+    try:
+        check_env(env, skip_render_check=True)
+        base = ("base_vx_m_s", "base_vy_m_s", "base_wz_rad_s") if robot == "panda_mobile" else ()
+        assert env.action_names[-len(base) or None :] == base or not base
+    finally:
+        env.close()
