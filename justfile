@@ -73,6 +73,10 @@ check: lint typecheck layers schema-check
 bench-env *ARGS:
     python -m benchmarks.env_step {{ARGS}}
 
+# End-effector actions on the Panda: IK cost per tick and how the TCP follows 1 cm steps.
+bench-ik *ARGS:
+    python -m benchmarks.ee_ik {{ARGS}}
+
 # HAL overhead per robot against a raw mj_step loop; writes benchmarks/results/hal_step.json.
 bench-hal *ARGS:
     python -m benchmarks.hal_step {{ARGS}}

@@ -102,9 +102,8 @@ class EeCommand:
         reference comes back to where the step got (no wind-up at the workspace edge)."""
         base = self.base(data)
         targets = self.ee.joint_targets(data, commanded, base.multiply(self.reference), self.dt)
-        reached = base.inverse().multiply(self.ee.commanded_pose(data, targets))
-        if np.linalg.norm(reached.translation() - self.reference.translation()) > _SNAP_M:
-            self.reference = reached
+        if self.ee.shortfall_m > _SNAP_M:
+            self.reference = base.inverse().multiply(self.ee.commanded_pose(data, targets))
         return targets
 
 

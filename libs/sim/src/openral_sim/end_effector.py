@@ -87,6 +87,9 @@ class EndEffector:
         )
         self._limits, self._frozen = self._constraints(model, addresses, robot)
         self._arm_qpos = addresses.qpos[self.arm]
+        self.shortfall_m = 0.0
+        """How far the last step's TCP ends from its target, to first order [m] (more than
+        rounding: the limits stopped it short)."""
 
     def _constraints(
         self, model: mujoco.MjModel, addresses: RobotAddresses, robot: LoadedRobot
@@ -156,5 +159,13 @@ class EndEffector:
             )
         except mink.MinkError as error:
             raise HalError(f"end-effector IK found no step: {error}") from error
+        step = velocity * dt  # the task's residual after it, to first order: e + J dq
+        residual = self.task.compute_error(self.configuration) + (
+            self.task.compute_jacobian(self.configuration) @ step
+        )
+        self.shortfall_m = float(
+            np.linalg.norm(residual[:3])
+            + np.linalg.norm(residual[3:]) * np.linalg.norm(self.offset)
+        )
         q = self.configuration.integrate(velocity, dt)
         return np.asarray(q[self._arm_qpos], dtype=np.float64)
