@@ -128,6 +128,32 @@ def graph_topics(node: Node, *, include_hidden: bool = False) -> list[TopicInfo]
     ]
 
 
+SETTLED_S = 0.6
+"""The graph counts as discovered once its topic list has not changed for this long [s]:
+a participant's endpoints arrive one by one (a subscriber-only topic such as /cmd_vel can
+come last)."""
+
+
+def settled_topics(
+    node: Node, *, wait_s: float, longest_s: float, include_hidden: bool = False
+) -> tuple[list[TopicInfo], float]:
+    """The topics after ``wait_s`` of discovery, once the list has stayed the same for
+    :data:`SETTLED_S` (or ``longest_s`` in all, whatever it is then; empty: nothing came);
+    and the seconds waited."""
+    start = time.monotonic()
+    time.sleep(wait_s)
+    infos = graph_topics(node, include_hidden=include_hidden)
+    changed = time.monotonic()
+    while True:
+        now = time.monotonic()
+        if (infos and now - changed >= SETTLED_S) or now - start >= longest_s:
+            return infos, now - start
+        time.sleep(POLL_S)
+        latest = graph_topics(node, include_hidden=include_hidden)
+        if latest != infos:
+            infos, changed = latest, time.monotonic()
+
+
 def wait_for_topic(node: Node, topic: str, timeout_s: float) -> TopicInfo:
     """Block until ``topic`` has a publisher; raise TopicNotFound after ``timeout_s`` [s]."""
     topic = topic_name(topic)

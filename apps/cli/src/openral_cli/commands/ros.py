@@ -85,9 +85,9 @@ def _quiet_ctrl_c() -> Iterator[None]:
 
 
 LATE_DISCOVERY_S = 3.0
-"""How much longer ``topics`` looks when the graph is still empty after ``--wait``: FastDDS
-announces a participant again every 3 s, so a peer that missed the first announcement
-(a loaded machine) shows up within that [s]."""
+"""How much longer ``topics`` may look after ``--wait`` while the graph is empty or still
+changing: FastDDS announces a participant again every 3 s, so a peer that missed the first
+announcement (a loaded machine) shows up within that [s]."""
 
 
 @app.command("topics")
@@ -110,18 +110,14 @@ def topics(
     """Table of the topics in the graph: name, type(s), publishers and (--rate) rate."""
     require_ros()
     from openral_core.errors import escaped
-    from openral_nodes.topic_graph import graph_topics
+    from openral_nodes.topic_graph import settled_topics
     from openral_nodes.topic_probe import measure_rates
     from rich.table import Table
 
     with _probe_node(domain_id) as node:
-        time.sleep(wait)
-        infos = graph_topics(node, include_hidden=all_topics)
-        waited = wait
-        while not infos and waited < wait + LATE_DISCOVERY_S:  # a peer missed our announcement
-            time.sleep(0.1)
-            waited += 0.1
-            infos = graph_topics(node, include_hidden=all_topics)
+        infos, waited = settled_topics(
+            node, wait_s=wait, longest_s=wait + LATE_DISCOVERY_S, include_hidden=all_topics
+        )
         rates = measure_rates(node, infos, window) if rate else {}
         domain = node.context.get_domain_id()
     if not infos:
