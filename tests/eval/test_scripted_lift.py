@@ -1,4 +1,5 @@
-"""``scripted_lift`` on the franka tabletop: it lifts the randomised cube, deterministically.
+"""``scripted_lift`` on the franka and mobile-Panda tabletops, in end-effector deltas: it
+lifts the randomised cube, deterministically.
 
 Over seeds 0-19 (the cube moved ±5 cm and turned ±180°), at least 18 episodes succeed
 (the cube 5 cm up for 0.5 s) within 300 control steps; the same seed twice gives the same
@@ -18,15 +19,17 @@ from tests.conftest import ROBOTS
 SCENE = str(ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml")
 
 
-def test_it_lifts_the_cube_on_at_least_18_of_20_seeds() -> None:
+@pytest.mark.parametrize("robot", ["franka_panda", "panda_mobile"])
+def test_it_lifts_the_cube_on_at_least_18_of_20_seeds(robot: str) -> None:
+    scene = str(ROBOTS / robot / "scenes" / "tabletop.yaml")
     results = [
-        run_episode(EpisodeSpec(SCENE, seed, "scripted_lift", (), 300)) for seed in range(20)
+        run_episode(EpisodeSpec(scene, seed, "scripted_lift", (), 300)) for seed in range(20)
     ]
     assert all(r.error is None for r in results), [r.error for r in results if r.error]
     won = [r for r in results if r.success]
     print(f"scripted_lift: {len(won)}/20, mean steps {np.mean([r.steps for r in won]):.1f}")
     assert len(won) >= 18
-    again = run_episode(EpisodeSpec(SCENE, 7, "scripted_lift", (), 300))
+    again = run_episode(EpisodeSpec(scene, 7, "scripted_lift", (), 300))
     assert again.trajectory_sha256 == results[7].trajectory_sha256
 
 
@@ -85,18 +88,8 @@ def test_the_gripper_holds_the_lifted_cube() -> None:
 
 
 def test_without_a_tool_centre_point_in_the_manifest_it_says_where_to_add_one() -> None:
-    import mujoco
-    from openral_eval.privileged import Privileged, PrivilegedGripper
-
-    model = mujoco.MjModel.from_xml_string("<mujoco><worldbody/></mujoco>")
-    bare = PrivilegedGripper(slot=0, tcp_body=-1, tcp_offset_m=(0.0, 0.0, 0.0))
-    world = Privileged(model, mujoco.MjData(model), {}, (), (), (bare,))
-    obs = {
-        "images": {},
-        "joint_positions": np.zeros(1),
-        "action_spec": (("finger",), np.zeros(1)),
-        "time_s": 0.0,
-        "privileged": world,
-    }
-    with pytest.raises(PolicyConfigError, match=r"set sim\.grippers\[0\]\.tcp_body"):
-        make_policy("scripted_lift").act(obs)  # type: ignore[arg-type]
+    so101 = str(ROBOTS / "so101" / "scenes" / "tabletop.yaml")  # no tcp_body in its manifest
+    result = run_episode(EpisodeSpec(so101, 0, "scripted_lift", (), 5))
+    assert result.error is not None and result.steps == 0
+    assert "ee_delta_pose needs a native scene and a robot with a tool centre point" in result.error
+    assert "sim.grippers[0].tcp_body" in result.error

@@ -42,8 +42,9 @@ from openral_sim.rollout import SceneRollout
 from openral_sim.scene import scene_robot
 from openral_sim.sensor_schedule import sensor_rates
 
+from openral_eval.env_actions import ActionMode
 from openral_eval.policies import make_policy
-from openral_eval.policy import Observation, PolicyAdapter
+from openral_eval.policy import Observation, PolicyAdapter, action_mode
 from openral_eval.privileged import Pose, Privileged, PrivilegedGripper
 from openral_eval.scene_env import EnvConfig, SceneEnv
 from openral_eval.video import VideoWriter
@@ -102,8 +103,8 @@ class EpisodeResult:
 
 _HALS: dict[str, tuple[SimAttachedHAL, LoadedRobot]] = {}
 """This process's scenes (attached HALs) by file, built on first use."""
-_ENVS: dict[tuple[str, tuple[str, ...], int], SceneEnv] = {}
-"""This process's envs on those HALs, by scene, rendered sensors and step limit."""
+_ENVS: dict[tuple[str, tuple[str, ...], int, str], SceneEnv] = {}
+"""This process's envs on those HALs, by scene, rendered sensors, step limit and mode."""
 
 
 def scene_for(path: str) -> tuple[SimAttachedHAL, LoadedRobot]:
@@ -173,7 +174,7 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> _Run:
     inputs = _Inputs(hal, robot, policy)
     camera = inputs.video_camera(spec.video)
     video = VideoWriter.for_camera(spec.video, camera, _frame_rate_hz(hal, robot, camera))
-    env = env_for(spec, inputs.sensors(camera))
+    env = env_for(spec, inputs.sensors(camera), action_mode(policy))
     env.reset(seed=spec.seed)
     run, started = _Run(frames=len(hal.last_observation().images)), hal.read_state().sim_time_s
     try:
@@ -182,7 +183,8 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> _Run:
             state = hal.read_state()
             digest.update(state.positions.tobytes())
             video.add(hal.last_observation())
-            action = policy.act(inputs.observation(state.positions, run.steps))
+            obs = inputs.observation(state.positions, run.steps, env.tcp_pose())
+            action = policy.act(obs)
             _, _, terminated, truncated, info = env.step(env.clipped(action))
             run.steps += 1
             run.frames += len(hal.last_observation().images)
@@ -196,14 +198,17 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> _Run:
     return run
 
 
-def env_for(spec: EpisodeSpec, sensors: tuple[str, ...]) -> SceneEnv:
+def env_for(spec: EpisodeSpec, sensors: tuple[str, ...], mode: str) -> SceneEnv:
     """The gymnasium env an episode steps (the one :func:`~openral_eval.make_env` gives, on
-    this process's HAL of the scene): ``sensors`` rendered, truncated at the step limit."""
+    this process's HAL of the scene): ``sensors`` rendered, actions in ``mode``, truncated
+    at the step limit."""
     hal, robot = scene_for(spec.scene)
     limit = spec.steps or _horizon(hal) or DEFAULT_STEPS
-    config = EnvConfig(spec.scene, sensors=sensors, max_steps=limit)
-    key = (spec.scene, sensors, limit)
+    key = (spec.scene, sensors, limit, mode)
     if key not in _ENVS:
+        config = EnvConfig(
+            spec.scene, sensors=sensors, max_steps=limit, action_mode=ActionMode(mode)
+        )
         _ENVS[key] = SceneEnv(config, hal=(hal, robot))
     return _ENVS[key]
 
@@ -247,7 +252,9 @@ class _Inputs:
         wanted = {*self.slots.values(), *([video_camera] if video_camera else [])}
         return tuple(sorted(wanted))
 
-    def observation(self, positions: np.ndarray, step: int) -> Observation:
+    def observation(
+        self, positions: np.ndarray, step: int, tcp_pose: np.ndarray | None
+    ) -> Observation:
         hal = self.hal
         frames = hal.read_images() if self.slots else {}
         missing = [sensor for sensor in self.slots.values() if sensor not in frames]
@@ -259,6 +266,8 @@ class _Inputs:
             "action_spec": (hal.action_names, hal.hold_action()),
             "time_s": step * hal.control_period_s,
         }
+        if tcp_pose is not None:
+            obs["tcp_pose"] = tcp_pose
         if self.policy.needs_privileged:
             scene_obs = hal.last_observation()
             obs["task_state"] = dict(scene_obs.task_state)
@@ -282,6 +291,7 @@ class _Inputs:
             arm_slots=tuple(int(s) for s in slots),
             arm_dofs=tuple(int(d) for d in scene.addresses.qvel[slots]),
             grippers=self._grippers(model),
+            base=scene.frames().base_pose(self.scratch),
         )
 
     def _grippers(self, model: mujoco.MjModel) -> tuple[PrivilegedGripper, ...]:

@@ -3,7 +3,9 @@
 
 A policy is anything with :attr:`PolicyAdapter.required_slots` (the VLA camera slots it
 needs frames for), :attr:`PolicyAdapter.needs_privileged` (whether it reads the simulation
-itself, which only an evaluation episode can give) and ``act(observation) -> action``.
+itself, which only an evaluation episode can give) and ``act(observation) -> action``; its
+class may also declare ``action_mode`` (:func:`action_mode`: joint targets by default, or
+end-effector deltas).
 The rskill runner and the evaluator read those declarations; neither probes a policy for
 anything else.
 """
@@ -32,6 +34,9 @@ class Observation(TypedDict):
     """HAL action slot names and the hold action that keeps the robot still."""
     time_s: float
     """Seconds since the runner's first tick with a complete observation."""
+    tcp_pose: NotRequired[npt.NDArray[np.float64]]
+    """The tool centre point in the robot's base frame: x, y, z [m], then the quaternion
+    w, x, y, z (episodes, on a robot whose manifest gives its gripper a ``tcp_body``)."""
     task_state: NotRequired[Mapping[str, npt.NDArray[np.float64]]]
     """The scene's task state (object poses; robosuite's object observations), for a
     policy with ``needs_privileged`` (episodes only)."""
@@ -62,6 +67,27 @@ class PolicyAdapter(Protocol):
 
 class PolicyConfigError(OpenralError):
     """An unknown policy, parameter or parameter value."""
+
+
+ACTION_MODES = ("joint_position", "ee_delta_pose")
+"""What a policy's actions may be: joint targets (every path), or end-effector deltas in
+the robosuite preset (episodes on a native scene)."""
+
+
+def action_mode(policy: object) -> str:
+    """The action mode a policy's class declares in ``action_mode`` (default
+    ``joint_position``: one value per action slot of ``obs["action_spec"]``).
+
+    Raises:
+        PolicyConfigError: A mode policies cannot use.
+    """
+    mode = vars(type(policy)).get("action_mode", ACTION_MODES[0])
+    if mode not in ACTION_MODES:
+        raise PolicyConfigError(
+            f"policy {type(policy).__name__} declares action_mode {mode!r}; valid: "
+            f"{', '.join(ACTION_MODES)}"
+        )
+    return str(mode)
 
 
 def parse_params(items: Iterable[str]) -> dict[str, str]:

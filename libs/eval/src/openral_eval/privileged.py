@@ -3,8 +3,9 @@
 A policy that sets ``needs_privileged = True`` gets ``obs["privileged"]`` on every step of
 an episode on a native scene (never under ROS: the rskill runner refuses such a policy):
 the scene's model, a scratch copy of the simulation state it may compute on
-(``mj_kinematics``, Jacobians), the world pose of every scene object, and the robot's
-grippers as the manifest declares them (action slot, tool centre point).
+(``mj_kinematics``, Jacobians), the world pose of every scene object and of the robot's base
+frame, and the robot's grippers as the manifest declares them (action slot, tool centre
+point).
 """
 
 from __future__ import annotations
@@ -45,3 +46,5 @@ class Privileged:
     """Each of those joints' degree of freedom in :attr:`model` (Jacobian columns)."""
     grippers: tuple[PrivilegedGripper, ...] = ()
     """The manifest's grippers, in manifest order."""
+    base: Pose | None = None
+    """The world pose of the robot's base frame (the frame ``tcp_pose`` is stated in)."""

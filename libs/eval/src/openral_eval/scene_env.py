@@ -44,7 +44,7 @@ from openral_sim.rollout import SceneRollout
 from openral_sim.scene import scene_robot
 from openral_sim.state_sensors import state_sensors_of
 
-from openral_eval.env_actions import ActionContract, ActionMode, end_effector
+from openral_eval.env_actions import BASE_SLOTS, ActionContract, ActionMode, end_effector
 from openral_eval.env_observation import EnvObservation, ObservationLayout
 
 ENV_ID = "openral/Scene-v0"
@@ -135,7 +135,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
             self.hal.last_observation(),
             self.hal.read_state(),
             privileged=self.config.privileged,
-            tcp_pose=self._tcp_pose(),
+            tcp_pose=self.tcp_pose(),
         )
         self.observation_space = cast(spaces.Space[EnvObservation], self.layout.space)
         self.actions = ActionContract(
@@ -206,12 +206,18 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
     def clipped(self, action: object) -> npt.NDArray[np.float64]:
         """``action`` clamped onto the action space, as ``deploy sim`` clamps a command
         onto the manifest's limits (an evaluation episode drives a policy by that contract;
-        :meth:`step` itself refuses what is outside).
+        :meth:`step` itself refuses what is outside). A policy's action has no base slots
+        (its contract has none): on a mobile base they are zero, the base stays still.
 
         Raises:
             ActionRejected: Wrong type or width, or a non-finite value.
         """
-        values = validated_action(action, self.action_names)
+        names = self.action_names
+        if self.actions.base:
+            names = names[: -len(BASE_SLOTS)]
+        values = validated_action(action, names)
+        if self.actions.base:
+            values = np.concatenate([values, np.zeros(len(BASE_SLOTS))])
         return np.clip(values, self.box.low, self.box.high)
 
     def render(self) -> npt.NDArray[np.uint8] | None:
@@ -228,9 +234,9 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
 
     def _observe(self) -> EnvObservation:
         obs = self.hal.last_observation()  # a native scene's carries the HAL's joint sample
-        return self.layout.observe(obs, obs.joints or self.hal.read_state(), self._tcp_pose())
+        return self.layout.observe(obs, obs.joints or self.hal.read_state(), self.tcp_pose())
 
-    def _tcp_pose(self) -> npt.NDArray[np.float64] | None:
+    def tcp_pose(self) -> npt.NDArray[np.float64] | None:
         """The measured TCP pose in the base frame (None: no TCP here)."""
         if self._ee is None:
             return None

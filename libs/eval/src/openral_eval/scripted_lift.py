@@ -1,9 +1,12 @@
-"""``scripted_lift``: a privileged scripted policy that lifts a cube from above.
+"""``scripted_lift``: a privileged scripted policy that lifts a cube from above, in
+end-effector actions.
 
-It reads the simulation (:class:`~openral_eval.privileged.Privileged`): the cube's pose and
-the robot's first gripper as its manifest declares it (``sim.grippers[0]``: its action
-slot, ``tcp_body`` and ``tcp_offset_m``), so nothing of any one robot is written here. It
-then moves the gripper's tool centre point through four phases:
+It acts in ``ee_delta_pose`` (the robosuite preset: full scale 0.05 m and 0.5 rad a step,
+-1 opens the gripper, +1 closes it), so the one IK of :mod:`openral_sim.end_effector` turns
+its motions into joint targets under the manifest's limits, and nothing of any one robot is
+written here: the tool centre point comes from the observation (``tcp_pose``, base frame,
+from the manifest's ``tcp_body``) and the cube's pose from the privileged state, brought
+into the base frame. It moves the tool centre point through four phases:
 
 1. ``approach``: ``approach_m`` above the cube, fingers pointing down and turned to the
    cube's nearest face;
@@ -11,10 +14,9 @@ then moves the gripper's tool centre point through four phases:
 3. ``close``: the gripper closes for ``close_s``;
 4. ``lift``: ``lift_m`` above where the cube started.
 
-Each step it turns the Cartesian error into joint targets by damped least squares on the
-point's Jacobian: speed at most ``speed_m_s``, turn rate at most 1.5 rad/s. The targets
-are integrated onto the previous command, so gravity's sag does not become a lasting
-error. It uses no randomness and no wall clock: the same episode gives the same actions.
+Each step asks for ``gain`` times the remaining error, at most ``speed_m_s`` and a turn
+rate of 1.5 rad/s. It uses no randomness and no wall clock: the same episode gives the
+same actions.
 """
 
 from __future__ import annotations
@@ -25,17 +27,20 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 from openral_mujoco.state import FloatArray
+from openral_sim.ee_modes import PRESETS
 
 from openral_eval.policy import Observation, PolicyConfigError
-from openral_eval.privileged import Privileged, PrivilegedGripper
+from openral_eval.privileged import Pose
 
 PHASES = ("approach", "descend", "close", "lift")
-DAMPING = 0.05
-"""Damped-least-squares damping [m] (keeps steps small near singularities)."""
 TURN_RATE = 1.5
 """Largest commanded turn rate [rad/s]."""
 REACHED_M = 0.008
 """A phase's target counts as reached within this distance [m]."""
+PRESET = PRESETS["robosuite"]
+"""The ``ee_delta_pose`` convention it acts in."""
+OPEN, CLOSE = -1.0, 1.0
+"""Its gripper values (robosuite's signs)."""
 
 
 @dataclass(frozen=True)
@@ -63,120 +68,93 @@ class ScriptedLift:
     """Its parameters (``--param key=value``)."""
 
     needs_privileged = True
-    """It reads the simulation (only an evaluation episode on a native scene gives it)."""
+    """It reads the cube's pose from the simulation (evaluation episodes only)."""
     required_slots: tuple[str, ...] = ()
+    action_mode = "ee_delta_pose"
+    """Its actions move the tool centre point (robosuite preset)."""
 
     def __init__(self, config: LiftConfig) -> None:
         self.config = config
         self.phase = PHASES[0]
-        self._command: FloatArray | None = None
         self._closing_s = 0.0
         self._start: FloatArray | None = None
         self._period_s = 0.05
         self._last_time_s: float | None = None
 
     def act(self, obs: Observation) -> FloatArray:
-        """The next action: arm joint targets from the IK step, and the gripper command."""
+        """The next action: the TCP's motion towards the phase's target, and the gripper."""
         world = obs.get("privileged")
-        if world is None:
-            raise PolicyConfigError("scripted_lift needs privileged state (episodes only)")
-        _, hold = obs["action_spec"]
-        if self._command is None:
-            self._command = np.asarray(hold, dtype=np.float64).copy()
+        tcp = obs.get("tcp_pose")
+        if world is None or tcp is None or world.base is None:
+            raise PolicyConfigError(
+                "scripted_lift needs privileged state and the robot's tcp_pose "
+                "(episodes on a native scene, a manifest with sim.grippers[0].tcp_body)"
+            )
         now = float(obs["time_s"])
         if self._last_time_s is not None and now > self._last_time_s:
             self._period_s = now - self._last_time_s  # the control period
         self._last_time_s = now
-        gripper = _gripper(world)
         if self.config.object not in world.objects:
             have = ", ".join(sorted(world.objects)) or "none"
             raise PolicyConfigError(f"no scene object {self.config.object!r}; objects: {have}")
-        position, quat = world.objects[self.config.object]
+        cube, cube_quat = _in_base(world.base, world.objects[self.config.object])
         if self._start is None:
-            self._start = np.array(position, dtype=np.float64)
-        hand = _tcp(world, gripper)  # the kinematics of this step, computed once
-        target, closing = self._phase_target(np.asarray(position), hand[0])
-        self._command[list(world.arm_slots)] += self._ik_step(world, hand, target, np.asarray(quat))
-        self._command[gripper.slot] = closing
-        return self._command.copy()
+            self._start = cube.copy()
+        target, gripper = self._phase_target(cube, tcp[:3])
+        return np.concatenate([self._motion(tcp, target, cube_quat), [gripper]])
 
     # -- phases ----------------------------------------------------------------------------
 
     def _phase_target(self, cube: FloatArray, tcp: FloatArray) -> tuple[FloatArray, float]:
-        """Where the gripper's centre (now at ``tcp``) should go, and the gripper command."""
+        """Where the gripper's centre (now at ``tcp``) should go, and the gripper value."""
         config = self.config
         above = cube + np.array([0.0, 0.0, config.approach_m])
         if self.phase == "approach":
             if np.linalg.norm(tcp - above) < REACHED_M:
                 self.phase = "descend"
-            return above, 1.0
+            return above, OPEN
         if self.phase == "descend":
             if np.linalg.norm(tcp - cube) < REACHED_M:
                 self.phase = "close"
-            return cube, 1.0
+            return cube, OPEN
         if self.phase == "close":
             self._closing_s += self._period_s
             if self._closing_s >= config.close_s:
                 self.phase = "lift"
-            return cube, 0.0
+            return cube, CLOSE
         assert self._start is not None
-        return self._start + np.array([0.0, 0.0, config.lift_m]), 0.0
+        return self._start + np.array([0.0, 0.0, config.lift_m]), CLOSE
 
-    # -- kinematics ------------------------------------------------------------------------
-
-    def _ik_step(
-        self,
-        world: Privileged,
-        hand: tuple[FloatArray, FloatArray, int],
-        target: FloatArray,
-        cube_quat: FloatArray,
-    ) -> FloatArray:
-        """Joint target increments for one control period towards ``target``, from the
-        ``hand`` that :meth:`_tcp` computed for this step."""
-        model, data = world.model, world.data
-        tcp, rotation, body = hand
-        mujoco.mj_comPos(model, data)
-        jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
-        mujoco.mj_jac(model, data, jacp, jacr, tcp, body)
-        dofs = list(world.arm_dofs)
-        jacobian = np.vstack([jacp[:, dofs], jacr[:, dofs]])
-        velocity = self.config.gain * (target - tcp)
+    def _motion(self, tcp: FloatArray, target: FloatArray, cube_quat: FloatArray) -> FloatArray:
+        """The six motion values of one step, in the preset's full scale."""
+        velocity = self.config.gain * (target - tcp[:3])
         speed = np.linalg.norm(velocity)
         if speed > self.config.speed_m_s:
             velocity *= self.config.speed_m_s / speed
-        turn = np.clip(
-            self.config.gain * _orientation_error(rotation, cube_quat), -TURN_RATE, TURN_RATE
-        )
-        twist = np.concatenate([velocity, turn])
-        damped = jacobian @ jacobian.T + DAMPING**2 * np.eye(6)
-        rates = jacobian.T @ np.linalg.solve(damped, twist)
-        step: FloatArray = rates * self._period_s
-        return step
+        rotation = np.empty(9)
+        mujoco.mju_quat2Mat(rotation, tcp[3:])
+        error = _orientation_error(rotation.reshape(3, 3), cube_quat)
+        turn = np.clip(self.config.gain * error, -TURN_RATE, TURN_RATE)
+        move = velocity * self._period_s / PRESET.translation_m
+        spin = turn * self._period_s / PRESET.rotation_rad
+        motion: FloatArray = np.clip(np.concatenate([move, spin]), -1.0, 1.0)
+        return motion
 
 
-def _gripper(world: Privileged) -> PrivilegedGripper:
-    """The robot's first gripper with a tool centre point (refused when there is none)."""
-    for gripper in world.grippers:
-        if gripper.tcp_body >= 0:
-            return gripper
-    raise PolicyConfigError(
-        "scripted_lift needs a gripper with a tool centre point: set sim.grippers[0].tcp_body "
-        "(and tcp_offset_m) in the robot's manifest"
-    )
-
-
-def _tcp(world: Privileged, gripper: PrivilegedGripper) -> tuple[FloatArray, FloatArray, int]:
-    """(tool centre point in the world [m], its body's rotation matrix, body id)."""
-    model, data, body = world.model, world.data, gripper.tcp_body
-    mujoco.mj_kinematics(model, data)
-    rotation = data.xmat[body].reshape(3, 3).copy()
-    offset = rotation @ np.asarray(gripper.tcp_offset_m, dtype=np.float64)
-    return data.xpos[body] + offset, rotation, body
+def _in_base(base: Pose, pose: Pose) -> tuple[FloatArray, FloatArray]:
+    """``pose`` (world) in the frame whose world pose is ``base``."""
+    position, quat = base
+    inverse = np.empty(4)
+    mujoco.mju_negQuat(inverse, quat)
+    local, turned = np.empty(3), np.empty(4)
+    mujoco.mju_rotVecQuat(local, np.asarray(pose[0]) - position, inverse)
+    mujoco.mju_mulQuat(turned, inverse, np.asarray(pose[1]))
+    return local, turned
 
 
 def _orientation_error(rotation: FloatArray, cube_quat: FloatArray) -> FloatArray:
-    """Rotation vector [rad, world] from the hand's orientation to fingers-down, turned to
-    the cube face nearest the hand's present yaw (a cube looks the same every 90°)."""
+    """Rotation vector [rad] from the hand's orientation to fingers-down, turned to the
+    cube face nearest the hand's present yaw (a cube looks the same every 90°)."""
     cube = np.empty(9)
     mujoco.mju_quat2Mat(cube, cube_quat)
     cube_x = cube.reshape(3, 3)[:, 0]
