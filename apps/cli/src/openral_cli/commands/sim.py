@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from openral_cli.commands.policies import policies
+from openral_cli.commands.sim_policy import run_policy
 from openral_cli.commands.sweep import sweep
 from openral_cli.console import out, progress
 from openral_cli.help_text import command_group
@@ -41,6 +42,8 @@ app.command("policies")(policies)
 SWAY_RAD = 0.15
 """Amplitude of the demo motion around the start pose."""
 MOTIONS = ("sway", "hold")
+DEFAULT_STEPS = 50
+"""Steps of a ``--motion`` run."""
 
 
 @dataclass
@@ -56,7 +59,12 @@ class Recording:
 @app.command("run")
 def run(
     config: Annotated[Path, typer.Option("--config", help="Deploy-scene YAML file.")],
-    steps: Annotated[int, typer.Option("--steps", min=1, help="Control steps to run.")] = 50,
+    steps: Annotated[
+        int | None,
+        typer.Option(
+            "--steps", min=1, help="Control steps (default: 50; with --policy, an episode's)."
+        ),
+    ] = None,
     out_dir: Annotated[
         Path | None, typer.Option("--out", help="Write PNG frames and joint states here.")
     ] = None,
@@ -69,12 +77,21 @@ def run(
     motion: Annotated[
         str, typer.Option("--motion", help="'sway' (a slow joint-space sine) or 'hold'.")
     ] = "sway",
+    policy: Annotated[
+        str | None,
+        typer.Option("--policy", help="Run one episode of this policy (name or file.py:Class)."),
+    ] = None,
+    params: Annotated[
+        list[str] | None, typer.Option("--param", "-p", help="Policy parameter key=value.")
+    ] = None,
+    seed: Annotated[int, typer.Option("--seed", help="The episode's seed (with --policy).")] = 0,
 ) -> None:
     """Run SCENE headless for N control steps; save every camera frame and joint state.
 
     The scene is driven exactly as ``openral deploy sim`` drives it: through the
     SimAttachedHAL that ``build_hal`` attaches, from the hold action of its backend. The
-    scene file and the robot's manifest are each read once.
+    scene file and the robot's manifest are each read once. With ``--policy``, one episode
+    of that policy runs instead, exactly as ``sim sweep`` runs it (``--seed``).
     """
     from openral_core import open_robot
     from openral_core.loader import load_scene
@@ -82,8 +99,17 @@ def run(
     from openral_sim.scene import build_scene, check_scene_robot, scene_robot
     from rich.table import Table
 
+    if policy is not None:
+        if robot is not None or manifest is not None:
+            raise typer.BadParameter(
+                "--policy runs the scene's own robot, as a sweep does; drop --robot/--manifest",
+                param_hint="--policy",
+            )
+        run_policy(config, policy, params or [], seed, steps, out_dir)
+        return
     if motion not in MOTIONS:
         raise typer.BadParameter("expected 'sway' or 'hold'", param_hint="--motion")
+    steps = steps or DEFAULT_STEPS
     scene = load_scene(config)
     if manifest is not None:
         loaded = open_robot(manifest)
