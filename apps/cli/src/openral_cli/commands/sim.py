@@ -93,12 +93,6 @@ def run(
     scene file and the robot's manifest are each read once. With ``--policy``, one episode
     of that policy runs instead, exactly as ``sim sweep`` runs it (``--seed``).
     """
-    from openral_core import open_robot
-    from openral_core.loader import load_scene
-    from openral_hal.factory import HalMode, build_hal
-    from openral_sim.scene import build_scene, check_scene_robot, scene_robot
-    from rich.table import Table
-
     if policy is not None:
         if robot is not None or manifest is not None:
             raise typer.BadParameter(
@@ -107,9 +101,27 @@ def run(
             )
         run_policy(config, policy, params or [], seed, steps, out_dir)
         return
+    _run_motion(config, steps or DEFAULT_STEPS, out_dir, (robot, manifest), motion)
+
+
+def _run_motion(
+    config: Path,
+    steps: int,
+    out_dir: Path | None,
+    who: tuple[str | None, Path | None],
+    motion: str,
+) -> None:
+    """The ``--motion`` run: the scene's robot (or ``who``: a robot id, a manifest) swaying
+    or holding for ``steps`` steps, every frame and joint state recorded."""
+    from openral_core import open_robot
+    from openral_core.loader import load_scene
+    from openral_hal.factory import HalMode, build_hal
+    from openral_sim.scene import build_scene, check_scene_robot, scene_robot
+    from rich.table import Table
+
+    robot, manifest = who
     if motion not in MOTIONS:
         raise typer.BadParameter("expected 'sway' or 'hold'", param_hint="--motion")
-    steps = steps or DEFAULT_STEPS
     scene = load_scene(config)
     if manifest is not None:
         loaded = open_robot(manifest)
