@@ -290,3 +290,20 @@ def test_gravity_compensation_is_refused_on_a_floating_base(
             "leave it out (or false)"
         )
     }
+
+
+def test_a_tool_frame_quaternion_must_be_unit_and_is_stored_normalised(
+    write_manifest: ManifestWriter,
+) -> None:
+    jaw = "mirror_actuator_index: 3}"
+    path = write_manifest((jaw, "mirror_actuator_index: 3, tcp_quat_wxyz: [0.0, 0.5, 0.5, 0.0]}"))
+    assert _findings(path) == {
+        "sim.grippers[0].tcp_quat_wxyz": "norm 0.7071; expected a unit quaternion (norm 1)"
+    }
+    near = write_manifest(
+        (jaw, "mirror_actuator_index: 3, tcp_quat_wxyz: [0.0, 0.9995, 0.0, 0.0]}")
+    )
+    from openral_core.tables import hal_wiring
+
+    wiring = hal_wiring(load_robot(near))
+    assert wiring is not None and wiring.grippers[0].tcp_quat_wxyz == (0.0, 1.0, 0.0, 0.0)

@@ -86,13 +86,33 @@ def test_modes_the_scene_or_robot_cannot_take_are_one_clear_error() -> None:
     robosuite = ROBOTS / "franka_panda" / "scenes" / "lift_robosuite.yaml"
     with pytest.raises(ValueError, match="ee_pose needs a native scene"):
         make_env(robosuite, action_mode="ee_pose")
-    ur5e = ROBOTS / "ur5e" / "scenes" / "tabletop.yaml"
+    ur5e = ROBOTS / "ur5e" / "scenes" / "tabletop.yaml"  # no gripper: no tool centre point
     with pytest.raises(ValueError, match=r"sim.grippers\[0\].tcp_body"):
         make_env(ur5e, action_mode="ee_delta_pose")
 
 
+def test_a_five_joint_arm_puts_its_tcp_where_asked_first() -> None:
+    """The so101 (5 arm joints) cannot hold any pose: asked for position and orientation,
+    it reaches the position (the tool frame from its tcp_quat_wxyz points along the jaws)."""
+    env = make_env(
+        ROBOTS / "so101" / "scenes" / "tabletop.yaml", action_mode="ee_delta_pose", sensors=False
+    )
+    try:
+        env.reset(seed=0)
+        down = np.array([0.0, 0.0, -0.1, 0.0, 0.0, 0.0, -1.0])  # 5 mm a step down
+        for _ in range(3):  # the arm's servos still settle under gravity after the reset
+            obs, *_ = env.step(down)
+        start = obs["tcp_pose"][:3].copy()
+        for _ in range(8):
+            obs, *_ = env.step(down)
+        moved = obs["tcp_pose"][:3] - start
+        assert abs(moved[2] + 0.04) < 0.005 and np.linalg.norm(moved[:2]) < 0.005, moved
+    finally:
+        env.close()
+
+
 @pytest.mark.parametrize("mode", ["ee_delta_pose", "ee_pose"])
-@pytest.mark.parametrize("robot", ["franka_panda", "panda_mobile"])
+@pytest.mark.parametrize("robot", ["franka_panda", "panda_mobile", "so101"])
 def test_gymnasium_check_env_passes_in_end_effector_modes(robot: str, mode: str) -> None:
     from gymnasium.utils.env_checker import check_env
 

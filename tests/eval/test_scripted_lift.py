@@ -88,8 +88,8 @@ def test_the_gripper_holds_the_lifted_cube() -> None:
 
 
 def test_without_a_tool_centre_point_in_the_manifest_it_says_where_to_add_one() -> None:
-    so101 = str(ROBOTS / "so101" / "scenes" / "tabletop.yaml")  # no tcp_body in its manifest
-    result = run_episode(EpisodeSpec(so101, 0, "scripted_lift", (), 5))
+    ur5e = str(ROBOTS / "ur5e" / "scenes" / "tabletop.yaml")  # no gripper, so no tool centre point
+    result = run_episode(EpisodeSpec(ur5e, 0, "scripted_lift", (), 5))
     assert result.error is not None and result.steps == 0
     assert "ee_delta_pose needs a native scene and a robot with a tool centre point" in result.error
     assert "sim.grippers[0].tcp_body" in result.error

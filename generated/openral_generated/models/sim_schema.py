@@ -69,6 +69,11 @@ TcpOffsetMItem = TypeAliasType(
 )
 
 
+TcpQuatWxyzItem = TypeAliasType(
+    "TcpQuatWxyzItem", Annotated[StrictFloat, Field(ge=-1.0, le=1.0)]
+)
+
+
 class SimGripperDescription(OpenralModel):
     """
     Wiring of one gripper.
@@ -124,6 +129,13 @@ class SimGripperDescription(OpenralModel):
     ] = None
     """
     The tool centre point (between the fingertips when closed) in `tcp_body`'s frame [m]. Absent with a `tcp_body`: the body's origin.
+    """
+    tcp_quat_wxyz: Annotated[
+        list[TcpQuatWxyzItem] | None,
+        Field(examples=[[0.0, 1.0, 0.0, 0.0]], max_length=4, min_length=4),
+    ] = None
+    """
+    Orientation of the tool frame in `tcp_body`'s frame, a unit quaternion (w, x, y, z): the tool frame's z axis points along the fingers, away from the wrist, and its x axis across the jaws. Absent: the body's own axes (a body whose z axis already points along the fingers, as the Panda's hand).
     """
 
 

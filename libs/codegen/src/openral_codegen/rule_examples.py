@@ -140,6 +140,13 @@ RULE_BREAKS = (
         "  floating_base: true\n  gravity_compensation: true\n",
     ),
     RuleBreak(
+        SchemaName.ROBOT,
+        18,
+        ROBOT_FILE,
+        "tcp_offset_m: [0.0, 0.0, 0.1034]",
+        "tcp_offset_m: [0.0, 0.0, 0.1034]\n      tcp_quat_wxyz: [0.0, 1.0, 1.0, 0.0]",
+    ),
+    RuleBreak(
         SchemaName.SCENE,
         1,
         SCENE_FILE,

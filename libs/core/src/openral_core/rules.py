@@ -7,6 +7,7 @@ in the file. The rules run only on documents that already passed the schema.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator, Mapping, Sequence
 
 from openral_core.episode_rules import episode_findings
@@ -201,6 +202,10 @@ def _sim_findings(robot: RobotDescription) -> Iterator[Finding]:
         low, high = gripper.ctrl_range
         if not low < high:
             yield (*path, "ctrl_range"), f"lower bound {low} must be below upper bound {high}"
+        quat = gripper.tcp_quat_wxyz
+        if quat is not None and abs(math.hypot(*quat) - 1.0) > 1e-3:  # rule 18
+            norm = math.hypot(*quat)
+            yield (*path, "tcp_quat_wxyz"), f"norm {norm:.4g}; expected a unit quaternion (norm 1)"
     yield from _start_pose_findings(robot, gripper_joints)
     if sim.gravity_compensation and sim.floating_base:  # rule 17
         yield (

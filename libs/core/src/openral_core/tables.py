@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -62,6 +63,8 @@ class GripperWiring:
     """MJCF body carrying the tool centre point (None: not declared)."""
     tcp_offset_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     """The tool centre point in ``tcp_body``'s frame [m]."""
+    tcp_quat_wxyz: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+    """The tool frame's orientation in ``tcp_body``'s frame (z along the fingers)."""
 
 
 @dataclass(frozen=True)
@@ -103,6 +106,7 @@ class HalWiring:
                     "ctrl_range": tuple(g["ctrl_range"]),
                     "qpos_addrs": tuple(g["qpos_addrs"]),
                     "tcp_offset_m": tuple(g.get("tcp_offset_m", (0.0, 0.0, 0.0))),
+                    "tcp_quat_wxyz": tuple(g.get("tcp_quat_wxyz", (1.0, 0.0, 0.0, 0.0))),
                 }
             )
             for g in data["grippers"]
@@ -232,6 +236,7 @@ def hal_wiring(robot: RobotDescription) -> HalWiring | None:
             mirror_actuator_index=g.mirror_actuator_index,
             tcp_body=g.tcp_body,
             tcp_offset_m=_triple(g.tcp_offset_m),
+            tcp_quat_wxyz=_unit_quat(g.tcp_quat_wxyz),
         )
         for g in sim.grippers
     )
@@ -352,6 +357,15 @@ def _gains(
         return {n: float(gains) for n in driven}
 
     return per_joint(control.kp), per_joint(control.kd)
+
+
+def _unit_quat(values: list[float] | None) -> tuple[float, float, float, float]:
+    """``values`` normalised (rule 18 bounds how far from unit they may be), else identity."""
+    if values is None:
+        return (1.0, 0.0, 0.0, 0.0)
+    norm = math.hypot(*values)
+    w, x, y, z = (v / norm for v in values)
+    return (w, x, y, z)
 
 
 def _triple(values: list[float] | None) -> tuple[float, float, float]:

@@ -1,7 +1,7 @@
 """The robot's tool centre point (TCP) in a native scene, and the one IK that moves it.
 
 The TCP is the manifest's first gripper's ``tcp_body`` with its ``tcp_offset_m`` (between
-the fingertips). Its pose is stated in the robot's base frame (the frame ``/tf`` calls the
+the fingertips) and ``tcp_quat_wxyz`` (the tool frame: z along the fingers). Its pose is stated in the robot's base frame (the frame ``/tf`` calls the
 base: a mobile base's moving frame, else the robot's root): position [m] and orientation
 as a unit quaternion (w, x, y, z).
 
@@ -9,7 +9,8 @@ as a unit quaternion (w, x, y, z).
 IK with mink on the scene's own model (the kinematics the robot really has there), solved
 by daqp as one quadratic programme per control tick:
 
-- a frame task on the TCP body (gain 1: the whole error in one control period);
+- a frame task on the TCP body (gain 1: the whole error in one control period; on an arm
+  of fewer than six joints, which cannot hold every pose, the orientation weighs a tenth);
 - the manifest's position limits of every arm joint (:class:`ArmPositionLimit`) and its
   velocity limits (mink's ``VelocityLimit``) as inequalities;
 - every other degree of freedom (grippers, a mobile base, the scene's objects) frozen.
@@ -34,6 +35,11 @@ SOLVER = "daqp"
 """The QP solver of every IK step."""
 _SPEED_SHARE = 0.8
 """Share of a joint's velocity limit the IK may plan for (the rest: the servo's headroom)."""
+_FULL_POSE_JOINTS = 6
+"""Arm joints it takes to place the TCP anywhere in any orientation."""
+_FEW_JOINTS_TURN_COST = 0.1
+"""Weight of the orientation error [1/rad] against the position error [1/m] for an arm with
+fewer joints (a 5-joint arm cannot hold both; the position comes first)."""
 _POSITION_GAIN = 0.95
 """Share of the distance to a position limit one step may close (mink's default)."""
 
@@ -80,10 +86,14 @@ class EndEffector:
         if self.body < 0:
             raise HalError(f"the scene's model has no body {gripper.tcp_body!r} (tcp_body)")
         self.offset = np.asarray(gripper.tcp_offset_m, dtype=np.float64)
+        turn = mink.SO3(np.asarray(gripper.tcp_quat_wxyz, dtype=np.float64))
+        self.flange = mink.SE3.from_rotation_and_translation(turn, self.offset)
+        """The TCP's pose in the ``tcp_body`` frame."""
         self.arm = addresses.arm_slots
         self.configuration = mink.Configuration(model)
+        turning = 1.0 if len(self.arm) >= _FULL_POSE_JOINTS else _FEW_JOINTS_TURN_COST
         self.task = mink.FrameTask(
-            gripper.tcp_body, "body", position_cost=1.0, orientation_cost=1.0, gain=1.0
+            gripper.tcp_body, "body", position_cost=1.0, orientation_cost=turning, gain=1.0
         )
         self._limits, self._frozen = self._constraints(model, addresses, robot)
         self._arm_qpos = addresses.qpos[self.arm]
@@ -112,18 +122,17 @@ class EndEffector:
 
     def world_pose(self, data: mujoco.MjData) -> mink.SE3:
         """The TCP's pose in the world frame as ``data`` holds it."""
-        rotation = data.xmat[self.body].reshape(3, 3)
-        position = data.xpos[self.body] + rotation @ self.offset
-        return mink.SE3.from_rotation_and_translation(
-            mink.SO3(np.array(data.xquat[self.body])), position
+        body = mink.SE3.from_rotation_and_translation(
+            mink.SO3(np.array(data.xquat[self.body])), np.array(data.xpos[self.body])
         )
+        return body.multiply(self.flange)
 
     def commanded_pose(self, data: mujoco.MjData, commanded: FloatArray) -> mink.SE3:
         """The TCP's world pose with the arm at its ``commanded`` targets (the rest of the
         state from ``data``)."""
         self._set(data, commanded)
-        flange = self.configuration.get_transform_frame_to_world(self.task.frame_name, "body")
-        return flange.multiply(mink.SE3.from_translation(self.offset))
+        body = self.configuration.get_transform_frame_to_world(self.task.frame_name, "body")
+        return body.multiply(self.flange)
 
     def _set(self, data: mujoco.MjData, commanded: FloatArray) -> None:
         q = np.array(data.qpos)
@@ -145,8 +154,7 @@ class EndEffector:
             HalError: The solver found no step (it reports why).
         """
         self._set(data, commanded)
-        flange = mink.SE3.from_translation(self.offset).inverse()
-        self.task.set_target(target_world.multiply(flange))
+        self.task.set_target(target_world.multiply(self.flange.inverse()))
         try:
             velocity = mink.solve_ik(
                 self.configuration,
