@@ -1,9 +1,10 @@
 """The robot's tool centre point (TCP) in a native scene, and the one IK that moves it.
 
 The TCP is the manifest's first gripper's ``tcp_body`` with its ``tcp_offset_m`` (between
-the fingertips) and ``tcp_quat_wxyz`` (the tool frame: z along the fingers). Its pose is stated in the robot's base frame (the frame ``/tf`` calls the
-base: a mobile base's moving frame, else the robot's root): position [m] and orientation
-as a unit quaternion (w, x, y, z).
+the fingertips) and ``tcp_quat_wxyz`` (the tool frame: z along the fingers). Its pose is
+stated in the robot's base frame (the frame ``/tf`` calls the base: a mobile base's moving
+frame, else the robot's root): position [m] and orientation as a unit quaternion (w, x, y,
+z).
 
 :meth:`EndEffector.joint_targets` turns a TCP pose into arm joint targets by differential
 IK with mink on the scene's own model (the kinematics the robot really has there), solved
