@@ -39,7 +39,6 @@ from openral_hal.factory import HalMode, build_hal
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_mujoco.action import validated_action
 from openral_mujoco.errors import ActionRejected
-from openral_sim.ee_modes import pose_vector
 from openral_sim.rollout import SceneRollout
 from openral_sim.scene import scene_robot
 from openral_sim.state_sensors import state_sensors_of
@@ -241,7 +240,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         if self._ee is None:
             return None
         handles = self.hal.mujoco_handles()
-        return None if handles is None else pose_vector(self._ee.tcp_pose(handles[1]))
+        return None if handles is None else self._ee.tcp_vector(handles[1])
 
     @staticmethod
     def _info(*, success: bool) -> dict[str, Any]:

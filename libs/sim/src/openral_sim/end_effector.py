@@ -87,7 +87,8 @@ class EndEffector:
         if self.body < 0:
             raise HalError(f"the scene's model has no body {gripper.tcp_body!r} (tcp_body)")
         self.offset = np.asarray(gripper.tcp_offset_m, dtype=np.float64)
-        turn = mink.SO3(np.asarray(gripper.tcp_quat_wxyz, dtype=np.float64))
+        self.flange_quat = np.asarray(gripper.tcp_quat_wxyz, dtype=np.float64)
+        turn = mink.SO3(self.flange_quat)
         self.flange = mink.SE3.from_rotation_and_translation(turn, self.offset)
         """The TCP's pose in the ``tcp_body`` frame."""
         self.arm = addresses.arm_slots
