@@ -124,3 +124,24 @@ def test_runner_refuses_a_policy_whose_slots_the_manifest_lacks() -> None:
         "g1: camera1 <- /openral/cameras/head/image; "
         "pick another policy or set its required_slots parameter"
     )
+
+
+class _EndEffectorPolicy:
+    """A policy whose actions are end-effector deltas (7 values), not joint targets."""
+
+    required_slots = ()
+    needs_privileged = False
+    action_mode = "ee_delta_pose"
+
+    def act(self, obs: Observation) -> npt.NDArray[np.float64]:
+        return np.zeros(7)
+
+
+def test_runner_refuses_a_policy_that_acts_in_end_effector_deltas() -> None:
+    with ros_session(DOMAIN_ID) as context, pytest.raises(RunnerAborted) as caught:
+        RskillRunnerNode(
+            context=context,
+            parameter_overrides=runner_parameters("franka_panda"),
+            policy=_EndEffectorPolicy(),
+        )
+    assert "acts in ee_delta_pose; a ROS graph takes joint targets" in str(caught.value)

@@ -28,6 +28,7 @@ from openral_bridge.ros_messages import LATCHED
 from openral_core import VlaSlot, open_robot_by_id
 from openral_core.errors import OpenralError
 from openral_eval.policies import Observation, PolicyAdapter, make_policy, parse_params
+from openral_eval.policy import action_mode
 from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -145,6 +146,12 @@ class RskillRunnerNode(Node):
             raise RunnerAborted(
                 f"policy {self.policy_name} reads the simulation itself (privileged state); "
                 "it runs in `openral sim sweep`, not on a ROS graph"
+            )
+        if action_mode(self.policy) != "joint_position":
+            raise RunnerAborted(
+                f"policy {self.policy_name} acts in {action_mode(self.policy)}; a ROS graph "
+                "takes joint targets on /openral/safe_action (end-effector targets are not "
+                "served there yet); run it with `openral sim sweep` or `sim run --policy`"
             )
         provided = [entry.slot for entry in self.slot_table]
         if any(slot not in provided for slot in self.policy.required_slots):
