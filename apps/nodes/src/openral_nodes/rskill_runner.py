@@ -112,6 +112,26 @@ def runner_parameters(
     return [Parameter(n, t, v) for n, t, v in values]  # type: ignore[no-untyped-call]
 
 
+def _refuse_off_graph(policy: PolicyAdapter, name: str) -> None:
+    """Refuse, in one line, a policy a ROS graph cannot serve: one that reads the
+    simulation itself, or one whose actions are not joint targets.
+
+    Raises:
+        RunnerAborted: Such a policy.
+    """
+    if policy.needs_privileged:
+        raise RunnerAborted(
+            f"policy {name} reads the simulation itself (privileged state); "
+            "it runs in `openral sim sweep`, not on a ROS graph"
+        )
+    if action_mode(policy) != "joint_position":
+        raise RunnerAborted(
+            f"policy {name} acts in {action_mode(policy)}; a ROS graph takes joint targets "
+            "on /openral/safe_action (end-effector targets are not served there yet); run it "
+            "with `openral sim sweep` or `sim run --policy`"
+        )
+
+
 class RskillRunnerNode(Node):
     """Runs one policy against the openral topic contract (see the module docstring).
 
@@ -142,17 +162,7 @@ class RskillRunnerNode(Node):
         self.slot_table = robot.tables.vla_slots
         self.policy = policy or make_policy(policy_name, parse_params(params or []))
         self.policy_name = policy_name if policy is None else type(policy).__name__
-        if self.policy.needs_privileged:
-            raise RunnerAborted(
-                f"policy {self.policy_name} reads the simulation itself (privileged state); "
-                "it runs in `openral sim sweep`, not on a ROS graph"
-            )
-        if action_mode(self.policy) != "joint_position":
-            raise RunnerAborted(
-                f"policy {self.policy_name} acts in {action_mode(self.policy)}; a ROS graph "
-                "takes joint targets on /openral/safe_action (end-effector targets are not "
-                "served there yet); run it with `openral sim sweep` or `sim run --policy`"
-            )
+        _refuse_off_graph(self.policy, self.policy_name)
         provided = [entry.slot for entry in self.slot_table]
         if any(slot not in provided for slot in self.policy.required_slots):
             raise MissingSlots(
