@@ -34,19 +34,16 @@ from pathlib import Path
 import mujoco
 import numpy as np
 from openral_core.loaded import LoadedRobot
-from openral_core.loader import load_scene
-from openral_hal.factory import HalMode, build_hal
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_sim.observation import Observation as SceneObservation
 from openral_sim.rollout import SceneRollout
-from openral_sim.scene import scene_robot
 from openral_sim.sensor_schedule import sensor_rates
 
 from openral_eval.env_actions import ActionMode
 from openral_eval.policies import make_policy
 from openral_eval.policy import Observation, PolicyAdapter, action_mode
 from openral_eval.privileged import Pose, Privileged, PrivilegedGripper
-from openral_eval.scene_env import EnvConfig, SceneEnv
+from openral_eval.scene_env import EnvConfig, SceneEnv, attached_hal, scene_horizon
 from openral_eval.video import VideoWriter
 
 DEFAULT_STEPS = 300
@@ -111,14 +108,10 @@ def scene_for(path: str) -> tuple[SimAttachedHAL, LoadedRobot]:
     """The HAL of the scene of ``path`` and its robot, built once per process by
     :func:`~openral_hal.factory.build_hal`."""
     if path not in _HALS:
-        scene = load_scene(Path(path))
-        robot = scene_robot(scene)
-        hal = build_hal(robot, mode=HalMode.SIM, scene=scene)
-        if not isinstance(hal, SimAttachedHAL):  # build_hal attaches every scene
-            raise TypeError(f"build_hal gave a {type(hal).__name__} for scene {path}")
+        built = attached_hal(path)
         if not _HALS:
             atexit.register(close_scenes)
-        _HALS[path] = (hal, robot)
+        _HALS[path] = built
     return _HALS[path]
 
 
@@ -203,7 +196,7 @@ def env_for(spec: EpisodeSpec, sensors: tuple[str, ...], mode: str) -> SceneEnv:
     this process's HAL of the scene): ``sensors`` rendered, actions in ``mode``, truncated
     at the step limit."""
     hal, robot = scene_for(spec.scene)
-    limit = spec.steps or _horizon(hal) or DEFAULT_STEPS
+    limit = spec.steps or scene_horizon(hal) or DEFAULT_STEPS
     key = (spec.scene, sensors, limit, mode)
     if key not in _ENVS:
         config = EnvConfig(
@@ -219,10 +212,6 @@ def _frame_rate_hz(hal: SimAttachedHAL, robot: LoadedRobot, camera: str | None) 
         return 1.0
     control_hz = 1.0 / hal.control_period_s
     return sensor_rates(robot.description, control_hz, sensors=[camera])[camera]
-
-
-def _horizon(hal: SimAttachedHAL) -> int | None:
-    return hal.env.horizon if isinstance(hal.env, SceneRollout) else None
 
 
 class _Inputs:

@@ -119,7 +119,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
             raise ValueError(f"unknown render mode {render_mode!r}; valid: rgb_array")
         self.render_mode = render_mode
         self._owns_hal = hal is None
-        self.hal, self.robot = hal if hal is not None else _build(self.config.scene)
+        self.hal, self.robot = hal if hal is not None else attached_hal(self.config.scene)
         self._observed = self._chosen_sensors()
         self._choose_sensors()
         self.hal.env_reset_seed = 0
@@ -147,7 +147,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         """The action space, typed as what it is."""
         self.action_space = self.box
         self.steps = 0
-        self._limit = self.config.max_steps or _horizon(self.hal)
+        self._limit = self.config.max_steps or scene_horizon(self.hal)
         if self.config.seed is not None:
             self.action_space.seed(self.config.seed)
             super().reset(seed=self.config.seed)
@@ -277,8 +277,9 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
             scene.render_observations = True
 
 
-def _build(scene_file: str) -> tuple[SimAttachedHAL, LoadedRobot]:
-    """The HAL of ``scene_file`` (not yet connected) and its robot."""
+def attached_hal(scene_file: str) -> tuple[SimAttachedHAL, LoadedRobot]:
+    """The HAL :func:`~openral_hal.factory.build_hal` attaches to ``scene_file`` (not yet
+    connected), and its robot."""
     scene = load_scene(Path(scene_file))
     robot = scene_robot(scene)
     hal = build_hal(robot, mode=HalMode.SIM, scene=scene)
@@ -287,7 +288,8 @@ def _build(scene_file: str) -> tuple[SimAttachedHAL, LoadedRobot]:
     return hal, robot
 
 
-def _horizon(hal: SimAttachedHAL) -> int | None:
+def scene_horizon(hal: SimAttachedHAL) -> int | None:
+    """Steps per episode of the scene ``hal`` is attached to (None: it sets none)."""
     return hal.env.horizon if isinstance(hal.env, SceneRollout) else None
 
 
