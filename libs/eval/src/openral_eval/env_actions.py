@@ -112,16 +112,16 @@ class ActionContract:
         joints, twist = values, None
         if self.base:
             joints, twist = values[:-3], BaseTwist(*(float(v) for v in values[-3:]))
-        glide = self.mode is not ActionMode.JOINT_POSITION
-        if glide:
+        if self.mode is not ActionMode.JOINT_POSITION:
             joints = self._joint_action(joints)
+        action: object = joints
         if twist is not None:
             slots = dict(zip(self.hal.action_names, joints.tolist(), strict=True))
-            self.hal.tick(Action(slots=slots, base=twist), glide=glide)
-        elif glide:
-            self.hal.tick(joints, glide=True)
-        else:
-            self.hal.send_action(joints)
+            action = Action(slots=slots, base=twist)
+        if self.mode is ActionMode.JOINT_POSITION:
+            self.hal.send_action(action)
+        else:  # the IK's targets are the next sample of a path: the set point glides there
+            self.hal.tick(action, glide=True)
 
     def _joint_action(self, values: FloatArray) -> FloatArray:
         """The joint action of an end-effector action: the hold, with the IK's arm targets

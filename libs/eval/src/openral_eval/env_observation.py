@@ -86,7 +86,8 @@ class ObservationLayout:
         slots = {slot.sensor: slot.slot for slot in robot.tables.vla_slots}
         self.slots = {sensor: slot for sensor, slot in slots.items() if sensor in first.images}
         self.privileged = privileged
-        self._latest: EnvObservation = {}
+        self._latest: dict[str, dict[str, object]] = {}
+        """Sensor kind → sensor → its newest frame."""
         self.space = spaces.Dict(self._spaces(self.observe(first, joints, tcp_pose)))
 
     def _spaces(self, obs: EnvObservation, low: float = -_INF) -> dict[str, spaces.Space[object]]:
@@ -122,9 +123,7 @@ class ObservationLayout:
         self._keep("depth", {n: _depth_image(f.depth_m) for n, f in obs.depth.items()})
         self._keep("lidar", {n: scan.ranges for n, scan in obs.scans.items()})
         self._keep("state_sensors", {n: _reading(r) for n, r in obs.readings.items()})
-        for kind, frames in self._latest.items():
-            if isinstance(frames, dict) and frames:
-                out[kind] = _copied(frames)
+        out.update((kind, _copied(frames)) for kind, frames in self._latest.items() if frames)
         cameras = out.get("cameras")
         if isinstance(cameras, dict) and self.slots:
             out["camera_slots"] = {self.slots[n]: cameras[n] for n in self.slots if n in cameras}
@@ -140,9 +139,7 @@ class ObservationLayout:
 
     def _keep(self, kind: str, frames: Mapping[str, object]) -> None:
         """Remember the newest frame of each sensor of ``kind``."""
-        latest = self._latest.setdefault(kind, {})
-        if isinstance(latest, dict):
-            latest.update(frames)
+        self._latest.setdefault(kind, {}).update(frames)
 
 
 def _copied(frames: Mapping[str, object]) -> dict[str, object]:
