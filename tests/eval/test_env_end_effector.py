@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from openral_core.models import LimitedJoint
 from openral_eval.scene_env import SceneEnv, make_env
+from openral_mujoco.errors import ActionRejected
 
 from tests.conftest import ROBOTS
 
@@ -121,5 +122,22 @@ def test_gymnasium_check_env_passes_in_end_effector_modes(robot: str, mode: str)
         check_env(env, skip_render_check=True)
         base = ("base_vx_m_s", "base_vy_m_s", "base_wz_rad_s") if robot == "panda_mobile" else ()
         assert env.action_names[-len(base) or None :] == base or not base
+    finally:
+        env.close()
+
+
+def test_an_ee_pose_without_an_orientation_is_refused_and_nothing_moves() -> None:
+    env = make_env(TABLETOP, action_mode="ee_pose", sensors=False)
+    try:
+        obs, _ = env.reset(seed=0)
+        before = env.hal.read_state()
+        zero = np.concatenate([obs["tcp_pose"][:3], np.zeros(4), [1.0]])
+        with pytest.raises(ActionRejected, match=r"quaternion \(qw, qx, qy, qz\) has norm 0"):
+            env.step(zero)
+        after = env.hal.read_state()
+        assert after.sim_time_s == before.sim_time_s
+        np.testing.assert_array_equal(after.positions, before.positions)
+        obs, *_ = env.step(np.concatenate([obs["tcp_pose"], [1.0]]))  # a good one still works
+        assert np.linalg.norm(obs["tcp_pose"][:3] - zero[:3]) < 0.01
     finally:
         env.close()

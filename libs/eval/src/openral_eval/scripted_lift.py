@@ -28,9 +28,9 @@ import mujoco
 import numpy as np
 from openral_mujoco.state import FloatArray
 from openral_sim.ee_modes import PRESETS
+from openral_sim.frame_tree import pose_in_frame
 
 from openral_eval.policy import Observation, PolicyConfigError
-from openral_eval.privileged import Pose
 
 PHASES = ("approach", "descend", "close", "lift")
 TURN_RATE = 1.5
@@ -97,7 +97,7 @@ class ScriptedLift:
         if self.config.object not in world.objects:
             have = ", ".join(sorted(world.objects)) or "none"
             raise PolicyConfigError(f"no scene object {self.config.object!r}; objects: {have}")
-        cube, cube_quat = _in_base(world.base, world.objects[self.config.object])
+        cube, cube_quat = pose_in_frame(world.base, world.objects[self.config.object])
         if self._start is None:
             self._start = cube.copy()
         target, gripper = self._phase_target(cube, tcp[:3])
@@ -139,17 +139,6 @@ class ScriptedLift:
         spin = turn * self._period_s / PRESET.rotation_rad
         motion: FloatArray = np.clip(np.concatenate([move, spin]), -1.0, 1.0)
         return motion
-
-
-def _in_base(base: Pose, pose: Pose) -> tuple[FloatArray, FloatArray]:
-    """``pose`` (world) in the frame whose world pose is ``base``."""
-    position, quat = base
-    inverse = np.empty(4)
-    mujoco.mju_negQuat(inverse, quat)
-    local, turned = np.empty(3), np.empty(4)
-    mujoco.mju_rotVecQuat(local, np.asarray(pose[0]) - position, inverse)
-    mujoco.mju_mulQuat(turned, inverse, np.asarray(pose[1]))
-    return local, turned
 
 
 def _orientation_error(rotation: FloatArray, cube_quat: FloatArray) -> FloatArray:

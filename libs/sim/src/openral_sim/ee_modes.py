@@ -22,13 +22,16 @@ from dataclasses import dataclass
 import mink
 import mujoco
 import numpy as np
+from openral_mujoco.errors import ActionRejected
 from openral_mujoco.state import FloatArray
 
 from openral_sim.end_effector import EndEffector
-from openral_sim.frame_tree import FrameTree
+from openral_sim.frame_tree import FrameTree, pose_in_frame
 
 DELTA_WIDTH = 7
 POSE_WIDTH = 8
+_SMALLEST_QUAT = 1e-6
+"""An ``ee_pose`` quaternion shorter than this has no direction to normalise to."""
 _SNAP_M = 1e-3
 """A step that ends farther than this from the reference [m] moves the reference there."""
 
@@ -69,22 +72,9 @@ class EeCommand:
         position, quat = self.frames.base_pose(data)
         return mink.SE3.from_rotation_and_translation(mink.SO3(quat), position)
 
-    def tcp_pose(self, data: mujoco.MjData) -> mink.SE3:
-        """The TCP's pose in the base frame."""
-        return self.base(data).inverse().multiply(self.ee.world_pose(data))
-
     def tcp_vector(self, data: mujoco.MjData) -> FloatArray:
-        """:meth:`tcp_pose` as 7 values (position [m], quaternion w, x, y, z), with MuJoCo's
-        own quaternion routines (a few microseconds: it is in every observation)."""
-        body, ee = self.ee.body, self.ee
-        world_q, offset = np.empty(4), np.empty(3)
-        mujoco.mju_mulQuat(world_q, data.xquat[body], ee.flange_quat)
-        mujoco.mju_rotVecQuat(offset, ee.offset, data.xquat[body])
-        base_p, base_q = self.frames.base_pose(data)
-        inverse, position, quat = np.empty(4), np.empty(3), np.empty(4)
-        mujoco.mju_negQuat(inverse, base_q)
-        mujoco.mju_rotVecQuat(position, data.xpos[body] + offset - base_p, inverse)
-        mujoco.mju_mulQuat(quat, inverse, world_q)
+        """The TCP's pose in the base frame as 7 values: position [m], quaternion w, x, y, z."""
+        position, quat = pose_in_frame(self.frames.base_pose(data), self.ee.world_pose(data))
         return np.concatenate([position, quat])
 
     def reset(self, data: mujoco.MjData, commanded: FloatArray) -> None:
@@ -106,8 +96,18 @@ class EeCommand:
     def absolute(
         self, data: mujoco.MjData, commanded: FloatArray, action: FloatArray
     ) -> tuple[FloatArray, float]:
-        """(arm joint targets, gripper command) of one ``ee_pose`` action."""
-        quat = action[3:7] / np.linalg.norm(action[3:7])
+        """(arm joint targets, gripper command) of one ``ee_pose`` action.
+
+        Raises:
+            ActionRejected: The quaternion is (nearly) zero: no orientation at all.
+        """
+        norm = float(np.linalg.norm(action[3:7]))
+        if norm < _SMALLEST_QUAT:
+            raise ActionRejected(
+                f"ee_pose quaternion (qw, qx, qy, qz) has norm {norm:g}; expected a rotation "
+                "(it is normalised, but not from zero)"
+            )
+        quat = action[3:7] / norm
         self.reference = mink.SE3.from_rotation_and_translation(mink.SO3(quat), action[:3])
         return self._solve(data, commanded), float(action[7])
 

@@ -12,8 +12,9 @@ by daqp as one quadratic programme per control tick:
 
 - a frame task on the TCP body (gain 1: the whole error in one control period; on an arm
   of fewer than six joints, which cannot hold every pose, the orientation weighs a tenth);
-- the manifest's position limits of every arm joint (:class:`ArmPositionLimit`) and its
-  velocity limits (mink's ``VelocityLimit``) as inequalities;
+- the manifest's position limits of every arm joint (:class:`ArmPositionLimit`, the
+  envelope of :class:`~openral_mujoco.command_limits.CommandLimits`) and its velocity
+  limits (mink's ``VelocityLimit``) as inequalities;
 - every other degree of freedom (grippers, a mobile base, the scene's objects) frozen.
 
 A target out of reach is approached as far as those limits allow and no further: the
@@ -27,7 +28,7 @@ import mujoco
 import numpy as np
 from mink.limits.limit import Constraint
 from openral_core.loaded import LoadedRobot
-from openral_core.models import LimitedJoint
+from openral_mujoco.command_limits import CommandLimits
 from openral_mujoco.errors import HalError
 from openral_mujoco.robot_addresses import RobotAddresses
 from openral_mujoco.state import FloatArray
@@ -108,26 +109,25 @@ class EndEffector:
     ) -> tuple[list[mink.Limit], list[mink.DofFreezingTask]]:
         """The arm's position and velocity limits, and every other DOF frozen."""
         joints = [robot.description.joints[int(i)] for i in self.arm]
-        low = np.array(
-            [j.position_limits[0] if isinstance(j, LimitedJoint) else -np.inf for j in joints]
-        )
-        high = np.array(
-            [j.position_limits[1] if isinstance(j, LimitedJoint) else np.inf for j in joints]
-        )
+        wiring = robot.tables.hal_wiring
+        envelope = CommandLimits(robot.description, wiring.grippers if wiring is not None else ())
+        low, high = envelope.low[self.arm], envelope.high[self.arm]
         dofs = [int(d) for d in addresses.qvel[self.arm]]
         positions = ArmPositionLimit(model.nv, list(addresses.qpos[self.arm]), dofs, low, high)
         names = robot.tables.joint_name_map
         speeds = {names[j.name]: _SPEED_SHARE * j.velocity_limit for j in joints}
-        frozen = [d for d in range(model.nv) if d not in set(dofs)]
+        arm_dofs = set(dofs)
+        frozen = [d for d in range(model.nv) if d not in arm_dofs]
         freeze = [mink.DofFreezingTask(model, dof_indices=frozen)] if frozen else []
         return [positions, mink.VelocityLimit(model, speeds)], freeze
 
-    def world_pose(self, data: mujoco.MjData) -> mink.SE3:
-        """The TCP's pose in the world frame as ``data`` holds it."""
-        body = mink.SE3.from_rotation_and_translation(
-            mink.SO3(np.array(data.xquat[self.body])), np.array(data.xpos[self.body])
-        )
-        return body.multiply(self.flange)
+    def world_pose(self, data: mujoco.MjData) -> tuple[FloatArray, FloatArray]:
+        """The TCP's world position [m] and orientation (w, x, y, z) as ``data`` holds them
+        (MuJoCo's own quaternion routines: a few microseconds, it is in every observation)."""
+        quat, offset = np.empty(4), np.empty(3)
+        mujoco.mju_mulQuat(quat, data.xquat[self.body], self.flange_quat)
+        mujoco.mju_rotVecQuat(offset, self.offset, data.xquat[self.body])
+        return data.xpos[self.body] + offset, quat
 
     def commanded_pose(self, data: mujoco.MjData, commanded: FloatArray) -> mink.SE3:
         """The TCP's world pose with the arm at its ``commanded`` targets (the rest of the

@@ -251,6 +251,19 @@ def _sensor_pose(data: mujoco.MjData, sensor: SensorFrame) -> tuple[FloatArray, 
     return np.array(data.site_xpos[sensor.site]), quat
 
 
+def pose_in_frame(
+    frame: tuple[FloatArray, FloatArray], pose: tuple[FloatArray, FloatArray]
+) -> tuple[FloatArray, FloatArray]:
+    """A world ``pose`` (position [m], quaternion w, x, y, z) in the frame whose world pose
+    is ``frame`` (one pose: MuJoCo's quaternion routines; :meth:`FrameSample.relative` does
+    the same for many rows)."""
+    inverse, position, quat = np.empty(4), np.empty(3), np.empty(4)
+    mujoco.mju_negQuat(inverse, frame[1])
+    mujoco.mju_rotVecQuat(position, np.asarray(pose[0]) - frame[0], inverse)
+    mujoco.mju_mulQuat(quat, inverse, np.asarray(pose[1]))
+    return position, quat
+
+
 # -- quaternions (w, x, y, z), one per row ---------------------------------------------------
 
 
