@@ -20,7 +20,8 @@ Transitions:
   time), take commands (``/openral/safe_action``, ``/openral/joint_trajectory``, the E-stop
   and ``/openral/reset`` services: :mod:`openral_nodes.command_interfaces`) and start the
   :class:`~openral_nodes.scene_bridges.SceneBridges` (cameras, depth and lidar, a mobile
-  base's ``/cmd_vel`` and ``/odom``);
+  base's ``/cmd_vel`` and ``/odom``, the TCP's ``/openral/ee_target`` and
+  ``/openral/tcp_pose``);
 - deactivate → stop all of that (the HAL stays connected and holds still);
 - cleanup / shutdown / error → also disconnect and drop the HAL; shutdown also sets the
   ``shutdown_event`` the owner passed, so a process can end when told to over ROS.
@@ -199,6 +200,8 @@ class ManifestLifecycleNode(LifecycleNode):
             viewer_enabled=bool(self._param("viewer_enabled")),
             camera_rate_hz=float(self._param("camera_publish_rate_hz")) or None,
             odom_rate_hz=float(self._param("joint_state_rate_hz")),
+            loop=self.loop,
+            robot=self._loaded,
         )
         self.bridge.setup()
         if self.loop is not None:  # the pace is judged from here on, not over the start-up

@@ -6,7 +6,10 @@
   sensors (:class:`~openral_bridge.state_sensor_bridge.StateSensorBridge`): whatever HAL
   implements the sensor Protocols (:mod:`openral_sim.sensor_sources`), simulated or real;
 - for a robot with a mobile base, ``/cmd_vel`` in and ``/odom`` out
-  (:class:`~openral_bridge.base_bridge.BaseBridge`, at the joint-state rate).
+  (:class:`~openral_bridge.base_bridge.BaseBridge`, at the joint-state rate);
+- for a robot with a tool centre point in a native scene, ``/openral/ee_target`` in and
+  ``/openral/tcp_pose`` out (:class:`~openral_bridge.ee_bridge.EeBridge`, at the
+  joint-state rate).
 
 Every sensor's rate comes from one rule (:func:`~openral_sim.sensor_schedule.sensor_rates`):
 its manifest rate, the ``camera_rate_hz`` override applied to RGB, depth and lidar alike,
@@ -21,13 +24,18 @@ import threading
 from typing import TYPE_CHECKING
 
 from openral_bridge.base_bridge import BaseBridge
+from openral_bridge.control_loop import ControlLoop
+from openral_bridge.ee_bridge import EeBridge
 from openral_bridge.pacer import Pacer
 from openral_bridge.range_bridge import RangeBridge
 from openral_bridge.sim_sensor_bridge import SimSensorBridge
 from openral_bridge.state_sensor_bridge import StateSensorBridge
 from openral_bridge.topics import TopicInfo
+from openral_core.loaded import LoadedRobot
 from openral_hal.factory import can_tick
 from openral_hal.protocol import MobileBaseHal, RobotHal
+from openral_hal.sim_attached import SimAttachedHAL
+from openral_hal.tool_centre import ee_command
 from openral_sim.sensor_schedule import sensor_rates
 from openral_sim.sensor_sources import DepthSource, LidarSource, StateSensorSource
 
@@ -48,6 +56,8 @@ class SceneBridges:
         viewer_enabled: bool,
         camera_rate_hz: float | None,
         odom_rate_hz: float,
+        loop: ControlLoop | None = None,
+        robot: LoadedRobot | None = None,
     ) -> None:
         """Nothing is created until :meth:`setup` (see the bridges for the arguments)."""
         control_hz = 1.0 / hal.control_period_s if can_tick(hal) else None
@@ -63,6 +73,7 @@ class SceneBridges:
         self.base = None
         if isinstance(hal, MobileBaseHal) and hal.base is not None:
             self.base = BaseBridge(node, hal, odom_rate_hz, lock)
+        self.ee = _ee_bridge(node, hal, loop, robot, odom_rate_hz, lock)
         self.sensors = SimSensorBridge(
             node,
             hal,
@@ -84,6 +95,8 @@ class SceneBridges:
             self.state.start(self.pacer)
         if self.base is not None:
             self.base.start(self.pacer)
+        if self.ee is not None:
+            self.ee.start(self.pacer)
 
     def publish_now(self) -> None:
         """Every camera, depth camera and lidar publishes the scene as it is now (after a
@@ -96,6 +109,8 @@ class SceneBridges:
 
     def teardown(self) -> None:
         """Stop every bridge (idempotent)."""
+        if self.ee is not None:
+            self.ee.stop()
         if self.base is not None:
             self.base.stop()
         if self.state is not None:
@@ -109,4 +124,24 @@ class SceneBridges:
         rows = self.sensors.topics()
         rows += self.range.topics() if self.range is not None else []
         rows += self.state.topics() if self.state is not None else []
+        rows += self.ee.topics() if self.ee is not None else []
         return rows + (self.base.topics() if self.base is not None else [])
+
+
+def _ee_bridge(
+    node: Node,
+    hal: RobotHal,
+    loop: ControlLoop | None,
+    robot: LoadedRobot | None,
+    rate_hz: float,
+    lock: threading.Lock,
+) -> EeBridge | None:
+    """The end-effector bridge of a simulated HAL whose action slots are the manifest
+    joints, in a native scene, of a robot with a TCP (else None)."""
+    if loop is None or robot is None or not isinstance(hal, SimAttachedHAL):
+        return None
+    if hal.action_names != hal.joint_names:
+        return None
+    with lock:
+        ee = ee_command(hal, robot)
+    return EeBridge(node, hal, ee, loop, rate_hz, lock) if ee is not None else None

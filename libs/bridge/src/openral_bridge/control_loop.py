@@ -13,7 +13,9 @@ the scene's ``control_freq_hz``) and each tick advances the scene by exactly one
   in force on a position-controlled scene, the backend's hold on a delta controller);
 - with no new action while a joint trajectory runs (:attr:`ControlLoop.follower`), gliding
   to the trajectory's point at the end of the period; an offered action pre-empts the
-  trajectory, and a tick the E-stop keeps from stepping aborts it.
+  trajectory, and a tick the E-stop keeps from stepping aborts it;
+- else, with an end-effector target in force (:attr:`ControlLoop.ee`), gliding to the IK's
+  step towards it; an offered action, a trajectory, the E-stop and a reset end the target.
 
 A reset (:meth:`ControlLoop.reset`, any thread) is carried out by the next tick instead of
 a step, so it never races one: the scene is reset, stepped once with its hold (as
@@ -40,7 +42,7 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 from openral_hal.protocol import Tickable
@@ -57,6 +59,20 @@ WARN_EVERY_S = 2.0
 """At most one warning per this many seconds for a stream of failing ticks [s]."""
 RESET_TIMEOUT_S = 10.0
 """Longest wait of :meth:`ControlLoop.reset` for a tick to carry the reset out [s]."""
+
+
+class Following(Protocol):
+    """What a control loop follows between offered actions: a path, a target."""
+
+    def next_action(
+        self, hold: FloatArray, now_s: float, period_s: float
+    ) -> tuple[FloatArray, DesiredPoint] | None:
+        """The action of the coming period and its desired point (None: nothing to follow)."""
+        ...
+
+    def cancel(self, reason: str = "cancelled") -> bool:
+        """Stop following; True when something was followed."""
+        ...
 
 
 class ResetFailed(RuntimeError):
@@ -102,9 +118,7 @@ class ControlLoop:
             on_reset: Called on the loop's thread right after a reset's tick (the HAL lock
                 is not held).
         """
-        self.node = node
-        self.hal = hal
-        self.on_tick = on_tick
+        self.node, self.hal, self.on_tick = node, hal, on_tick
         self.lock = lock if lock is not None else threading.Lock()
         self.period_s = float(hal.control_period_s)
         self.ticks = 0
@@ -117,13 +131,15 @@ class ControlLoop:
         """Ticks that raised (a diverged simulation, a refused action)."""
         self.watch = RealTimeWatch()
         self.state: JointStateSample | None = None
-        """The HAL's state read right after the last tick that stepped (holding the lock;
-        the scene does not change between ticks); None before one, or after a failed tick."""
-        self.follower = follower
-        self.on_sample = on_sample
-        self.on_reset = on_reset
+        """The HAL's state right after the last tick that stepped (read holding the lock);
+        None before one, or after a failed tick."""
+        self.follower, self.on_sample, self.on_reset = follower, on_sample, on_reset
         self.followed = 0
-        """Ticks that glided along a trajectory."""
+        """Ticks that glided along a trajectory or towards an end-effector target."""
+        self.ee: Following | None = None
+        """The end-effector target (wired by :mod:`openral_bridge.ee_bridge`); its points
+        go to :attr:`on_ee_sample`."""
+        self.on_ee_sample: Callable[[DesiredPoint], None] | None = None
         self.watchers: list[Callable[[JointStateSample], None]] = []
         """Called in order with the state after every tick that stepped the scene (the HAL
         lock not held), e.g. to judge a trajectory goal against its path."""
@@ -164,6 +180,8 @@ class ControlLoop:
             reset.done.set()
         if self.follower is not None:
             self.follower.cancel("the control loop stopped")
+        if self.ee is not None:
+            self.ee.cancel("the control loop stopped")
 
     def add_reader(self, read: Callable[[], None]) -> None:
         """Run ``read`` after every tick that steps (see :attr:`readers`), and once now,
@@ -178,6 +196,8 @@ class ControlLoop:
         it pre-empts a joint trajectory. True when it ended one."""
         follower = self.follower
         preempted = follower.cancel("a safe_action pre-empted it") if follower else False
+        if self.ee is not None:
+            self.ee.cancel("a safe_action pre-empted it")
         with self._pending_lock:
             if self._pending is not None:
                 self.superseded += 1
@@ -219,10 +239,11 @@ class ControlLoop:
             self._carry_out(reset)
             return
         sample: DesiredPoint | None = None
+        toward_ee = False
         try:
             with self.lock:
                 if action is None:
-                    action, sample = self._trajectory_step()
+                    action, sample, toward_ee = self._follow_step()
                 stepped = self.hal.tick(action, glide=sample is not None)
                 state = self.hal.read_state() if stepped else self.state
                 self.state = state
@@ -240,20 +261,32 @@ class ControlLoop:
                 with self._pending_lock:
                     self.superseded += 1
             return
-        self._after_step(state, action is not None and sample is None, sample)
+        self._after_step(state, action is not None and sample is None, sample, toward_ee)
 
-    def _trajectory_step(self) -> tuple[FloatArray | None, DesiredPoint | None]:
-        """(action, desired point) of a running trajectory for this tick, else (None, None);
-        under the HAL lock."""
+    def _follow_step(self) -> tuple[FloatArray | None, DesiredPoint | None, bool]:
+        """(action, desired point, towards the ee target) of this tick: a running trajectory
+        first (it ends an ee target), else the ee target, else (None, None, False); under
+        the HAL lock."""
         now_s = self.state.sim_time_s if self.state is not None else None
-        if self.follower is None or now_s is None:
-            return None, None
+        if now_s is None or (self.follower is None and self.ee is None):
+            return None, None, False
         hold = np.asarray(self.hal.hold_action(), dtype=np.float64)
-        step = self.follower.next_action(hold, now_s, self.period_s)
-        return (None, None) if step is None else step
+        if self.follower is not None:
+            step = self.follower.next_action(hold, now_s, self.period_s)
+            if step is not None:
+                if self.ee is not None:
+                    self.ee.cancel("a joint trajectory pre-empted it")
+                return step[0], step[1], False
+        if self.ee is not None and (step := self.ee.next_action(hold, now_s, self.period_s)):
+            return step[0], step[1], True
+        return None, None, False
 
     def _after_step(
-        self, state: JointStateSample | None, applied: bool, sample: DesiredPoint | None
+        self,
+        state: JointStateSample | None,
+        applied: bool,
+        sample: DesiredPoint | None,
+        toward_ee: bool,
     ) -> None:
         self.ticks += 1
         self.applied += int(applied)
@@ -262,8 +295,9 @@ class ControlLoop:
             self.on_tick(sim_time)
         if sample is not None:
             self.followed += 1
-            if self.on_sample is not None:
-                self.on_sample(sample)
+            publish = self.on_ee_sample if toward_ee else self.on_sample
+            if publish is not None:
+                publish(sample)
         if state is not None:
             for watch in self.watchers:
                 watch(state)
@@ -277,6 +311,8 @@ class ControlLoop:
             with self.lock:
                 if self.follower is not None:  # the old path never runs from the reset pose
                     self.follower.cancel("the scene was reset")
+                if self.ee is not None:
+                    self.ee.cancel("the scene was reset")
                 request.text = self.hal.reset()
                 stepped = self.hal.tick(None)
                 self.state = self.hal.read_state() if stepped else None
@@ -307,6 +343,8 @@ class ControlLoop:
             self._pending = None
 
     def _abort_trajectory(self, reason: str) -> None:
+        if self.ee is not None and self.ee.cancel(reason):
+            self._log().warning(f"end-effector target dropped: {reason}")
         if self.follower is not None and self.follower.cancel(reason):
             self._log().warning(f"joint trajectory aborted: {reason}")
 

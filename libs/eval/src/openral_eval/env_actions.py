@@ -20,12 +20,9 @@ import numpy as np
 from openral_core.loaded import LoadedRobot
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_mujoco.action import Action, BaseTwist
-from openral_mujoco.errors import HalError
 from openral_mujoco.state import FloatArray
 from openral_sim.action_bounds import Bounds, action_bounds
 from openral_sim.ee_modes import PRESETS, EeCommand
-from openral_sim.end_effector import EndEffector
-from openral_sim.rollout import SceneRollout
 
 BASE_SLOTS = ("base_vx_m_s", "base_vy_m_s", "base_wz_rad_s")
 """Names of a mobile base's action slots, after the others."""
@@ -39,20 +36,6 @@ class ActionMode(StrEnum):
     JOINT_POSITION = "joint_position"
     EE_DELTA_POSE = "ee_delta_pose"
     EE_POSE = "ee_pose"
-
-
-def end_effector(hal: SimAttachedHAL, robot: LoadedRobot) -> EeCommand | None:
-    """The TCP of the robot in its native scene (None: not a native scene, or the manifest
-    declares no ``tcp_body``)."""
-    scene = hal.env if isinstance(hal.env, SceneRollout) else None
-    handles = hal.mujoco_handles()
-    if scene is None or handles is None:
-        return None
-    try:
-        ee = EndEffector(handles[0], scene.addresses, robot)
-    except HalError:
-        return None
-    return EeCommand(ee, scene.frames(), hal.control_period_s)
 
 
 class ActionContract:

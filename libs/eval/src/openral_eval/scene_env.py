@@ -37,13 +37,14 @@ from openral_core.loaded import LoadedRobot
 from openral_core.loader import load_scene
 from openral_hal.factory import HalMode, build_hal
 from openral_hal.sim_attached import SimAttachedHAL
+from openral_hal.tool_centre import ee_command
 from openral_mujoco.action import validated_action
 from openral_mujoco.errors import ActionRejected
 from openral_sim.rollout import SceneRollout
 from openral_sim.scene import scene_robot
 from openral_sim.state_sensors import state_sensors_of
 
-from openral_eval.env_actions import BASE_SLOTS, ActionContract, ActionMode, end_effector
+from openral_eval.env_actions import BASE_SLOTS, ActionContract, ActionMode
 from openral_eval.env_observation import EnvObservation, ObservationLayout
 
 ENV_ID = "openral/Scene-v0"
@@ -128,7 +129,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
             self.hal.reset()
         else:
             self.hal.connect()
-        self._ee = end_effector(self.hal, self.robot)
+        self._ee = ee_command(self.hal, self.robot)
         self.layout = ObservationLayout(
             self.robot,
             self.hal.last_observation(),

@@ -181,6 +181,7 @@ def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
     """What the graph offers: published topics in a table (fits 80 columns), then inputs."""
     from openral_bridge.topics import (
         CMD_VEL,
+        EE_TARGET,
         ESTOP,
         FOLLOW_JOINT_TRAJECTORY,
         JOINT_TRAJECTORY,
@@ -214,6 +215,10 @@ def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
         out.print(f"          {JOINT_TRAJECTORY} ({kind})", soft_wrap=False)
         kind = "control_msgs/action/FollowJointTrajectory"
         out.print(f"          {FOLLOW_JOINT_TRAJECTORY} ({kind})", soft_wrap=False)
+    if node.bridge is not None and node.bridge.ee is not None:
+        frame = node.bridge.ee.follower.base_frame
+        kind = f"geometry_msgs/msg/PoseStamped, the TCP in {frame}"
+        out.print(f"          {EE_TARGET} ({kind})", soft_wrap=False)
     if node.bridge is not None and node.bridge.base is not None:
         out.print(f"base:     {CMD_VEL} (geometry_msgs/msg/Twist, base frame)", soft_wrap=False)
     out.print(f"E-stop:   {ESTOP}, {RELEASE_ESTOP} (std_srvs/srv/Trigger)", soft_wrap=False)
