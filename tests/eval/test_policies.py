@@ -78,7 +78,7 @@ def test_make_policy_converts_string_parameters_by_field_type() -> None:
     [
         ("dance", {}, "unknown policy 'dance'; available: wave, scripted_lift"),
         ("wave", {"speed": "1"}, "unknown parameter 'speed'.*valid: amplitude, period_s"),
-        ("wave", {"amplitude": "big"}, "amplitude='big': expected float"),
+        ("wave", {"amplitude": "big"}, "amplitude='big': Input should be a valid number"),
         ("wave", {"period_s": "0"}, "period_s must be > 0"),
     ],
 )

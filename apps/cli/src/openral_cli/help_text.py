@@ -18,8 +18,13 @@ from typing import Any
 import typer
 from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
-__all__ = ["command_group"]
+__all__ = ["PARAM_HELP", "command_group"]
 
+PARAM_HELP = (
+    "Policy parameter key=value (repeatable): a JSON value where it is JSON, "
+    "key.field=value for one field of a nested config."
+)
+"""The help of every command's ``--param``/``-p`` (see :mod:`openral_eval.policy_config`)."""
 _KINDS = {"str": "TEXT", "int": "INTEGER", "float": "FLOAT", "Path": "PATH", "bool": "BOOLEAN"}
 
 

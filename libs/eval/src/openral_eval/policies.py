@@ -1,7 +1,8 @@
 """The built-in policies by name, and the ones installed packages register.
 
-Built-in policies are registered by name with a config dataclass whose fields double as
-``key=value`` parameters on the command line (:func:`~openral_eval.policy.parse_config`).
+Built-in policies are registered by name with a config type (a dataclass or a pydantic
+model) whose fields double as ``key=value`` parameters on the command line
+(:mod:`openral_eval.policy_config`).
 
 Example::
 
@@ -16,13 +17,8 @@ from functools import partial
 from typing import TYPE_CHECKING, Any
 
 from openral_eval.osc_lift import OscLift
-from openral_eval.policy import (
-    Observation,
-    PolicyAdapter,
-    PolicyConfigError,
-    parse_config,
-    parse_params,
-)
+from openral_eval.policy import Observation, PolicyAdapter, PolicyConfigError
+from openral_eval.policy_config import config_fields, parse_config, parse_params
 from openral_eval.policy_source import build, is_reference, load_class
 from openral_eval.scripted_lift import ScriptedLift
 from openral_eval.wave import WaveConfig, WavePolicy
@@ -48,7 +44,7 @@ __all__ = [
 
 @dataclass(frozen=True)
 class PolicyEntry:
-    """A registered policy: its config dataclass and how to build it from one."""
+    """A registered policy: its config type and how to build it from one."""
 
     config_type: type[Any]
     build: Callable[[Any], PolicyAdapter]
@@ -154,9 +150,23 @@ def available_policies() -> list[PolicyListing]:
 
 def _defaults(entry: PolicyEntry) -> tuple[tuple[str, str], ...]:
     """Each config field and its default, written as ``-p`` would take it."""
-    import dataclasses
 
     def text(value: object) -> str:
-        return ",".join(map(str, value)) if isinstance(value, tuple) else str(value)
+        if isinstance(value, tuple | list) and all(isinstance(v, str) for v in value):
+            return ",".join(value)
+        if isinstance(value, str):
+            return value
+        return _json_text(value)
 
-    return tuple((f.name, text(f.default)) for f in dataclasses.fields(entry.config_type))
+    fields = config_fields(entry.config_type)
+    return tuple((name, text(default)) for name, (_, default) in fields.items())
+
+
+def _json_text(value: object) -> str:
+    """A default as JSON (how ``-p`` reads it back); its ``repr`` when JSON cannot hold it."""
+    import pydantic
+
+    try:
+        return pydantic.TypeAdapter(type(value)).dump_json(value).decode()
+    except (pydantic.PydanticSchemaGenerationError, ValueError):
+        return repr(value)

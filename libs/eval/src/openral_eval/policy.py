@@ -1,5 +1,5 @@
-"""The policy seam: what a policy sees each step, what it declares it needs, and how its
-``key=value`` parameters become its config.
+"""The policy seam: what a policy sees each step and what it declares it needs (its
+parameters: :mod:`openral_eval.policy_config`).
 
 A policy is anything with :attr:`PolicyAdapter.required_slots` (the VLA camera slots it
 needs frames for), :attr:`PolicyAdapter.needs_privileged` (whether it reads the simulation
@@ -12,9 +12,8 @@ anything else.
 
 from __future__ import annotations
 
-import dataclasses
-from collections.abc import Iterable, Mapping
-from typing import Any, NotRequired, Protocol, TypedDict, runtime_checkable
+from collections.abc import Mapping
+from typing import NotRequired, Protocol, TypedDict, runtime_checkable
 
 import numpy as np
 import numpy.typing as npt
@@ -88,49 +87,3 @@ def action_mode(policy: object) -> str:
             f"{', '.join(ACTION_MODES)}"
         )
     return str(mode)
-
-
-def parse_params(items: Iterable[str]) -> dict[str, str]:
-    """``["k=v", …]`` → ``{"k": "v", …}``."""
-    params: dict[str, str] = {}
-    for item in items:
-        key, sep, value = item.partition("=")
-        if not sep or not key.strip():
-            raise PolicyConfigError(f"policy parameter {item!r} is not key=value")
-        params[key.strip()] = value.strip()
-    return params
-
-
-def parse_config(config_type: type[Any], params: Mapping[str, str], policy: str) -> Any:
-    """An instance of the dataclass ``config_type`` with string ``params`` converted by field.
-
-    Each value is converted to the type of the field's default: float, int, str, or a
-    comma-separated tuple of strings.
-    """
-    fields = {f.name: f for f in dataclasses.fields(config_type)}
-    values: dict[str, object] = {}
-    for key, text in params.items():
-        field = fields.get(key)
-        if field is None:
-            raise PolicyConfigError(
-                f"unknown parameter {key!r} for policy {policy!r}; valid: {', '.join(fields)}"
-            )
-        default: object = field.default
-        try:
-            values[key] = _convert(text, default)
-        except ValueError as error:
-            raise PolicyConfigError(
-                f"{policy} parameter {key}={text!r}: expected {type(default).__name__}"
-            ) from error
-    return config_type(**values)
-
-
-def _convert(text: str, like: object) -> object:
-    """``text`` as the type of ``like``: float, int, str or a comma-separated str tuple."""
-    if isinstance(like, tuple):
-        return tuple(part.strip() for part in text.split(",") if part.strip())
-    if isinstance(like, float):
-        return float(text)
-    if isinstance(like, int):
-        return int(text)
-    return text

@@ -2,10 +2,11 @@
 ``package.module:ClassName``, beside the registered names.
 
 The class is built from a config the same way a registered policy is: when it has a
-``config_type`` class attribute (a dataclass), ``--param key=value`` fills that config's
-fields and the class is called with it; without one, it takes no parameters and is called
-with none. A file is executed once per process (a sweep's worker builds a policy per
-episode) under a module name derived from its absolute path.
+``config_type`` class attribute (a pydantic model or a dataclass), ``--param key=value``
+fills that config's fields (:mod:`openral_eval.policy_config`) and the class is called with
+it; without one, it takes no parameters and is called with none. A file is executed once
+per process (a sweep's worker builds a policy per episode) under a module name derived
+from its absolute path.
 
 Example::
 
@@ -25,6 +26,7 @@ from types import ModuleType
 from typing import Any
 
 from openral_eval.policy import PolicyAdapter, PolicyConfigError
+from openral_eval.policy_config import is_config_type
 
 _LOADED: dict[Path, ModuleType] = {}
 """Files executed in this process, by absolute path."""
@@ -45,7 +47,8 @@ def load_class(reference: str) -> tuple[type[Any], type[Any]]:
 
     Raises:
         PolicyConfigError: The file or module cannot be found or imported, it has no such
-            class, or the class's ``config_type`` is not a dataclass; one line each.
+            class, or the class's ``config_type`` is neither a pydantic model nor a
+            dataclass; one line each.
     """
     where, _, class_name = reference.rpartition(":")
     if not where or not class_name.isidentifier():
@@ -61,9 +64,10 @@ def load_class(reference: str) -> tuple[type[Any], type[Any]]:
             f"{', '.join(defined) or 'none'}"
         )
     config_type = getattr(cls, "config_type", NoConfig)
-    if not (isinstance(config_type, type) and dataclasses.is_dataclass(config_type)):
+    if not is_config_type(config_type):
         raise PolicyConfigError(
-            f"policy {reference!r}: {class_name}.config_type must be a dataclass of its parameters"
+            f"policy {reference!r}: {class_name}.config_type must be a pydantic model or a "
+            "dataclass of its parameters"
         )
     return cls, config_type
 

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from openral_cli.console import line, out, progress, status
-from openral_cli.help_text import command_group
+from openral_cli.help_text import PARAM_HELP, command_group
 from openral_cli.ros_available import require_ros
 
 if TYPE_CHECKING:
@@ -48,7 +48,7 @@ def run(
     policy: Annotated[str, typer.Option("--policy", help="Built-in policy name.")] = "wave",
     params: Annotated[
         list[str] | None,
-        typer.Option("--param", "-p", help="Policy parameter key=value (repeatable)."),
+        typer.Option("--param", "-p", help=PARAM_HELP),
     ] = None,
     rate: Annotated[float, typer.Option("--rate", min=0.1, help="Actions per second.")] = 10.0,
     duration: Annotated[

@@ -30,7 +30,7 @@ from openral_cli.commands.policies import policies
 from openral_cli.commands.sim_policy import run_policy
 from openral_cli.commands.sweep import sweep
 from openral_cli.console import out, progress
-from openral_cli.help_text import command_group
+from openral_cli.help_text import PARAM_HELP, command_group
 
 if TYPE_CHECKING:
     from openral_hal.protocol import ObservingHal, RobotHal
@@ -81,9 +81,7 @@ def run(
         str | None,
         typer.Option("--policy", help="Run one episode of this policy (name or file.py:Class)."),
     ] = None,
-    params: Annotated[
-        list[str] | None, typer.Option("--param", "-p", help="Policy parameter key=value.")
-    ] = None,
+    params: Annotated[list[str] | None, typer.Option("--param", "-p", help=PARAM_HELP)] = None,
     seed: Annotated[int, typer.Option("--seed", help="The episode's seed (with --policy).")] = 0,
 ) -> None:
     """Run SCENE headless for N control steps; save every camera frame and joint state.

@@ -24,6 +24,7 @@ import typer
 from openral_core.errors import OpenralError
 
 from openral_cli.console import err, out, progress
+from openral_cli.help_text import PARAM_HELP
 
 if TYPE_CHECKING:
     from openral_eval.episode import EpisodeResult, EpisodeSpec
@@ -108,9 +109,7 @@ def sweep(
     seeds: Annotated[str, typer.Option("--seeds", help="START:STOP, a seed, or 1,5,9.")],
     policy: Annotated[str, typer.Option("--policy", help="Policy name (registered).")],
     out_dir: Annotated[Path, typer.Option("--out", help="Directory for the results.")],
-    params: Annotated[
-        list[str] | None, typer.Option("--param", "-p", help="Policy parameter key=value.")
-    ] = None,
+    params: Annotated[list[str] | None, typer.Option("--param", "-p", help=PARAM_HELP)] = None,
     steps: Annotated[
         int | None, typer.Option("--steps", min=1, help="Step limit (default: the scene's).")
     ] = None,
