@@ -77,7 +77,7 @@ def test_a_bad_parameter_is_one_line_naming_it(params: dict[str, str], message: 
 
 
 def test_items_must_be_key_value_and_fields_list_their_defaults() -> None:
-    assert parse_params(["a=1", "b={\"c\": 2}", "a=3"]) == {"a": "3", "b": '{"c": 2}'}
+    assert parse_params(["a=1", 'b={"c": 2}', "a=3"]) == {"a": "3", "b": '{"c": 2}'}
     with pytest.raises(PolicyConfigError, match="'oops' is not key=value"):
         parse_params(["oops"])
     fields = config_fields(ReachConfig)
