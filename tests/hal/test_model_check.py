@@ -61,6 +61,15 @@ UR5E = ROBOTS / "ur5e" / "robot.yaml"
             "sim.floating_base",
             "no free joint at qpos 0",
         ),
+        (
+            (
+                "  keyframe_index: 0\n",
+                "  keyframe_index: 0\n  ik_collision_pairs:\n"
+                "    - {bodies: [wrist_3_link], avoid: [base, shoulderlink]}\n",
+            ),
+            "sim.ik_collision_pairs[0].avoid[1]",
+            "not in the model (did you mean shoulder_link?)",
+        ),
     ],
 )
 def test_a_mismatch_names_the_field_and_the_model_value(

@@ -204,6 +204,32 @@ class TorquePdControl(OpenralModel):
     """
 
 
+Body = TypeAliasType("Body", Annotated[StrictStr, Field(max_length=128, min_length=1)])
+
+
+AvoidItem = TypeAliasType(
+    "AvoidItem", Annotated[StrictStr, Field(max_length=128, min_length=1)]
+)
+
+
+class IkCollisionPair(OpenralModel):
+    """
+    Two groups of bodies of the robot's model that the end-effector IK keeps apart.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    bodies: Annotated[list[Body], Field(max_length=32, min_length=1)]
+    """
+    Body names of the robot's MJCF (e.g. the hand and its fingers).
+    """
+    avoid: Annotated[list[AvoidItem], Field(max_length=32, min_length=1)]
+    """
+    Body names of the robot's MJCF their collision geoms must stay clear of (e.g. the base and the first links).
+    """
+
+
 class SimDescription(OpenralModel):
     """
     MuJoCo wiring of one robot: where its MJCF model comes from and how the canonical joints map onto the model's qpos, qvel and actuators. Every map is optional: without one, joints map 1:1 in canonical order (offset by 7 in qpos and 6 in qvel when the robot has a floating base).
@@ -279,6 +305,16 @@ class SimDescription(OpenralModel):
     ] = []
     """
     Gripper wiring, one entry per gripper: single arms have one, bimanual robots two.
+    """
+    ik_collision_pairs: Annotated[
+        list[IkCollisionPair] | None, Field(max_length=16)
+    ] = None
+    """
+    Self-collision avoidance of the end-effector IK: pairs of body groups of the robot's model it keeps apart. Each item names two groups of bodies (`bodies`, `avoid`); every collision geom (non-zero contype or conaffinity) of a body in one group is kept at least `ik_collision_margin_m` from every collision geom of a body in the other, as an inequality of each IK step (mink's collision avoidance). Bodies welded together or parent and child are never paired (they touch by construction). Absent: the IK keeps only the joint limits.
+    """
+    ik_collision_margin_m: Annotated[StrictFloat, Field(ge=0.0, le=0.1)] = 0.01
+    """
+    Smallest distance the IK leaves between the geoms of `ik_collision_pairs` [m], 0 to 0.1. Default 0.01.
     """
     keyframe_index: Annotated[StrictInt | None, Field(ge=0, le=1000)] = None
     """

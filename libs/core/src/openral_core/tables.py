@@ -90,6 +90,10 @@ class HalWiring:
     """Arm joint → its value after every reset (rad or m), over the keyframe's."""
     gravity_compensation: bool = False
     """MuJoCo cancels gravity on the robot's bodies, through its joints' actuators."""
+    ik_collision_pairs: tuple[tuple[tuple[str, ...], tuple[str, ...]], ...] = ()
+    """(bodies, bodies to avoid) pairs the end-effector IK keeps apart (MJCF body names)."""
+    ik_collision_margin_m: float = 0.01
+    """Smallest distance the IK leaves between those bodies' collision geoms [m]."""
 
     @property
     def first_gripper(self) -> str | None:
@@ -111,7 +115,17 @@ class HalWiring:
             )
             for g in data["grippers"]
         )
-        return cls(**{**data, "joint_names": tuple(data["joint_names"]), "grippers": grippers})
+        pairs = tuple(
+            (tuple(bodies), tuple(avoid)) for bodies, avoid in data.get("ik_collision_pairs", ())
+        )
+        return cls(
+            **{
+                **data,
+                "joint_names": tuple(data["joint_names"]),
+                "grippers": grippers,
+                "ik_collision_pairs": pairs,
+            }
+        )
 
 
 @dataclass(frozen=True)
@@ -261,6 +275,10 @@ def hal_wiring(robot: RobotDescription) -> HalWiring | None:
         },
         start_pose=dict(sim.start_pose or {}),
         gravity_compensation=sim.gravity_compensation,
+        ik_collision_pairs=tuple(
+            (tuple(p.bodies), tuple(p.avoid)) for p in sim.ik_collision_pairs or ()
+        ),
+        ik_collision_margin_m=sim.ik_collision_margin_m,
     )
 
 

@@ -7,7 +7,6 @@ sim's ``/openral/ee_target``), so an end-effector action means the same thing ev
 from __future__ import annotations
 
 from openral_core.loaded import LoadedRobot
-from openral_mujoco.errors import HalError
 from openral_sim.ee_modes import EeCommand
 from openral_sim.end_effector import EndEffector
 from openral_sim.rollout import SceneRollout
@@ -17,13 +16,17 @@ from openral_hal.sim_attached import SimAttachedHAL
 
 def ee_command(hal: SimAttachedHAL, robot: LoadedRobot) -> EeCommand | None:
     """The TCP of ``robot`` in the HAL's native scene (None: not a native scene, not
-    connected, or the manifest declares no ``tcp_body``)."""
+    connected, or the manifest declares no ``tcp_body``).
+
+    Raises:
+        HalError: The manifest declares a TCP the scene's model cannot place (a missing
+            ``tcp_body`` or a body of ``sim.ik_collision_pairs``; the message says which).
+    """
     scene = hal.env if isinstance(hal.env, SceneRollout) else None
     handles = hal.mujoco_handles()
-    if scene is None or handles is None:
+    wiring = robot.tables.hal_wiring
+    grippers = wiring.grippers if wiring is not None else ()
+    if scene is None or handles is None or not grippers or grippers[0].tcp_body is None:
         return None
-    try:
-        ee = EndEffector(handles[0], scene.addresses, robot)
-    except HalError:
-        return None
+    ee = EndEffector(handles[0], scene.addresses, robot)
     return EeCommand(ee, scene.frames(), hal.control_period_s)

@@ -62,6 +62,7 @@ def check_robot(
         *_joint_rows(description, wiring, model),
         *_gripper_rows(wiring, model),
         *_keyframe_and_base_rows(wiring, model),
+        *_ik_collision_rows(wiring, model),
     ]
     models = [model]
     if description.mobile_base is not None:
@@ -291,6 +292,15 @@ def _sensor_rows(description: RobotDescription, models: list[mujoco.MjModel]) ->
         if isinstance(sensor, StateSensor):
             for row in state_sensor_rows(field, sensor, models):
                 yield CheckRow(*row)
+
+
+def _ik_collision_rows(wiring: HalWiring, model: mujoco.MjModel) -> Iterator[CheckRow]:
+    """Each body of ``sim.ik_collision_pairs`` is a body of the robot's model."""
+    for index, groups in enumerate(wiring.ik_collision_pairs):
+        for field, bodies in zip(("bodies", "avoid"), groups, strict=True):
+            for position, body in enumerate(bodies):
+                where = f"sim.ik_collision_pairs[{index}].{field}[{position}]"
+                yield _exists(where, body, mujoco.mjtObj.mjOBJ_BODY, [model])
 
 
 def _exists(field: str, name: str, kind: mujoco.mjtObj, models: list[mujoco.MjModel]) -> CheckRow:

@@ -15,6 +15,9 @@ by daqp as one quadratic programme per control tick:
 - the manifest's position limits of every arm joint (:class:`ArmPositionLimit`, the
   envelope of :class:`~openral_mujoco.command_limits.CommandLimits`) and its velocity
   limits (mink's ``VelocityLimit``) as inequalities;
+- self-collision avoidance between the collision geoms of the body groups the manifest
+  lists in ``sim.ik_collision_pairs``, kept at least ``sim.ik_collision_margin_m`` apart
+  (:mod:`openral_sim.self_collision`);
 - every other degree of freedom (grippers, a mobile base, the scene's objects) frozen.
 
 A target out of reach is approached as far as those limits allow and no further: the
@@ -32,6 +35,8 @@ from openral_mujoco.command_limits import CommandLimits
 from openral_mujoco.errors import HalError
 from openral_mujoco.robot_addresses import RobotAddresses
 from openral_mujoco.state import FloatArray
+
+from openral_sim.self_collision import collision_limit
 
 SOLVER = "daqp"
 """The QP solver of every IK step."""
@@ -119,7 +124,9 @@ class EndEffector:
         arm_dofs = set(dofs)
         frozen = [d for d in range(model.nv) if d not in arm_dofs]
         freeze = [mink.DofFreezingTask(model, dof_indices=frozen)] if frozen else []
-        return [positions, mink.VelocityLimit(model, speeds)], freeze
+        limits: list[mink.Limit] = [positions, mink.VelocityLimit(model, speeds)]
+        collisions = collision_limit(model, robot) if wiring is not None else None
+        return limits + ([collisions] if collisions is not None else []), freeze
 
     def world_pose(self, data: mujoco.MjData) -> tuple[FloatArray, FloatArray]:
         """The TCP's world position [m] and orientation (w, x, y, z) as ``data`` holds them
