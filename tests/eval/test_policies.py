@@ -92,3 +92,13 @@ def test_bad_policy_names_and_parameters_raise_one_clear_error(
 def test_parse_params_rejects_items_without_equals() -> None:
     with pytest.raises(PolicyConfigError, match="'amplitude' is not key=value"):
         parse_params(["amplitude"])
+
+
+def test_a_subclass_keeps_its_parents_action_mode() -> None:
+    from openral_eval.policy import action_mode
+    from openral_eval.scripted_lift import LiftConfig, ScriptedLift
+
+    class Tuned(ScriptedLift):
+        pass
+
+    assert action_mode(Tuned(LiftConfig())) == "ee_delta_pose"

@@ -80,7 +80,7 @@ def action_mode(policy: object) -> str:
     Raises:
         PolicyConfigError: A mode policies cannot use.
     """
-    mode = vars(type(policy)).get("action_mode", ACTION_MODES[0])
+    mode = getattr(type(policy), "action_mode", ACTION_MODES[0])  # a subclass inherits it
     if mode not in ACTION_MODES:
         raise PolicyConfigError(
             f"policy {type(policy).__name__} declares action_mode {mode!r}; valid: "
