@@ -100,13 +100,15 @@ def test_a_reference_that_cannot_be_built_is_one_line(
         ("Hangs", "2", "timeout: still running after 3 s of wall time; its worker was stopped"),
         ("Exits", "1", "its worker process died, every time it ran"),
         ("Crashes", "2", "its worker process died, every time it ran"),
+        ("Hangs", "ray", "timeout: still running after 3 s of wall time; its worker was stopped"),
     ],
 )
 def test_a_policy_that_breaks_its_process_costs_only_its_episode(
     tmp_path: Path, policy: str, workers: str, error: str
 ) -> None:
     command = [str(OPENRAL), "sim", "sweep", "--config", str(TABLETOP), "--seeds", "0:2"]
-    command += ["--policy", f"{HOSTILE}:{policy}", "--workers", workers, "--video", "none"]
+    where = ["--ray", "local", "--workers", "2"] if workers == "ray" else ["--workers", workers]
+    command += ["--policy", f"{HOSTILE}:{policy}", *where, "--video", "none"]
     command += ["--episode-timeout", "3", "--out", str(tmp_path / "out")]
     env = {**os.environ, "COLUMNS": "200"}
     result = subprocess.run(command, capture_output=True, text=True, cwd=REPO, env=env, timeout=120)

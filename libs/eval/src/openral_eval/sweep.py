@@ -18,7 +18,9 @@ same (scene, seed, policy) gives the same result anywhere; only the wall times d
 - Ray (the optional ``ray`` extra; :mod:`openral_eval.ray_session`): ``address``
   ``local`` starts a Ray instance on this machine with ``workers`` CPUs; any other address
   joins that cluster. Each episode is one task of one CPU, retried :data:`RETRIES` times
-  when its worker dies.
+  when its worker dies; at most one task per CPU of the cluster runs at a time, so an
+  episode still running ``timeout_s`` after it was submitted is cancelled (its worker
+  killed) and recorded with the same ``timeout:`` error.
 
 Every finished episode goes to ``on_result`` on this process's main thread, as soon as it
 ends, in whatever order episodes end. ``on_ready`` is called once, when every worker is up
@@ -30,6 +32,7 @@ start-up, a fixed cost; what comes after it is the episodes.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Sequence
 from functools import partial
 from pathlib import Path
@@ -97,6 +100,7 @@ def run_ray(
     workers: int,
     on_result: OnResult,
     on_ready: OnReady = _nothing,
+    timeout_s: float = math.inf,
 ) -> None:
     """Every episode as a Ray task (see the module doc).
 
@@ -105,22 +109,56 @@ def run_ray(
             ``address`` cannot be joined.
     """
     with ray_session(address, workers) as ray:
+        paths = _scene_paths(specs)
+        _warm_up(ray, paths, len(specs))
+        on_ready()
+        slots = max(1, int(ray.cluster_resources().get("CPU", workers)))
+        tasks = _RayTasks(ray, slots, timeout_s)
+        todo = list(reversed(specs))
+        while todo or tasks.running:
+            while todo and len(tasks.running) < slots:
+                tasks.start(todo.pop())
+            for result in tasks.next_results():
+                on_result(result)
+
+
+class _RayTasks:
+    """The episodes running as Ray tasks, at most one per CPU of the cluster, so each
+    starts when it is submitted and its wall-time limit runs from then."""
+
+    def __init__(self, ray: ModuleType, slots: int, timeout_s: float) -> None:
+        self.ray, self.timeout_s = ray, timeout_s
+        self.task = ray.remote(num_cpus=1, max_retries=RETRIES)(run_episode)
+        self.running: dict[object, tuple[EpisodeSpec, float]] = {}
+        """Task reference → (its spec, its deadline on the monotonic clock [s])."""
+
+    def start(self, spec: EpisodeSpec) -> None:
+        self.running[self.task.remote(spec)] = (spec, time.monotonic() + self.timeout_s)
+
+    def next_results(self) -> list[EpisodeResult]:
+        """Wait for the next episode to end or the next deadline to pass; the results of
+        what ended, and a ``timeout:`` result for each task past its deadline (cancelled,
+        its worker process killed)."""
         from ray.exceptions import RayError
 
-        _warm_up(ray, _scene_paths(specs), len(specs))
-        on_ready()
-        task = ray.remote(num_cpus=1, max_retries=RETRIES)(run_episode)
-        waiting = {task.remote(spec): spec for spec in specs}
-        while waiting:
-            finished, _ = ray.wait(list(waiting), num_returns=1)
-            for ref in finished:
-                spec = waiting.pop(ref)
-                try:
-                    on_result(ray.get(ref))
-                except RayError as error:
-                    on_result(
-                        EpisodeResult.unfinished(spec, f"Ray gave up on it: {type(error).__name__}")
-                    )
+        deadline = min(end for _, end in self.running.values())
+        wait_s = None if math.isinf(deadline) else max(0.0, deadline - time.monotonic())
+        finished, _ = self.ray.wait(list(self.running), num_returns=1, timeout=wait_s)
+        results = []
+        for ref in finished:
+            spec, _ = self.running.pop(ref)
+            try:
+                results.append(self.ray.get(ref))
+            except RayError as error:
+                why = f"Ray gave up on it: {type(error).__name__}"
+                results.append(EpisodeResult.unfinished(spec, why))
+        now = time.monotonic()
+        for ref, (spec, end) in list(self.running.items()):
+            if now >= end:
+                self.ray.cancel(ref, force=True)
+                del self.running[ref]
+                results.append(_timed_out(self.timeout_s, spec))
+        return results
 
 
 def _scene_paths(specs: Sequence[EpisodeSpec]) -> list[str]:

@@ -301,7 +301,7 @@ def _run(
 
         clock.start()
         if ray is not None:
-            run_ray(todo, ray, workers, record, clock.mark_ready)
+            run_ray(todo, ray, workers, record, clock.mark_ready, timeout_s)
         elif todo:  # even one worker is a process of its own: a policy's crash costs only
             # its episode (sys.exit, a segfault), and a hung one its time limit
             run_pool(todo, min(workers, len(todo)), record, clock.mark_ready, timeout_s)
