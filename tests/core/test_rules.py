@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 from openral_core import ManifestError, load_robot
 
-from tests.conftest import REPO, ManifestWriter
+from tests.conftest import FRANKA, REPO, ManifestWriter
 
 
 def _findings(path: object) -> dict[str, str]:
@@ -292,18 +292,35 @@ def test_gravity_compensation_is_refused_on_a_floating_base(
     }
 
 
+TCP = "tcp: {body: hand, offset_m: [0.0, 0.0, 0.1034]}"
+
+
+def _franka_tcp(write_manifest: ManifestWriter, tcp: str) -> Path:
+    return write_manifest((TCP, tcp), base=FRANKA, folder="franka_panda")
+
+
 def test_a_tool_frame_quaternion_must_be_unit_and_is_stored_normalised(
     write_manifest: ManifestWriter,
 ) -> None:
-    jaw = "mirror_actuator_index: 3}"
-    path = write_manifest((jaw, "mirror_actuator_index: 3, tcp_quat_wxyz: [0.0, 0.5, 0.5, 0.0]}"))
+    path = _franka_tcp(write_manifest, "tcp: {body: hand, quat_wxyz: [0.0, 0.5, 0.5, 0.0]}")
     assert _findings(path) == {
-        "sim.grippers[0].tcp_quat_wxyz": "norm 0.7071; expected a unit quaternion (norm 1)"
+        "sim.tcp.quat_wxyz": "norm 0.7071; expected a unit quaternion (norm 1)"
     }
-    near = write_manifest(
-        (jaw, "mirror_actuator_index: 3, tcp_quat_wxyz: [0.0, 0.9995, 0.0, 0.0]}")
-    )
-    from openral_core.tables import hal_wiring
+    near = _franka_tcp(write_manifest, "tcp: {body: hand, quat_wxyz: [0.0, 0.9995, 0.0, 0.0]}")
+    from openral_core.tables import TcpWiring, hal_wiring
 
     wiring = hal_wiring(load_robot(near))
-    assert wiring is not None and wiring.grippers[0].tcp_quat_wxyz == (0.0, 1.0, 0.0, 0.0)
+    assert wiring is not None and wiring.tcp == TcpWiring("hand", "body", quat_wxyz=(0, 1, 0, 0))
+
+
+@pytest.mark.parametrize(
+    ("tcp", "words"),
+    [
+        ("tcp: {body: hand, site: grip}", "names both body and site; expected exactly one"),
+        ("tcp: {offset_m: [0.0, 0.0, 0.1]}", "names neither body and site; expected exactly one"),
+    ],
+)
+def test_a_tool_centre_point_names_one_body_or_one_site(
+    write_manifest: ManifestWriter, tcp: str, words: str
+) -> None:
+    assert words in _findings(_franka_tcp(write_manifest, tcp))["sim.tcp"]

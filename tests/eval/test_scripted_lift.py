@@ -92,4 +92,4 @@ def test_without_a_tool_centre_point_in_the_manifest_it_says_where_to_add_one() 
     result = run_episode(EpisodeSpec(ur5e, 0, "scripted_lift", (), 5))
     assert result.error is not None and result.steps == 0
     assert "ee_delta_pose needs a native scene and a robot with a tool centre point" in result.error
-    assert "sim.grippers[0].tcp_body" in result.error
+    assert "sim.tcp" in result.error

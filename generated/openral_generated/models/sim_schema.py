@@ -64,16 +64,6 @@ CtrlRangeItem = TypeAliasType(
 QposAddr = TypeAliasType("QposAddr", Annotated[StrictInt, Field(ge=0, le=10000)])
 
 
-TcpOffsetMItem = TypeAliasType(
-    "TcpOffsetMItem", Annotated[StrictFloat, Field(ge=-10.0, le=10.0)]
-)
-
-
-TcpQuatWxyzItem = TypeAliasType(
-    "TcpQuatWxyzItem", Annotated[StrictFloat, Field(ge=-1.0, le=1.0)]
-)
-
-
 class SimGripperDescription(OpenralModel):
     """
     Wiring of one gripper.
@@ -115,27 +105,6 @@ class SimGripperDescription(OpenralModel):
     mirror_actuator_index: Annotated[StrictInt | None, Field(ge=0, le=10000)] = None
     """
     Optional second actuator that receives the negated command, for antisymmetric parallel jaws whose second finger is not a canonical joint.
-    """
-    tcp_body: Annotated[
-        StrictStr | None,
-        Field(examples=["hand"], pattern="^[A-Za-z_][A-Za-z0-9_./-]{0,127}$"),
-    ] = None
-    """
-    MJCF body of the robot's model that the gripper is mounted on (the hand or flange), whose frame carries the tool centre point. Absent: the gripper has no tool centre point, and a policy that needs one must be told it.
-    """
-    tcp_offset_m: Annotated[
-        list[TcpOffsetMItem] | None,
-        Field(examples=[[0.0, 0.0, 0.1034]], max_length=3, min_length=3),
-    ] = None
-    """
-    The tool centre point (between the fingertips when closed) in `tcp_body`'s frame [m]. Absent with a `tcp_body`: the body's origin.
-    """
-    tcp_quat_wxyz: Annotated[
-        list[TcpQuatWxyzItem] | None,
-        Field(examples=[[0.0, 1.0, 0.0, 0.0]], max_length=4, min_length=4),
-    ] = None
-    """
-    Orientation of the tool frame in `tcp_body`'s frame, a unit quaternion (w, x, y, z): the tool frame's z axis points along the fingers, away from the wrist, and its x axis across the jaws. Absent: the body's own axes (a body whose z axis already points along the fingers, as the Panda's hand).
     """
 
 
@@ -230,6 +199,54 @@ class IkCollisionPair(OpenralModel):
     """
 
 
+OffsetMItem = TypeAliasType(
+    "OffsetMItem", Annotated[StrictFloat, Field(ge=-10.0, le=10.0)]
+)
+
+
+QuatWxyzItem = TypeAliasType(
+    "QuatWxyzItem", Annotated[StrictFloat, Field(ge=-1.0, le=1.0)]
+)
+
+
+class ToolCentrePoint(OpenralModel):
+    """
+    The robot's tool centre point (TCP): a frame fixed to one body or site of its model, moved by end-effector actions and reported as `tcp_pose` in the base frame. Exactly one of `body` and `site`.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    body: Annotated[
+        StrictStr | None,
+        Field(examples=["hand"], pattern="^[A-Za-z_][A-Za-z0-9_./-]{0,127}$"),
+    ] = None
+    """
+    MJCF body the TCP is fixed to (the hand or flange).
+    """
+    site: Annotated[
+        StrictStr | None,
+        Field(examples=["gripperframe"], pattern="^[A-Za-z_][A-Za-z0-9_./-]{0,127}$"),
+    ] = None
+    """
+    MJCF site the TCP is fixed to (a tool or attachment site the model defines).
+    """
+    offset_m: Annotated[
+        list[OffsetMItem] | None,
+        Field(examples=[[0.0, 0.0, 0.1034]], max_length=3, min_length=3),
+    ] = None
+    """
+    The TCP in the body's or site's frame [m] (between the fingertips, for a gripper). Absent: its origin.
+    """
+    quat_wxyz: Annotated[
+        list[QuatWxyzItem] | None,
+        Field(examples=[[0.0, 1.0, 0.0, 0.0]], max_length=4, min_length=4),
+    ] = None
+    """
+    Orientation of the tool frame in the body's or site's frame, a unit quaternion (w, x, y, z): the tool frame's z axis points away from the wrist along the tool (the fingers), its x axis across the jaws. Absent: the frame's own axes.
+    """
+
+
 class SimDescription(OpenralModel):
     """
     MuJoCo wiring of one robot: where its MJCF model comes from and how the canonical joints map onto the model's qpos, qvel and actuators. Every map is optional: without one, joints map 1:1 in canonical order (offset by 7 in qpos and 6 in qvel when the robot has a floating base).
@@ -305,6 +322,10 @@ class SimDescription(OpenralModel):
     ] = []
     """
     Gripper wiring, one entry per gripper: single arms have one, bimanual robots two.
+    """
+    tcp: ToolCentrePoint | None = None
+    """
+    The robot's tool centre point, for end-effector actions (`ee_delta_pose`, `ee_pose`), the `tcp_pose` observation and deploy sim's `/openral/ee_target` and `/openral/tcp_pose`. Absent: the robot takes joint actions only.
     """
     ik_collision_pairs: Annotated[
         list[IkCollisionPair] | None, Field(max_length=16)

@@ -143,8 +143,15 @@ RULE_BREAKS = (
         SchemaName.ROBOT,
         18,
         ROBOT_FILE,
-        "tcp_offset_m: [0.0, 0.0, 0.1034]",
-        "tcp_offset_m: [0.0, 0.0, 0.1034]\n      tcp_quat_wxyz: [0.0, 1.0, 1.0, 0.0]",
+        "offset_m: [0.0, 0.0, 0.1034]}",
+        "offset_m: [0.0, 0.0, 0.1034], quat_wxyz: [0.0, 1.0, 1.0, 0.0]}",
+    ),
+    RuleBreak(
+        SchemaName.ROBOT,
+        19,
+        ROBOT_FILE,
+        "tcp: {body: hand,",
+        "tcp: {body: hand, site: hand_site,",
     ),
     RuleBreak(
         SchemaName.SCENE,

@@ -45,6 +45,7 @@ from openral_generated.models.sim_schema import (
     PositionControl,
     SimDescription,
     SimGripperDescription,
+    ToolCentrePoint,
     TorquePdControl,
 )
 
@@ -101,6 +102,7 @@ __all__ = [
     "SiteSensor",
     "StateSensor",
     "SuccessPredicate",
+    "ToolCentrePoint",
     "TorquePdControl",
     "TrajectoryRules",
 ]

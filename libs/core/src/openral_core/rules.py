@@ -19,6 +19,7 @@ from openral_core.models import (
     RobotDescription,
     SceneObject,
     Shape,
+    SimDescription,
     TorquePdControl,
 )
 from openral_core.tables import frame_names, vla_slot
@@ -183,6 +184,23 @@ def _frame_findings(robot: RobotDescription) -> Iterator[Finding]:
     yield from _unique(located, "frame")
 
 
+def _tcp_findings(sim: SimDescription) -> Iterator[Finding]:
+    """Rules 18 and 19: the tool centre point's quaternion and its one frame."""
+    tcp = sim.tcp
+    if tcp is None:
+        return
+    if (tcp.body is None) == (tcp.site is None):  # rule 19
+        both = "names both" if tcp.body is not None else "names neither"
+        yield (
+            ("sim", "tcp"),
+            f"{both} body and site; expected exactly one (the frame it is fixed to)",
+        )
+    quat = tcp.quat_wxyz
+    if quat is not None and abs(math.hypot(*quat) - 1.0) > 1e-3:  # rule 18
+        norm = math.hypot(*quat)
+        yield ("sim", "tcp", "quat_wxyz"), f"norm {norm:.4g}; expected a unit quaternion (norm 1)"
+
+
 def _sim_findings(robot: RobotDescription) -> Iterator[Finding]:
     sim = robot.sim
     if sim is None:
@@ -202,10 +220,7 @@ def _sim_findings(robot: RobotDescription) -> Iterator[Finding]:
         low, high = gripper.ctrl_range
         if not low < high:
             yield (*path, "ctrl_range"), f"lower bound {low} must be below upper bound {high}"
-        quat = gripper.tcp_quat_wxyz
-        if quat is not None and abs(math.hypot(*quat) - 1.0) > 1e-3:  # rule 18
-            norm = math.hypot(*quat)
-            yield (*path, "tcp_quat_wxyz"), f"norm {norm:.4g}; expected a unit quaternion (norm 1)"
+    yield from _tcp_findings(sim)
     yield from _start_pose_findings(robot, gripper_joints)
     if sim.gravity_compensation and sim.floating_base:  # rule 17
         yield (

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -40,6 +39,7 @@ from openral_core.models import (
     TorquePdControl,
 )
 from openral_core.paths import repo_root
+from openral_core.tcp_wiring import TcpWiring, tcp_wiring
 
 FREE_JOINT_NQPOS = 7
 """qpos entries of a MuJoCo free joint: position (3) + unit quaternion (4)."""
@@ -59,12 +59,6 @@ class GripperWiring:
     write_mode: str
     actuator_index: int
     mirror_actuator_index: int | None
-    tcp_body: str | None = None
-    """MJCF body carrying the tool centre point (None: not declared)."""
-    tcp_offset_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    """The tool centre point in ``tcp_body``'s frame [m]."""
-    tcp_quat_wxyz: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
-    """The tool frame's orientation in ``tcp_body``'s frame (z along the fingers)."""
 
 
 @dataclass(frozen=True)
@@ -90,6 +84,8 @@ class HalWiring:
     """Arm joint → its value after every reset (rad or m), over the keyframe's."""
     gravity_compensation: bool = False
     """MuJoCo cancels gravity on the robot's bodies, through its joints' actuators."""
+    tcp: TcpWiring | None = None
+    """The tool centre point (None: joint actions only)."""
     ik_collision_pairs: tuple[tuple[tuple[str, ...], tuple[str, ...]], ...] = ()
     """(bodies, bodies to avoid) pairs the end-effector IK keeps apart (MJCF body names)."""
     ik_collision_margin_m: float = 0.01
@@ -105,16 +101,15 @@ class HalWiring:
         """Inverse of ``dataclasses.asdict`` (the ``hal_wiring`` of a tables JSON file)."""
         grippers = tuple(
             GripperWiring(
-                **{
-                    **g,
-                    "ctrl_range": tuple(g["ctrl_range"]),
-                    "qpos_addrs": tuple(g["qpos_addrs"]),
-                    "tcp_offset_m": tuple(g.get("tcp_offset_m", (0.0, 0.0, 0.0))),
-                    "tcp_quat_wxyz": tuple(g.get("tcp_quat_wxyz", (1.0, 0.0, 0.0, 0.0))),
-                }
+                **{**g, "ctrl_range": tuple(g["ctrl_range"]), "qpos_addrs": tuple(g["qpos_addrs"])}
             )
             for g in data["grippers"]
         )
+        tcp = data.get("tcp")
+        if tcp is not None:
+            tcp = TcpWiring(
+                **{**tcp, "offset_m": tuple(tcp["offset_m"]), "quat_wxyz": tuple(tcp["quat_wxyz"])}
+            )
         pairs = tuple(
             (tuple(bodies), tuple(avoid)) for bodies, avoid in data.get("ik_collision_pairs", ())
         )
@@ -123,6 +118,7 @@ class HalWiring:
                 **data,
                 "joint_names": tuple(data["joint_names"]),
                 "grippers": grippers,
+                "tcp": tcp,
                 "ik_collision_pairs": pairs,
             }
         )
@@ -248,9 +244,6 @@ def hal_wiring(robot: RobotDescription) -> HalWiring | None:
             write_mode=g.write_mode.value,
             actuator_index=g.actuator_index if g.actuator_index is not None else actuators[g.joint],
             mirror_actuator_index=g.mirror_actuator_index,
-            tcp_body=g.tcp_body,
-            tcp_offset_m=_triple(g.tcp_offset_m),
-            tcp_quat_wxyz=_unit_quat(g.tcp_quat_wxyz),
         )
         for g in sim.grippers
     )
@@ -275,6 +268,7 @@ def hal_wiring(robot: RobotDescription) -> HalWiring | None:
         },
         start_pose=dict(sim.start_pose or {}),
         gravity_compensation=sim.gravity_compensation,
+        tcp=tcp_wiring(sim.tcp),
         ik_collision_pairs=tuple(
             (tuple(p.bodies), tuple(p.avoid)) for p in sim.ik_collision_pairs or ()
         ),
@@ -375,18 +369,3 @@ def _gains(
         return {n: float(gains) for n in driven}
 
     return per_joint(control.kp), per_joint(control.kd)
-
-
-def _unit_quat(values: list[float] | None) -> tuple[float, float, float, float]:
-    """``values`` normalised (rule 18 bounds how far from unit they may be), else identity."""
-    if values is None:
-        return (1.0, 0.0, 0.0, 0.0)
-    norm = math.hypot(*values)
-    w, x, y, z = (v / norm for v in values)
-    return (w, x, y, z)
-
-
-def _triple(values: list[float] | None) -> tuple[float, float, float]:
-    """Three floats (zeros when absent)."""
-    x, y, z = values if values is not None else (0.0, 0.0, 0.0)
-    return (float(x), float(y), float(z))

@@ -55,7 +55,7 @@ class ActionContract:
         if mode is not ActionMode.JOINT_POSITION and ee is None:
             raise ValueError(
                 f"action mode {mode.value} needs a native scene and a robot with a tool "
-                f"centre point (sim.grippers[0].tcp_body); {robot.name} in this scene has none"
+                f"centre point (sim.tcp); {robot.name} in this scene has none"
             )
         if preset not in PRESETS:
             raise ValueError(f"unknown ee preset {preset!r}; valid: {', '.join(PRESETS)}")

@@ -10,7 +10,7 @@ key                       value                                                 
                           read mode)
 ``joint_velocities``      the same joints                                           rad/s, m/s
 ``tcp_pose``              the tool centre point in the base frame: x, y, z, then    m
-                          the quaternion w, x, y, z (a robot with a ``tcp_body``,
+                          the quaternion w, x, y, z (a robot with a ``sim.tcp``,
                           in a native scene)
 ``cameras/<sensor>``      latest RGB frame, H x W x 3 uint8, top row first
 ``camera_slots/<slot>``   the same frame under its VLA slot (``camera1`` ...)

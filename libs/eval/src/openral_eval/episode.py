@@ -279,22 +279,16 @@ class _Inputs:
             objects=object_poses(scene_obs),
             arm_slots=tuple(int(s) for s in slots),
             arm_dofs=tuple(int(d) for d in scene.addresses.qvel[slots]),
-            grippers=self._grippers(model),
+            grippers=self._grippers(),
             base=scene.frames().base_pose(self.scratch),
         )
 
-    def _grippers(self, model: mujoco.MjModel) -> tuple[PrivilegedGripper, ...]:
-        """The manifest's grippers: action slot and tool centre point in ``model``."""
+    def _grippers(self) -> tuple[PrivilegedGripper, ...]:
+        """The manifest's grippers: their action slots."""
         wiring = self.robot.tables.hal_wiring
         names = self.hal.action_names
         return tuple(
-            PrivilegedGripper(
-                slot=names.index(g.joint),
-                tcp_body=-1
-                if g.tcp_body is None
-                else mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, g.tcp_body),
-                tcp_offset_m=g.tcp_offset_m,
-            )
+            PrivilegedGripper(slot=names.index(g.joint))
             for g in (wiring.grippers if wiring is not None else ())
             if g.joint in names
         )

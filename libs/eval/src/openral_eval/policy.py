@@ -35,7 +35,7 @@ class Observation(TypedDict):
     """Seconds since the runner's first tick with a complete observation."""
     tcp_pose: NotRequired[npt.NDArray[np.float64]]
     """The tool centre point in the robot's base frame: x, y, z [m], then the quaternion
-    w, x, y, z (episodes, on a robot whose manifest gives its gripper a ``tcp_body``)."""
+    w, x, y, z (episodes, on a robot whose manifest declares ``sim.tcp``)."""
     task_state: NotRequired[Mapping[str, npt.NDArray[np.float64]]]
     """The scene's task state (object poses; robosuite's object observations), for a
     policy with ``needs_privileged`` (episodes only)."""

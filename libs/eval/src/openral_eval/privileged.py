@@ -4,8 +4,8 @@ A policy that sets ``needs_privileged = True`` gets ``obs["privileged"]`` on eve
 an episode on a native scene (never under ROS: the rskill runner refuses such a policy):
 the scene's model, a scratch copy of the simulation state it may compute on
 (``mj_kinematics``, Jacobians), the world pose of every scene object and of the robot's base
-frame, and the robot's grippers as the manifest declares them (action slot, tool centre
-point).
+frame, and the action slots of the robot's grippers (the tool centre point's pose is the
+observation's ``tcp_pose``).
 """
 
 from __future__ import annotations
@@ -25,10 +25,6 @@ class PrivilegedGripper:
 
     slot: int
     """Its action slot (write mode ``normalised``: 1 open, 0 closed)."""
-    tcp_body: int
-    """Body id of its ``tcp_body`` in the scene's model (-1: the manifest declares none)."""
-    tcp_offset_m: tuple[float, float, float]
-    """The tool centre point in that body's frame [m]."""
 
 
 @dataclass(frozen=True)

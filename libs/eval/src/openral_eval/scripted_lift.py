@@ -5,7 +5,7 @@ It acts in ``ee_delta_pose`` (the robosuite preset: full scale 0.05 m and 0.5 ra
 -1 opens the gripper, +1 closes it), so the one IK of :mod:`openral_sim.end_effector` turns
 its motions into joint targets under the manifest's limits, and nothing of any one robot is
 written here: the tool centre point comes from the observation (``tcp_pose``, base frame,
-from the manifest's ``tcp_body``) and the cube's pose from the privileged state, brought
+from the manifest's ``sim.tcp``) and the cube's pose from the privileged state, brought
 into the base frame. It moves the tool centre point through four phases:
 
 1. ``approach``: ``approach_m`` above the cube, fingers pointing down and turned to the
@@ -88,7 +88,7 @@ class ScriptedLift:
         if world is None or tcp is None or world.base is None:
             raise PolicyConfigError(
                 "scripted_lift needs privileged state and the robot's tcp_pose "
-                "(episodes on a native scene, a manifest with sim.grippers[0].tcp_body)"
+                "(episodes on a native scene, a manifest with sim.tcp)"
             )
         now = float(obs["time_s"])
         if self._last_time_s is not None and now > self._last_time_s:

@@ -16,17 +16,16 @@ from openral_hal.sim_attached import SimAttachedHAL
 
 def ee_command(hal: SimAttachedHAL, robot: LoadedRobot) -> EeCommand | None:
     """The TCP of ``robot`` in the HAL's native scene (None: not a native scene, not
-    connected, or the manifest declares no ``tcp_body``).
+    connected, or the manifest declares no ``sim.tcp``).
 
     Raises:
         HalError: The manifest declares a TCP the scene's model cannot place (a missing
-            ``tcp_body`` or a body of ``sim.ik_collision_pairs``; the message says which).
+            ``sim.tcp`` frame or a body of ``sim.ik_collision_pairs``; the message says which).
     """
     scene = hal.env if isinstance(hal.env, SceneRollout) else None
     handles = hal.mujoco_handles()
     wiring = robot.tables.hal_wiring
-    grippers = wiring.grippers if wiring is not None else ()
-    if scene is None or handles is None or not grippers or grippers[0].tcp_body is None:
+    if scene is None or handles is None or wiring is None or wiring.tcp is None:
         return None
     ee = EndEffector(handles[0], scene.addresses, robot)
     return EeCommand(ee, scene.frames(), hal.control_period_s)

@@ -205,10 +205,6 @@ def _gripper_rows(wiring: HalWiring, model: mujoco.MjModel) -> Iterator[CheckRow
                 gripper.mirror_actuator_index,
                 model,
             )
-        if gripper.tcp_body is not None:
-            found = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, gripper.tcp_body) >= 0
-            actual = "a body of the model" if found else "no such body"
-            yield CheckRow(f"{prefix}.tcp_body", gripper.tcp_body, actual, ok=found)
 
 
 def _ctrl_range_row(
@@ -295,7 +291,12 @@ def _sensor_rows(description: RobotDescription, models: list[mujoco.MjModel]) ->
 
 
 def _ik_collision_rows(wiring: HalWiring, model: mujoco.MjModel) -> Iterator[CheckRow]:
-    """Each body of ``sim.ik_collision_pairs`` is a body of the robot's model."""
+    """The tool centre point's body or site, and each body of ``sim.ik_collision_pairs``,
+    are in the robot's model."""
+    tcp = wiring.tcp
+    if tcp is not None:
+        kind = mujoco.mjtObj.mjOBJ_BODY if tcp.kind == "body" else mujoco.mjtObj.mjOBJ_SITE
+        yield _exists(f"sim.tcp.{tcp.kind}", tcp.frame, kind, [model])
     for index, groups in enumerate(wiring.ik_collision_pairs):
         for field, bodies in zip(("bodies", "avoid"), groups, strict=True):
             for position, body in enumerate(bodies):

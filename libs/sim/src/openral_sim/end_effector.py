@@ -1,7 +1,7 @@
 """The robot's tool centre point (TCP) in a native scene, and the one IK that moves it.
 
-The TCP is the manifest's first gripper's ``tcp_body`` with its ``tcp_offset_m`` (between
-the fingertips) and ``tcp_quat_wxyz`` (the tool frame: z along the fingers). Its pose is
+The TCP is the manifest's ``sim.tcp``: a body or a site of the model, an ``offset_m`` (between
+the fingertips) and a ``quat_wxyz`` (the tool frame: z along the fingers). Its pose is
 stated in the robot's base frame (the frame ``/tf`` calls the base: a mobile base's moving
 frame, else the robot's root): position [m] and orientation as a unit quaternion (w, x, y,
 z).
@@ -76,32 +76,33 @@ class EndEffector:
     """The TCP of one robot in one native scene's model (see the module doc)."""
 
     def __init__(self, model: mujoco.MjModel, addresses: RobotAddresses, robot: LoadedRobot):
-        """Find the TCP body and set up the IK.
+        """Find the TCP's body or site and set up the IK.
 
         Raises:
-            HalError: The manifest declares no ``tcp_body`` on its first gripper, or the
-                scene's model has no such body.
+            HalError: The manifest declares no ``sim.tcp``, or the scene's model has no
+                such body or site.
         """
         wiring = robot.tables.hal_wiring
-        gripper = wiring.grippers[0] if wiring is not None and wiring.grippers else None
-        if gripper is None or gripper.tcp_body is None:
+        tcp = wiring.tcp if wiring is not None else None
+        if tcp is None:
             raise HalError(
-                f"{robot.name} has no tool centre point: end-effector actions need "
-                "sim.grippers[0].tcp_body (and tcp_offset_m) in its manifest"
+                f"{robot.name} has no tool centre point: end-effector actions need sim.tcp "
+                "(a body or site, and an offset) in its manifest"
             )
-        self.body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, gripper.tcp_body)
-        if self.body < 0:
-            raise HalError(f"the scene's model has no body {gripper.tcp_body!r} (tcp_body)")
-        self.offset = np.asarray(gripper.tcp_offset_m, dtype=np.float64)
-        self.flange_quat = np.asarray(gripper.tcp_quat_wxyz, dtype=np.float64)
+        kind = mujoco.mjtObj.mjOBJ_SITE if tcp.kind == "site" else mujoco.mjtObj.mjOBJ_BODY
+        self.kind, self.frame = tcp.kind, mujoco.mj_name2id(model, kind, tcp.frame)
+        if self.frame < 0:
+            raise HalError(f"the scene's model has no {tcp.kind} {tcp.frame!r} (sim.tcp)")
+        self.offset = np.asarray(tcp.offset_m, dtype=np.float64)
+        self.flange_quat = np.asarray(tcp.quat_wxyz, dtype=np.float64)
         turn = mink.SO3(self.flange_quat)
         self.flange = mink.SE3.from_rotation_and_translation(turn, self.offset)
-        """The TCP's pose in the ``tcp_body`` frame."""
+        """The TCP's pose in the body's or site's frame."""
         self.arm = addresses.arm_slots
         self.configuration = mink.Configuration(model)
         turning = 1.0 if len(self.arm) >= _FULL_POSE_JOINTS else _FEW_JOINTS_TURN_COST
         self.task = mink.FrameTask(
-            gripper.tcp_body, "body", position_cost=1.0, orientation_cost=turning, gain=1.0
+            tcp.frame, tcp.kind, position_cost=1.0, orientation_cost=turning, gain=1.0
         )
         self._limits, self._frozen = self._constraints(model, addresses, robot)
         self._arm_qpos = addresses.qpos[self.arm]
@@ -131,17 +132,22 @@ class EndEffector:
     def world_pose(self, data: mujoco.MjData) -> tuple[FloatArray, FloatArray]:
         """The TCP's world position [m] and orientation (w, x, y, z) as ``data`` holds them
         (MuJoCo's own quaternion routines: a few microseconds, it is in every observation)."""
+        if self.kind == "site":
+            position, frame = data.site_xpos[self.frame], np.empty(4)
+            mujoco.mju_mat2Quat(frame, data.site_xmat[self.frame])
+        else:
+            position, frame = data.xpos[self.frame], data.xquat[self.frame]
         quat, offset = np.empty(4), np.empty(3)
-        mujoco.mju_mulQuat(quat, data.xquat[self.body], self.flange_quat)
-        mujoco.mju_rotVecQuat(offset, self.offset, data.xquat[self.body])
-        return data.xpos[self.body] + offset, quat
+        mujoco.mju_mulQuat(quat, frame, self.flange_quat)
+        mujoco.mju_rotVecQuat(offset, self.offset, frame)
+        return position + offset, quat
 
     def commanded_pose(self, data: mujoco.MjData, commanded: FloatArray) -> mink.SE3:
         """The TCP's world pose with the arm at its ``commanded`` targets (the rest of the
         state from ``data``)."""
         self._set(data, commanded)
-        body = self.configuration.get_transform_frame_to_world(self.task.frame_name, "body")
-        return body.multiply(self.flange)
+        frame = self.configuration.get_transform_frame_to_world(self.task.frame_name, self.kind)
+        return frame.multiply(self.flange)
 
     def _set(self, data: mujoco.MjData, commanded: FloatArray) -> None:
         q = np.array(data.qpos)
