@@ -26,6 +26,7 @@ from rclpy.context import Context
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import CameraInfo, Image, JointState
+from std_srvs.srv import Trigger
 
 from tests.conftest import REPO
 
@@ -49,6 +50,15 @@ def wait_until(predicate: Callable[[], bool], timeout_s: float = WAIT_S, what: s
 
 
 @dataclass(frozen=True)
+def call_trigger(client: Any, name: str) -> Any:
+    """Call the ``std_srvs/Trigger`` service ``name`` through ``client`` and return the
+    response (fails the test when it is not offered or does not answer)."""
+    assert client.wait_for_service(timeout_sec=10.0), f"{name} is not offered"
+    future = client.call_async(Trigger.Request())
+    wait_until(future.done, 15.0, f"the answer of {name}")
+    return future.result()
+
+
 class Received:
     """One message and its arrival time (``time.monotonic()``)."""
 

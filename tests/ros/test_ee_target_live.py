@@ -42,7 +42,7 @@ from std_msgs.msg import Float64MultiArray, String
 from std_srvs.srv import Trigger
 
 from tests.ros.lifecycle_client import deploy_output, deploy_sim
-from tests.ros.ros_helpers import FRANKA_SCENE, Probe, wait_until
+from tests.ros.ros_helpers import FRANKA_SCENE, Probe, call_trigger, wait_until
 
 START_WAIT_S = 90.0
 BASE = "base_link"
@@ -63,11 +63,7 @@ class EeClient:
         self.services = {name: node.create_client(Trigger, name) for name in names}
 
     def call(self, name: str) -> Any:
-        client = self.services[name]
-        assert client.wait_for_service(timeout_sec=10.0), f"{name} is not offered"
-        future = client.call_async(Trigger.Request())
-        wait_until(future.done, 15.0, f"the answer of {name}")
-        return future.result()
+        return call_trigger(self.services[name], name)
 
     def send(self, pose: np.ndarray, frame: str = BASE) -> float:
         """Publish one target (7 values: position, w, x, y, z); returns when it was sent."""

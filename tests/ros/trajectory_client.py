@@ -35,7 +35,7 @@ from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory
 
 from tests.ros.lifecycle_client import deploy_output, deploy_sim
-from tests.ros.ros_helpers import FRANKA_SCENE, Probe, wait_until
+from tests.ros.ros_helpers import FRANKA_SCENE, Probe, call_trigger, wait_until
 
 START_WAIT_S = 90.0
 """Longest wait for deploy sim to load its scene and publish on a loaded machine [s]."""
@@ -66,11 +66,7 @@ class Client:
 
     def call(self, name: str) -> Any:
         """Call a Trigger service and return its response."""
-        client = self.services[name]
-        assert client.wait_for_service(timeout_sec=10.0), f"{name} is not offered"
-        future = client.call_async(Trigger.Request())
-        wait_until(future.done, 15.0, f"the answer of {name}")
-        return future.result()
+        return call_trigger(self.services[name], name)
 
     def positions(self, msg: Any) -> np.ndarray:
         """Positions of :data:`JOINTS` in a JointState."""
