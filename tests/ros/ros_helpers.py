@@ -49,7 +49,6 @@ def wait_until(predicate: Callable[[], bool], timeout_s: float = WAIT_S, what: s
         time.sleep(0.01)
 
 
-@dataclass(frozen=True)
 def call_trigger(client: Any, name: str) -> Any:
     """Call the ``std_srvs/Trigger`` service ``name`` through ``client`` and return the
     response (fails the test when it is not offered or does not answer)."""
@@ -59,6 +58,7 @@ def call_trigger(client: Any, name: str) -> Any:
     return future.result()
 
 
+@dataclass(frozen=True)
 class Received:
     """One message and its arrival time (``time.monotonic()``)."""
 
