@@ -1,8 +1,9 @@
-"""``scripted_lift`` on the franka and mobile-Panda tabletops, in end-effector deltas: it
-lifts the randomised cube, deterministically.
+"""``scripted_lift`` on the franka, mobile-Panda and so101 tabletops, in end-effector deltas:
+it lifts the randomised cube, deterministically, with nothing of any one robot in its code.
 
-Over seeds 0-19 (the cube moved ±5 cm and turned ±180°), at least 18 episodes succeed
-(the cube 5 cm up for 0.5 s) within 300 control steps; the same seed twice gives the same
+Over seeds 0-19 (the cube moved and turned per the scene's randomisation), at least 18
+episodes succeed on the Pandas and 15 on the so101 (the cube 5 cm up for 0.5 s) within 300
+control steps; the same seed twice gives the same
 joint trajectory; the rskill runner's registry names it; without privileged state it
 refuses with one clear message.
 """
@@ -19,8 +20,10 @@ from tests.conftest import ROBOTS
 SCENE = str(ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml")
 
 
-@pytest.mark.parametrize("robot", ["franka_panda", "panda_mobile"])
-def test_it_lifts_the_cube_on_at_least_18_of_20_seeds(robot: str) -> None:
+@pytest.mark.parametrize(
+    ("robot", "at_least"), [("franka_panda", 18), ("panda_mobile", 18), ("so101", 15)]
+)
+def test_it_lifts_the_cube_on_most_of_20_seeds(robot: str, at_least: int) -> None:
     scene = str(ROBOTS / robot / "scenes" / "tabletop.yaml")
     results = [
         run_episode(EpisodeSpec(scene, seed, "scripted_lift", (), 300)) for seed in range(20)
@@ -28,7 +31,7 @@ def test_it_lifts_the_cube_on_at_least_18_of_20_seeds(robot: str) -> None:
     assert all(r.error is None for r in results), [r.error for r in results if r.error]
     won = [r for r in results if r.success]
     print(f"scripted_lift: {len(won)}/20, mean steps {np.mean([r.steps for r in won]):.1f}")
-    assert len(won) >= 18
+    assert len(won) >= at_least
     again = run_episode(EpisodeSpec(scene, 7, "scripted_lift", (), 300))
     assert again.trajectory_sha256 == results[7].trajectory_sha256
 

@@ -241,6 +241,11 @@ def _add_table(spec: mujoco.MjSpec, base: np.ndarray, yaw: float, height: float)
     )
 
 
+EVERY_GROUP = 0xFFFF
+"""``conaffinity`` of a scene object: it touches every collision geom of the robot, whatever
+collision group (``contype`` bit) the robot's model puts it in."""
+
+
 def _add_object(spec: mujoco.MjSpec, obj: SceneObject) -> None:
     shapes = {
         "box": mujoco.mjtGeom.mjGEOM_BOX,
@@ -257,4 +262,5 @@ def _add_object(spec: mujoco.MjSpec, obj: SceneObject) -> None:
         size=size,
         rgba=list(obj.rgba or [0.8, 0.2, 0.2, 1.0]),
         mass=obj.mass_kg or 0.1,
+        conaffinity=EVERY_GROUP,
     )
