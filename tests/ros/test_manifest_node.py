@@ -117,9 +117,9 @@ def test_deploy_publishes_joint_states_cameras_and_action_spec(deployed: Deploye
 
 def test_camera_frames_come_at_most_at_10_hz_of_scene_time(deployed: Deployed) -> None:
     """Each camera's frames are stamped on control ticks (0.05 s of simulated time), in
-    order, never more than one per 0.1 s period of its schedule: a frame that comes due
-    while the camera is still rendering waits for a later tick, and the schedule keeps its
-    grid (:class:`~openral_sim.sensor_schedule.SensorSchedule`). How many frames a second
+    order, one per tick at most, and never more than 10 in any second of simulated time: a
+    frame that comes due while the camera is still rendering waits for a later tick
+    (:class:`~openral_sim.sensor_schedule.SensorSchedule`). How many frames a second
     this machine renders is a benchmark's question (``just bench-camera``), not this
     test's: the wall rate depends on the machine's load."""
     probe = deployed.probe
@@ -131,7 +131,7 @@ def test_camera_frames_come_at_most_at_10_hz_of_scene_time(deployed: Deployed) -
             ),
             what=f"{RATE_WINDOW_S} s of {camera} frames",
         )
-    tick, period = 1.0 / CONTROL_HZ, 1.0 / CAMERA_HZ
+    tick = 1.0 / CONTROL_HZ
     for camera in CAMERAS:
         frames = [
             r for r in probe.since(image_topic(camera), start) if r.at <= start + RATE_WINDOW_S
@@ -143,9 +143,8 @@ def test_camera_frames_come_at_most_at_10_hz_of_scene_time(deployed: Deployed) -
         assert len(frames) >= RATE_WINDOW_S * CAMERA_HZ / 4, f"{camera}: {len(frames)} frames"
         assert np.allclose(ticks, np.round(ticks), atol=1e-3), f"{camera}: off the ticks {stamps}"
         assert np.all(ticks >= 1.0 - 1e-3), f"{camera}: a tick sent two frames: {stamps}"
-        grid = np.min(np.mod(stamps + 1e-6, period))  # the schedule's phase: on-time frames
-        slots = np.floor((stamps - grid) / period + 1e-6)
-        assert np.all(np.diff(slots) >= 1), f"{camera}: two frames in one 0.1 s slot: {stamps}"
+        within_1_s = [np.sum((stamps >= t) & (stamps < t + 1.0 - 1e-6)) for t in stamps]
+        assert max(within_1_s) <= CAMERA_HZ + 1, f"{camera}: over 10 Hz of scene time: {stamps}"
 
 
 def test_idle_scene_advances_and_estop_freezes_it(deployed: Deployed) -> None:
