@@ -22,14 +22,14 @@ import threading
 
 import numpy as np
 from openral_hal.sim_attached import SimAttachedHAL
+from openral_mujoco.errors import ActionRejected
 from openral_mujoco.state import FloatArray
-from openral_sim.ee_modes import EeCommand
+from openral_sim.ee_modes import EeCommand, unit_quaternion
 
 from openral_bridge.trajectory_follower import DesiredPoint
 
 POSE_WIDTH = 7
 """A target: position x, y, z [m] and quaternion w, x, y, z in the base frame."""
-_SMALLEST_QUAT = 1e-6
 _FIELDS = tuple(f"position.{a}" for a in "xyz") + tuple(f"orientation.{a}" for a in "wxyz")
 
 
@@ -48,13 +48,10 @@ def checked_pose(position: tuple[float, ...], quat_wxyz: tuple[float, ...]) -> F
         if not math.isfinite(value):
             raise EeTargetRefused(f"pose.{name} is {value}; expected a finite number")
     pose = np.array(values, dtype=np.float64)
-    norm = float(np.linalg.norm(pose[3:]))
-    if norm < _SMALLEST_QUAT:
-        raise EeTargetRefused(
-            f"pose.orientation has norm {norm:g}; expected a rotation quaternion "
-            "(it is normalised, but not from zero)"
-        )
-    pose[3:] /= norm
+    try:
+        pose[3:] = unit_quaternion(pose[3:], "pose.orientation")
+    except ActionRejected as error:
+        raise EeTargetRefused(str(error)) from None
     return pose
 
 

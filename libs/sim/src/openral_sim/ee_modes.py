@@ -59,6 +59,21 @@ PRESETS = {
 """The ``ee_delta_pose`` presets by name."""
 
 
+def unit_quaternion(quat: FloatArray, name: str) -> FloatArray:
+    """``quat`` (w, x, y, z) normalised; ``name`` says what it is in the error.
+
+    Raises:
+        ActionRejected: Its norm is (nearly) zero: no orientation to normalise to.
+    """
+    norm = float(np.linalg.norm(quat))
+    if norm < _SMALLEST_QUAT:
+        raise ActionRejected(
+            f"{name} has norm {norm:g}; expected a rotation (it is normalised, but not from zero)"
+        )
+    unit: FloatArray = np.asarray(quat, dtype=np.float64) / norm
+    return unit
+
+
 class EeCommand:
     """Turns end-effector actions into arm joint targets and a gripper command."""
 
@@ -101,13 +116,7 @@ class EeCommand:
         Raises:
             ActionRejected: The quaternion is (nearly) zero: no orientation at all.
         """
-        norm = float(np.linalg.norm(action[3:7]))
-        if norm < _SMALLEST_QUAT:
-            raise ActionRejected(
-                f"ee_pose quaternion (qw, qx, qy, qz) has norm {norm:g}; expected a rotation "
-                "(it is normalised, but not from zero)"
-            )
-        quat = action[3:7] / norm
+        quat = unit_quaternion(action[3:7], "ee_pose quaternion (qw, qx, qy, qz)")
         self.reference = mink.SE3.from_rotation_and_translation(mink.SO3(quat), action[:3])
         return self._solve(data, commanded), float(action[7])
 
