@@ -3,6 +3,7 @@ a goal, collect its feedback, cancel it, read its result."""
 
 from __future__ import annotations
 
+import threading
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -53,6 +54,36 @@ def goal(
     return message
 
 
+class _AtomicActionClient(ActionClient):  # type: ignore[misc]
+    """An ActionClient whose requests register before their response can be taken.
+
+    rclpy (Jazzy) sends a goal, cancel or result request and only then records its sequence
+    number; a response taken on the spin thread in between is dropped ("Ignoring unexpected
+    cancel response") and its future never completes (ros2/rclpy#1123). One lock around the
+    send-and-register and around the handling of a response closes that window.
+    """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._register = threading.RLock()
+
+    def send_goal_async(self, *args: Any, **kwargs: Any) -> Any:
+        with self._register:
+            return super().send_goal_async(*args, **kwargs)
+
+    def _cancel_goal_async(self, goal_handle: Any) -> Any:
+        with self._register:
+            return super()._cancel_goal_async(goal_handle)
+
+    def _get_result_async(self, goal_handle: Any) -> Any:
+        with self._register:
+            return super()._get_result_async(goal_handle)
+
+    async def execute(self, taken_data: Any) -> None:
+        with self._register:
+            await super().execute(taken_data)
+
+
 @dataclass
 class Sent:
     """One goal sent: its handle, the feedback received (wall time, message), its result."""
@@ -65,7 +96,7 @@ class TrajectoryActionClient:
     """FollowJointTrajectory on a node spun by the caller."""
 
     def __init__(self, node: Node, timeout_s: float = 30.0) -> None:
-        self.client = ActionClient(node, FollowJointTrajectory, FOLLOW_JOINT_TRAJECTORY)
+        self.client = _AtomicActionClient(node, FollowJointTrajectory, FOLLOW_JOINT_TRAJECTORY)
         assert self.client.wait_for_server(timeout_sec=timeout_s), "no action server"
 
     def send(self, message: Any, timeout_s: float = 10.0) -> Sent:
