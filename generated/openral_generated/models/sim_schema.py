@@ -331,7 +331,7 @@ class SimDescription(OpenralModel):
         list[IkCollisionPair] | None, Field(max_length=16)
     ] = None
     """
-    Self-collision avoidance of the end-effector IK: pairs of body groups of the robot's model it keeps apart. Each item names two groups of bodies (`bodies`, `avoid`); every collision geom (non-zero contype or conaffinity) of a body in one group is kept at least `ik_collision_margin_m` from every collision geom of a body in the other, as an inequality of each IK step (mink's collision avoidance). Bodies welded together or parent and child are never paired (they touch by construction). Absent: the IK keeps only the joint limits.
+    Self-collision avoidance of the end-effector IK: pairs of body groups of the robot's model it keeps apart. Each item names two groups of bodies (`bodies`, `avoid`); every collision geom (non-zero contype or conaffinity) of a body in one group is kept at least `ik_collision_margin_m` from every collision geom of a body in the other, as an inequality of each IK step (a step may close at most 85 % of what is left above the margin). Bodies welded together or parent and child are never paired (they touch by construction). Absent: the IK keeps only the joint limits.
     """
     ik_collision_margin_m: Annotated[StrictFloat, Field(ge=0.0, le=0.1)] = 0.01
     """

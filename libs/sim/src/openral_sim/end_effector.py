@@ -7,29 +7,33 @@ frame, else the robot's root): position [m] and orientation as a unit quaternion
 z).
 
 :meth:`EndEffector.joint_targets` turns a TCP pose into arm joint targets by differential
-IK with mink on the scene's own model (the kinematics the robot really has there), solved
-by daqp as one quadratic programme per control tick:
+IK on the scene's own model (the kinematics the robot really has there): mink gives the
+frame task's error and Jacobian, and daqp solves one small quadratic programme per control
+tick whose variables are the arm's joints alone (every other degree of freedom, grippers,
+a mobile base, the scene's objects, stays where it is):
 
-- a frame task on the TCP body (gain 1: the whole error in one control period; on an arm
-  of fewer than six joints, which cannot hold every pose, the orientation weighs a tenth);
-- the manifest's position limits of every arm joint (:class:`ArmPositionLimit`, the
-  envelope of :class:`~openral_mujoco.command_limits.CommandLimits`) and its velocity
-  limits (mink's ``VelocityLimit``) as inequalities;
+- least squares on the frame task's error (gain 1: the whole error in one control period;
+  on an arm of fewer than six joints, which cannot hold every pose, the orientation weighs
+  a tenth);
+- as bounds on each joint's step: the manifest's position limits (the envelope of
+  :class:`~openral_mujoco.command_limits.CommandLimits`, a step closing at most 95 % of
+  what is left) and its velocity limit (80 % of it, over the control period);
 - self-collision avoidance between the collision geoms of the body groups the manifest
   lists in ``sim.ik_collision_pairs``, kept at least ``sim.ik_collision_margin_m`` apart
-  (:mod:`openral_sim.self_collision`);
-- every other degree of freedom (grippers, a mobile base, the scene's objects) frozen.
+  (:mod:`openral_sim.self_collision`), one row per pair within reach.
 
+Building the programme over the arm's joints, not every DOF of the scene with the others
+frozen by equalities (mink's ``solve_ik``), gives the same step for a third of the cost.
 A target out of reach is approached as far as those limits allow and no further: the
 solution is the best step inside them, never a step past a limit.
 """
 
 from __future__ import annotations
 
+import daqp
 import mink
 import mujoco
 import numpy as np
-from mink.limits.limit import Constraint
 from openral_core.loaded import LoadedRobot
 from openral_mujoco.command_limits import CommandLimits
 from openral_mujoco.errors import HalError
@@ -38,8 +42,10 @@ from openral_mujoco.state import FloatArray
 
 from openral_sim.self_collision import collision_limit
 
-SOLVER = "daqp"
-"""The QP solver of every IK step."""
+_DAMPING = 1e-6
+"""Levenberg-Marquardt damping of every IK step (on the arm's joints)."""
+_INACTIVE = -1e30
+"""daqp's "no lower bound" on a constraint row."""
 _SPEED_SHARE = 0.8
 """Share of a joint's velocity limit the IK may plan for (the rest: the servo's headroom)."""
 _FULL_POSE_JOINTS = 6
@@ -49,27 +55,6 @@ _FEW_JOINTS_TURN_COST = 0.1
 fewer joints (a 5-joint arm cannot hold both; the position comes first)."""
 _POSITION_GAIN = 0.95
 """Share of the distance to a position limit one step may close (mink's default)."""
-
-
-class ArmPositionLimit(mink.Limit):
-    """The manifest's position limits of the arm joints, as ``G dq <= h`` over every DOF."""
-
-    def __init__(
-        self, nv: int, qpos: list[int], dofs: list[int], low: FloatArray, high: FloatArray
-    ) -> None:
-        count = len(dofs)
-        self.qpos, self.low, self.high = np.array(qpos, dtype=np.intp), low, high
-        self.G = np.zeros((2 * count, nv))
-        self.G[np.arange(count), dofs] = 1.0
-        self.G[count + np.arange(count), dofs] = -1.0
-
-    def compute_qp_inequalities(self, configuration: mink.Configuration, dt: float) -> Constraint:
-        """Each arm joint may move at most :data:`_POSITION_GAIN` of the way to its limits."""
-        del dt
-        q = configuration.q[self.qpos]
-        upper = np.maximum(self.high - q, 0.0) * _POSITION_GAIN
-        lower = np.maximum(q - self.low, 0.0) * _POSITION_GAIN
-        return Constraint(G=self.G, h=np.concatenate([upper, lower]))
 
 
 class EndEffector:
@@ -98,36 +83,30 @@ class EndEffector:
         turn = mink.SO3(self.flange_quat)
         self.flange = mink.SE3.from_rotation_and_translation(turn, self.offset)
         """The TCP's pose in the body's or site's frame."""
+        self._flange_inverse = self.flange.inverse()
         self.arm = addresses.arm_slots
         self.configuration = mink.Configuration(model)
         turning = 1.0 if len(self.arm) >= _FULL_POSE_JOINTS else _FEW_JOINTS_TURN_COST
         self.task = mink.FrameTask(
             tcp.frame, tcp.kind, position_cost=1.0, orientation_cost=turning, gain=1.0
         )
-        self._limits, self._frozen = self._constraints(model, addresses, robot)
+        self._dofs = np.asarray(addresses.qvel[self.arm], dtype=np.intp)
         self._arm_qpos = addresses.qpos[self.arm]
+        self._low, self._high, self._speed = self._envelope(robot)
+        self._collisions = collision_limit(model, robot) if wiring is not None else None
         self.shortfall_m = 0.0
         """How far the last step's TCP ends from its target, to first order [m] (more than
         rounding: the limits stopped it short)."""
 
-    def _constraints(
-        self, model: mujoco.MjModel, addresses: RobotAddresses, robot: LoadedRobot
-    ) -> tuple[list[mink.Limit], list[mink.DofFreezingTask]]:
-        """The arm's position and velocity limits, and every other DOF frozen."""
-        joints = [robot.description.joints[int(i)] for i in self.arm]
+    def _envelope(self, robot: LoadedRobot) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The arm's position limits [rad or m] (the envelope of
+        :class:`~openral_mujoco.command_limits.CommandLimits`) and the speed [per s] the IK
+        may plan for."""
         wiring = robot.tables.hal_wiring
         envelope = CommandLimits(robot.description, wiring.grippers if wiring is not None else ())
-        low, high = envelope.low[self.arm], envelope.high[self.arm]
-        dofs = [int(d) for d in addresses.qvel[self.arm]]
-        positions = ArmPositionLimit(model.nv, list(addresses.qpos[self.arm]), dofs, low, high)
-        names = robot.tables.joint_name_map
-        speeds = {names[j.name]: _SPEED_SHARE * j.velocity_limit for j in joints}
-        arm_dofs = set(dofs)
-        frozen = [d for d in range(model.nv) if d not in arm_dofs]
-        freeze = [mink.DofFreezingTask(model, dof_indices=frozen)] if frozen else []
-        limits: list[mink.Limit] = [positions, mink.VelocityLimit(model, speeds)]
-        collisions = collision_limit(model, robot) if wiring is not None else None
-        return limits + ([collisions] if collisions is not None else []), freeze
+        joints = [robot.description.joints[int(i)] for i in self.arm]
+        speed = np.array([_SPEED_SHARE * j.velocity_limit for j in joints], dtype=np.float64)
+        return envelope.low[self.arm], envelope.high[self.arm], speed
 
     def world_pose(self, data: mujoco.MjData) -> tuple[FloatArray, FloatArray]:
         """The TCP's world position [m] and orientation (w, x, y, z) as ``data`` holds them
@@ -169,26 +148,49 @@ class EndEffector:
             HalError: The solver found no step (it reports why).
         """
         self._set(data, commanded)
-        self.task.set_target(target_world.multiply(self.flange.inverse()))
-        try:
-            velocity = mink.solve_ik(
-                self.configuration,
-                [self.task],
-                dt,
-                SOLVER,
-                damping=1e-6,
-                limits=self._limits,
-                constraints=self._frozen,
-            )
-        except mink.MinkError as error:
-            raise HalError(f"end-effector IK found no step: {error}") from error
-        step = velocity * dt  # the task's residual after it, to first order: e + J dq
-        residual = self.task.compute_error(self.configuration) + (
-            self.task.compute_jacobian(self.configuration) @ step
-        )
+        self.task.set_target(target_world.multiply(self._flange_inverse))
+        error = self.task.compute_error(self.configuration)
+        jacobian = self.task.compute_jacobian(self.configuration)[:, self._dofs]
+        step = self._solve(error, jacobian, commanded, dt)
+        residual = error + jacobian @ step  # the task's residual after the step, to first order
         self.shortfall_m = float(
             np.linalg.norm(residual[:3])
             + np.linalg.norm(residual[3:]) * np.linalg.norm(self.offset)
         )
-        q = self.configuration.integrate(velocity, dt)
-        return np.asarray(q[self._arm_qpos], dtype=np.float64)
+        return np.asarray(commanded + step, dtype=np.float64)  # one-DOF joints: q + Δq
+
+    def _solve(
+        self, error: FloatArray, jacobian: FloatArray, commanded: FloatArray, dt: float
+    ) -> FloatArray:
+        """The arm's joint step: least squares on the weighted task error, inside the
+        position limits, the speed cap over ``dt`` and the self-collision rows.
+
+        Raises:
+            HalError: The solver found no step.
+        """
+        cost = self.task.cost
+        weighted = cost[:, None] * jacobian
+        hessian = weighted.T @ weighted
+        hessian.flat[:: len(self._dofs) + 1] += _DAMPING
+        linear = (cost * (self.task.gain * error)) @ weighted
+        reach = self._speed * dt
+        upper = np.minimum(np.maximum(self._high - commanded, 0.0) * _POSITION_GAIN, reach)
+        lower = np.maximum(-np.maximum(commanded - self._low, 0.0) * _POSITION_GAIN, -reach)
+        rows, bounds = self._collision_rows()
+        step, _, exitflag, _ = daqp.solve(
+            hessian,
+            linear,
+            rows,
+            np.concatenate([upper, bounds]),
+            np.concatenate([lower, np.full(len(bounds), _INACTIVE)]),
+            np.zeros(len(upper) + len(bounds), dtype=np.intc),
+        )
+        if exitflag <= 0:
+            raise HalError(f"end-effector IK found no step (daqp exit flag {exitflag})")
+        return np.asarray(step, dtype=np.float64)
+
+    def _collision_rows(self) -> tuple[FloatArray, FloatArray]:
+        """The self-collision inequalities on the arm's joints (pairs in reach only)."""
+        if self._collisions is None:
+            return np.zeros((0, len(self._dofs))), np.zeros(0)
+        return self._collisions.rows(self.configuration.data, self._dofs)

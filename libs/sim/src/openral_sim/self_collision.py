@@ -8,28 +8,30 @@ and its child, and geoms whose contype and conaffinity never match.
 
 For each pair closer than the margin plus a look-ahead (pairs whose bounding spheres are
 farther apart are skipped before MuJoCo measures them), one IK step (the joint displacement
-``Δq`` of one control period, the variable of mink's QP) may close at most a share of what
+``Δq`` of one control period, the variable of the IK's QP) may close at most a share of what
 is left above the margin (``n · (J_b - J_a) Δq >= -gain (d - margin)``, with ``n`` the unit
 vector between their nearest points): far pairs cost nothing, a pair at the margin may only
 separate. (mink's own ``CollisionAvoidanceLimit`` divides that bound by the period, which
 lets a 20 Hz step close twenty times the gap.)
 
 MuJoCo 3.8.1's ``mj_geomDistance`` sometimes reports exactly 0 for two convex meshes
-well apart (google-deepmind/mujoco issue 3383), with their nearest points (``fromto``)
-right, or with none at all. A 0 is checked before it is believed
-(:meth:`SelfCollisionLimit._distance`), so a false contact does not freeze the arm.
+well apart (google-deepmind/mujoco issue 3383), with nearest points (``fromto``) that are
+not the nearest (on the Panda: 2.0 cm apart for a link and the hand 0.95 cm apart), or with
+none at all. An exact 0 from its native solver is asked again of libccd, the solver it
+falls back to with ``mjDSBL_NATIVECCD`` (:meth:`SelfCollisionLimit._distance`): a false
+contact neither freezes the arm nor, read as a larger gap, lets it through.
 """
 
 from __future__ import annotations
 
 import itertools
 
-import mink
 import mujoco
 import numpy as np
-from mink.limits.limit import Constraint
+import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
 from openral_mujoco.errors import HalError
+from openral_mujoco.state import FloatArray
 
 LOOK_AHEAD_M = 0.09
 """How far beyond the margin a pair starts to constrain the step [m]: more than the hand
@@ -41,7 +43,7 @@ _APART_M = 1e-9
 """Nearest points closer than this are one point (a true contact) [m]."""
 
 
-class SelfCollisionLimit(mink.Limit):
+class SelfCollisionLimit:
     """Geom pairs the IK keeps ``margin_m`` apart (see the module doc)."""
 
     def __init__(self, model: mujoco.MjModel, pairs: list[tuple[int, int]], margin_m: float):
@@ -53,13 +55,15 @@ class SelfCollisionLimit(mink.Limit):
         self._fromto = np.zeros(6)
         self._jac_a, self._jac_b = np.zeros((3, model.nv)), np.zeros((3, model.nv))
 
-    def compute_qp_inequalities(self, configuration: mink.Configuration, dt: float) -> Constraint:
-        """One row per pair: ``G Δq <= h`` bounds how far one step may close the pair."""
-        del dt  # the bound is a distance per step
-        model, data = self.model, configuration.data
-        rows, bounds = np.zeros((len(self.pairs), model.nv)), np.full(len(self.pairs), np.inf)
+    def rows(
+        self, data: mujoco.MjData, dofs: npt.NDArray[np.intp]
+    ) -> tuple[FloatArray, FloatArray]:
+        """``G Δq <= h`` over the DOFs ``dofs``: one row per pair in reach, bounding how far
+        one step may close it (pairs farther apart add no row)."""
         centres = data.geom_xpos
         apart = np.linalg.norm(centres[self._a] - centres[self._b], axis=1) - self._spheres
+        rows: list[FloatArray] = []
+        bounds: list[float] = []
         for row in np.flatnonzero(apart < self.reach_m):  # bounding spheres within reach
             a, b = self.pairs[row]
             distance = self._distance(data, a, b)
@@ -68,26 +72,28 @@ class SelfCollisionLimit(mink.Limit):
             if distance >= self.reach_m or length <= _APART_M:
                 continue  # far, or no direction to keep them apart along
             normal = gap / length if distance >= 0.0 else -gap / length
-            rows[row] = -normal @ self._relative_jacobian(data, a, b)
-            bounds[row] = max(GAIN * (distance - self.margin_m), 0.0)
-        return Constraint(G=rows, h=bounds)
+            rows.append(-normal @ self._relative_jacobian(data, a, b)[:, dofs])
+            bounds.append(max(GAIN * (distance - self.margin_m), 0.0))
+        if not rows:
+            return np.zeros((0, len(dofs))), np.zeros(0)
+        return np.array(rows), np.array(bounds)
 
     def _distance(self, data: mujoco.MjData, a: int, b: int) -> float:
         """The pair's signed distance [m] (at most the reach), nearest points in
-        ``_fromto``. A 0 with nearest points apart is their separation; a 0 with none at all
-        is asked again over half the reach, down to the margin, and a shorter reach's
-        "farther than this" is the (lower) distance used; none of them: 0, in contact."""
-        reach, fromto = self.reach_m, self._fromto
-        while reach >= self.margin_m:
-            fromto[:] = 0.0
-            distance = mujoco.mj_geomDistance(self.model, data, a, b, reach, fromto)
-            if distance != 0.0:
-                return float(distance)
-            apart = float(np.linalg.norm(fromto[3:] - fromto[:3]))
-            if apart > _APART_M or fromto.any():
-                return apart  # nearest points found: their separation (0: touching)
-            reach /= 2.0
-        return 0.0
+        ``_fromto``. MuJoCo's native convex solver is asked first; its exact 0 is asked
+        again of libccd (MuJoCo's other solver), whose answer is used (see the module doc)."""
+        self._fromto[:] = 0.0
+        distance = mujoco.mj_geomDistance(self.model, data, a, b, self.reach_m, self._fromto)
+        if distance != 0.0:
+            return float(distance)
+        options = self.model.opt
+        native = options.disableflags
+        options.disableflags = native | mujoco.mjtDisableBit.mjDSBL_NATIVECCD
+        try:
+            self._fromto[:] = 0.0
+            return float(mujoco.mj_geomDistance(self.model, data, a, b, self.reach_m, self._fromto))
+        finally:
+            options.disableflags = native
 
     def _relative_jacobian(self, data: mujoco.MjData, a: int, b: int) -> np.ndarray:
         """How the nearest point of ``b`` moves relative to that of ``a`` per dq [m]."""
