@@ -51,7 +51,7 @@ def _closest_approach(strip: bool, shift_m: tuple[float, float, float] = (0.0, 0
 
 
 def test_the_hand_stops_at_the_margin_and_goes_through_without_the_pairs() -> None:
-    shifts = [(0.0, 0.0, 0.0), (0.0, -0.05, 0.0), (0.05, 0.0, 0.05), (-0.03, 0.03, -0.03)]
+    shifts = [(0, 0, 0), (0, -0.05, 0), (0.05, 0, 0.05), (-0.03, 0.03, -0.03), (0.03, 0.03, 0)]
     with_pairs = min(_closest_approach(strip=False, shift_m=shift) for shift in shifts)
     without = _closest_approach(strip=True)
     print(f"closest approach: {with_pairs:.4f} m with the pairs, {without:.4f} m without")

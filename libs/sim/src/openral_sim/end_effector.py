@@ -14,7 +14,8 @@ a mobile base, the scene's objects, stays where it is):
 
 - least squares on the frame task's error (gain 1: the whole error in one control period;
   on an arm of fewer than six joints, which cannot hold every pose, the orientation weighs
-  a tenth);
+  a tenth), damped in proportion to the squared error (Levenberg-Marquardt) so a far target
+  out of reach is approached without chatter;
 - as bounds on each joint's step: the manifest's position limits (the envelope of
   :class:`~openral_mujoco.command_limits.CommandLimits`, a step closing at most 95 % of
   what is left) and its velocity limit (80 % of it, over the control period);
@@ -42,8 +43,16 @@ from openral_mujoco.state import FloatArray
 
 from openral_sim.self_collision import collision_limit
 
+_HALVINGS = 5
+"""Halvings of a step that would bring the robot's own links too close (then it holds)."""
+_CLEARANCE_SLACK_M = 5e-4
+"""How far [m] a step may end below the clearance it starts at (or the margin)."""
 _DAMPING = 1e-6
-"""Levenberg-Marquardt damping of every IK step (on the arm's joints)."""
+"""Fixed damping of every IK step (on the arm's joints)."""
+_LM_DAMPING = 0.1
+"""Levenberg-Marquardt damping per squared weighted task error: a target far out of reach
+(1 m: 0.1) gets a damped step and the arm comes to rest at the edge instead of alternating
+between speed-capped steps either side of it; at a delta action's 1 cm it adds 1e-5."""
 _INACTIVE = -1e30
 """daqp's "no lower bound" on a constraint row."""
 _SPEED_SHARE = 0.8
@@ -151,13 +160,33 @@ class EndEffector:
         self.task.set_target(target_world.multiply(self._flange_inverse))
         error = self.task.compute_error(self.configuration)
         jacobian = self.task.compute_jacobian(self.configuration)[:, self._dofs]
-        step = self._solve(error, jacobian, commanded, dt)
+        step = self._keep_clear(data, commanded, self._solve(error, jacobian, commanded, dt))
         residual = error + jacobian @ step  # the task's residual after the step, to first order
         self.shortfall_m = float(
             np.linalg.norm(residual[:3])
             + np.linalg.norm(residual[3:]) * np.linalg.norm(self.offset)
         )
         return np.asarray(commanded + step, dtype=np.float64)  # one-DOF joints: q + Δq
+
+    def _keep_clear(
+        self, data: mujoco.MjData, commanded: FloatArray, step: FloatArray
+    ) -> FloatArray:
+        """``step``, halved while it would end the pairs closer than the margin and closer
+        than they start (the QP bounds them to first order only; a turning hand can close a
+        pair faster); no step at all if a sixteenth of it still would."""
+        limit = self._collisions
+        if limit is None or limit.clearance_m >= limit.reach_m:
+            return step  # no pair within reach: nothing to check
+        floor = min(limit.margin_m, limit.clearance_m) - _CLEARANCE_SLACK_M
+        for _ in range(_HALVINGS):
+            self._set(data, commanded + step)
+            if limit.clearance(self.configuration.data) >= floor:
+                break
+            step = step / 2.0
+        else:
+            step = np.zeros_like(step)
+        self._set(data, commanded)
+        return step
 
     def _solve(
         self, error: FloatArray, jacobian: FloatArray, commanded: FloatArray, dt: float
@@ -171,8 +200,10 @@ class EndEffector:
         cost = self.task.cost
         weighted = cost[:, None] * jacobian
         hessian = weighted.T @ weighted
-        hessian.flat[:: len(self._dofs) + 1] += _DAMPING
-        linear = (cost * (self.task.gain * error)) @ weighted
+        weighted_error = cost * (self.task.gain * error)
+        damping = _DAMPING + _LM_DAMPING * float(weighted_error @ weighted_error)
+        hessian.flat[:: len(self._dofs) + 1] += damping
+        linear = weighted_error @ weighted
         reach = self._speed * dt
         upper = np.minimum(np.maximum(self._high - commanded, 0.0) * _POSITION_GAIN, reach)
         lower = np.maximum(-np.maximum(commanded - self._low, 0.0) * _POSITION_GAIN, -reach)

@@ -54,19 +54,34 @@ class SelfCollisionLimit:
         self._spheres = model.geom_rbound[self._a] + model.geom_rbound[self._b]
         self._fromto = np.zeros(6)
         self._jac_a, self._jac_b = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+        self.clearance_m = self.reach_m
+        """The smallest distance [m] of the pairs when :meth:`rows` last looked (at most
+        the reach)."""
+
+    def _near(self, data: mujoco.MjData) -> npt.NDArray[np.intp]:
+        """The pairs whose bounding spheres are within reach."""
+        centres = data.geom_xpos
+        apart = np.linalg.norm(centres[self._a] - centres[self._b], axis=1) - self._spheres
+        return np.flatnonzero(apart < self.reach_m)
+
+    def clearance(self, data: mujoco.MjData) -> float:
+        """The smallest signed distance [m] between the pairs in ``data`` (at most the
+        reach)."""
+        distances = (self._distance(data, *self.pairs[row]) for row in self._near(data))
+        return min(distances, default=self.reach_m)
 
     def rows(
         self, data: mujoco.MjData, dofs: npt.NDArray[np.intp]
     ) -> tuple[FloatArray, FloatArray]:
         """``G Δq <= h`` over the DOFs ``dofs``: one row per pair in reach, bounding how far
         one step may close it (pairs farther apart add no row)."""
-        centres = data.geom_xpos
-        apart = np.linalg.norm(centres[self._a] - centres[self._b], axis=1) - self._spheres
         rows: list[FloatArray] = []
         bounds: list[float] = []
-        for row in np.flatnonzero(apart < self.reach_m):  # bounding spheres within reach
+        self.clearance_m = self.reach_m
+        for row in self._near(data):
             a, b = self.pairs[row]
             distance = self._distance(data, a, b)
+            self.clearance_m = min(self.clearance_m, distance)
             gap = self._fromto[3:] - self._fromto[:3]
             length = float(np.linalg.norm(gap))
             if distance >= self.reach_m or length <= _APART_M:
