@@ -109,6 +109,10 @@ bench-reload *ARGS:
 bench-trajectory *ARGS:
     python -m benchmarks.trajectory_tracking {{ARGS}}
 
+# CPU that `deploy sim --record` adds to deploy sim alone on the franka tabletop, and messages dropped; writes benchmarks/results/record_cost.json.
+bench-record *ARGS:
+    python -m benchmarks.record_cost {{ARGS}}
+
 # Re-resolve every dependency and write requirements.lock (names, versions, hashes; no addresses). uv.lock is uv's working file, not committed.
 lock:
     {{justfile_directory()}}/.tools/venv/bin/uv lock --quiet

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 from openral_core.errors import OpenralError
 
+from openral_cli.commands.recording import start_recording, stop_recording
 from openral_cli.console import out
 from openral_cli.help_text import command_group
 from openral_cli.ros_available import require_ros
@@ -78,34 +79,62 @@ def sim(
         int | None,
         typer.Option("--domain-id", min=0, max=232, help="ROS domain id (default: ROS_DOMAIN_ID)."),
     ] = None,
+    record: Annotated[
+        Path | None,
+        typer.Option(
+            "--record",
+            help="Record every topic into a rosbag2 bag (MCAP) in this new folder.",
+            show_default=False,
+        ),
+    ] = None,
+    overwrite: Annotated[
+        bool, typer.Option("--overwrite", help="Replace --record's folder if it holds a bag.")
+    ] = False,
 ) -> None:
     """Bring SCENE's robot up as a ROS 2 graph: joint states, cameras, actions, E-stop."""
     parameters = _node_parameters(config, manifest, not no_viewer, camera_rate, joint_state_rate)
     parameters["publish_tf"] = not no_tf
     require_ros()
-    from openral_nodes.runtime import ros_session, spin_until
+    from openral_nodes.runtime import ros_session
+
+    with ros_session(domain_id=domain_id) as context:
+        domain = context.get_domain_id()
+        recorder = None if record is None else start_recording(record, overwrite, domain)
+        try:
+            reason, elapsed_s = _run_graph(context, parameters, config, duration)
+        finally:
+            if recorder is not None:
+                stop_recording(recorder)
+    stopped = f"stopped ({reason}) after {elapsed_s:.1f} s; clean shutdown"
+    out.print(stopped, soft_wrap=False, highlight=True)
+
+
+def _run_graph(
+    context: Context, parameters: dict[str, Any], config: Path, duration: float | None
+) -> tuple[str, float]:
+    """Bring the node up, serve until a signal, ``duration`` or a shutdown transition, then
+    take it down; why it stopped and how long it ran [s]."""
+    from openral_nodes.runtime import spin_until
     from rclpy.executors import SingleThreadedExecutor
 
     stop = threading.Event()
-    with ros_session(domain_id=domain_id) as context:
-        node = _make_node(context, parameters, stop)
-        executor = SingleThreadedExecutor(context=context)
-        executor.add_node(node)
-        previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in STOP_SIGNALS}
-        started = time.monotonic()
-        try:
-            _transition(node, "configure")
-            _transition(node, "activate")
-            _print_interfaces(node, config)
-            spin_until(executor, stop, timeout_s=duration)
-        finally:
-            reason = _shut_down(node, stop)
-            executor.shutdown()
-            node.destroy_node()  # type: ignore[no-untyped-call]
-            for sig, handler in previous.items():
-                signal.signal(sig, handler)
-    stopped = f"stopped ({reason}) after {time.monotonic() - started:.1f} s; clean shutdown"
-    out.print(stopped, soft_wrap=False, highlight=True)
+    node = _make_node(context, parameters, stop)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in STOP_SIGNALS}
+    started = time.monotonic()
+    try:
+        _transition(node, "configure")
+        _transition(node, "activate")
+        _print_interfaces(node, config)
+        spin_until(executor, stop, timeout_s=duration)
+    finally:
+        reason = _shut_down(node, stop)
+        executor.shutdown()
+        node.destroy_node()  # type: ignore[no-untyped-call]
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    return reason, time.monotonic() - started
 
 
 def _node_parameters(
