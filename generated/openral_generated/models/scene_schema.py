@@ -444,3 +444,10 @@ class DeployScene(OpenralModel):
     """
     What success means in this scene: every predicate holds (AND). An episode ends on success or at its step limit.
     """
+    task: Annotated[
+        StrictStr | None,
+        Field(examples=["lift the red cube"], max_length=300, min_length=1),
+    ] = None
+    """
+    What the robot is asked to do in this scene, in words (the task text of a LeRobot dataset exported from its episodes, and of a language-conditioned policy). Left out: the scene's id.
+    """

@@ -40,6 +40,7 @@ from openral_sim.rollout import SceneRollout
 from openral_sim.sensor_schedule import sensor_rates
 
 from openral_eval.env_actions import ActionMode
+from openral_eval.episode_frames import EpisodeFrames, dataset_cameras
 from openral_eval.policies import make_policy
 from openral_eval.policy import Observation, PolicyAdapter, action_mode
 from openral_eval.privileged import Pose, Privileged, PrivilegedGripper
@@ -64,6 +65,9 @@ class EpisodeSpec:
     """Step limit (None: the scene's horizon, else :data:`DEFAULT_STEPS`)."""
     video: str | None = None
     """Write an MP4 of the scene's first camera here (None: no video)."""
+    dataset: str | None = None
+    """Keep every step (state, action, success, each VLA camera's frame) for a dataset in
+    this ``.npz`` (None: keep nothing; :mod:`openral_eval.episode_frames`)."""
 
     @property
     def key(self) -> tuple[str, int, str, tuple[tuple[str, str], ...]]:
@@ -167,7 +171,9 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> _Run:
     inputs = _Inputs(hal, robot, policy)
     camera = inputs.video_camera(spec.video)
     video = VideoWriter.for_camera(spec.video, camera, _frame_rate_hz(hal, robot, camera))
-    env = env_for(spec, inputs.sensors(camera), action_mode(policy))
+    keep = _kept(spec, robot, hal.env.camera_names)
+    sensors = tuple(sorted({*inputs.sensors(camera), *(keep.cameras.values() if keep else ())}))
+    env = env_for(spec, sensors, action_mode(policy))
     env.reset(seed=spec.seed)
     run, started = _Run(frames=len(hal.last_observation().images)), hal.read_state().sim_time_s
     try:
@@ -177,18 +183,30 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> _Run:
             digest.update(state.positions.tobytes())
             video.add(hal.last_observation())
             obs = inputs.observation(state.positions, run.steps, env.tcp_pose())
-            action = policy.act(obs)
-            _, _, terminated, truncated, info = env.step(env.clipped(action))
+            action = env.clipped(policy.act(obs))
+            seen = hal.read_images() if keep is not None else {}
+            _, _, terminated, truncated, info = env.step(action)
             run.steps += 1
             run.frames += len(hal.last_observation().images)
             run.success = bool(info["success"])
+            if keep is not None:
+                keep.add(state.positions, action, run.success, seen)
             done = terminated or truncated
         video.add(hal.last_observation())
+        if keep is not None:
+            keep.save()
     finally:
         video.close()
     digest.update(hal.read_state().positions.tobytes())
     run.sim_time_s = float(hal.read_state().sim_time_s or 0.0) - float(started or 0.0)
     return run
+
+
+def _kept(spec: EpisodeSpec, robot: LoadedRobot, rendered: tuple[str, ...]) -> EpisodeFrames | None:
+    """Where an episode of a ``--dataset`` sweep keeps its steps (None: it keeps none)."""
+    if spec.dataset is None:
+        return None
+    return EpisodeFrames(Path(spec.dataset), dataset_cameras(robot, rendered))
 
 
 def env_for(spec: EpisodeSpec, sensors: tuple[str, ...], mode: str) -> SceneEnv:

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 from openral_core.errors import OpenralError
 
+from openral_cli.commands.sweep_dataset import export, with_dataset
 from openral_cli.console import err, out, progress
 from openral_cli.help_text import PARAM_HELP
 
@@ -34,6 +35,14 @@ VIDEO_CHOICES = ("first", "failures", "all", "none")
 EPISODE_TIMEOUT_S = 600.0
 """Default wall-time limit of one episode (``--episode-timeout``) [s]."""
 MAX_EPISODES = 100_000
+DatasetFolder = Annotated[
+    Path | None,
+    typer.Option(
+        "--dataset",
+        help="Also write the episodes as a LeRobot v3.0 dataset in this new folder.",
+        show_default=False,
+    ),
+]
 
 
 def parse_seeds(text: str) -> list[int]:
@@ -130,6 +139,7 @@ def sweep(
         float,
         typer.Option("--episode-timeout", min=0.001, help="Wall-time limit of one episode [s]."),
     ] = EPISODE_TIMEOUT_S,
+    dataset: DatasetFolder = None,
 ) -> None:
     """Run POLICY on every (scene, seed) episode through the same HAL contract as deploy
     sim, in parallel; write ``episodes.jsonl`` and ``summary.json`` and print each scene's
@@ -146,11 +156,15 @@ def sweep(
     if ray not in (None, "local"):
         check_ray_address(ray)  # before the results file is touched
     plan = _plan(config, parse_seeds(seeds), policy, pairs, steps, video, out_dir)
+    if dataset is not None:
+        plan = with_dataset(plan, config, dataset, (out_dir, resume, ray))
     log = _open_log(out_dir / "episodes.jsonl", resume=resume)
     where = (workers or os.cpu_count() or 1, ray, episode_timeout)
     clock = SweepClock()
     _run_plan(plan, log, where, video, out_dir, clock)
     _report(log.sort(plan), policy, out_dir, clock)
+    if dataset is not None:
+        export(dataset, plan, out_dir)
 
 
 def _check_arguments(config: list[Path], out_dir: Path, video: str) -> None:

@@ -1,0 +1,61 @@
+"""``openral sim sweep --dataset DIR``: the plan's episodes keep their steps, and the sweep
+ends by writing them as one LeRobot v3.0 dataset (:mod:`openral_eval.dataset_export`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import typer
+
+from openral_cli.console import out
+
+if TYPE_CHECKING:
+    from openral_eval.episode import EpisodeSpec
+
+
+def with_dataset(
+    plan: list[EpisodeSpec],
+    config: list[Path],
+    dataset: Path,
+    run: tuple[Path, bool, str | None],
+) -> list[EpisodeSpec]:
+    """``plan`` with each episode keeping its steps for ``dataset`` (checked first: a local
+    sweep, one robot, a folder that is new or this sweep's own when resuming); ``run`` is
+    (``--out``, ``--resume``, ``--ray``)."""
+    from dataclasses import replace
+
+    from openral_core.loader import load_scene, scene_folder_robot
+    from openral_eval.dataset_export import STAGING, check_dataset_folder
+
+    out_dir, resume, ray = run
+    if ray not in (None, "local"):
+        message = "episodes on a Ray cluster keep their steps on its machines; run locally"
+        raise typer.BadParameter(message, param_hint="--dataset")
+    robots = sorted({load_scene(p).robot_id or scene_folder_robot(p) or "?" for p in config})
+    if len(robots) > 1:
+        raise typer.BadParameter(
+            f"a dataset holds one robot; these scenes have {', '.join(robots)}",
+            param_hint="--dataset",
+        )
+    check_dataset_folder(dataset, robots[0], resume)
+    staging = out_dir / STAGING
+    slug = {p: "_".join(Path(p).with_suffix("").parts[-3:]).replace(".", "") for p in config}
+    return [
+        replace(spec, dataset=str(staging / f"{slug[Path(spec.scene)]}_seed{spec.seed}.npz"))
+        for spec in plan
+    ]
+
+
+def export(dataset: Path, plan: list[EpisodeSpec], out_dir: Path) -> None:
+    """Write the dataset from the kept episodes and say what it holds."""
+    from openral_eval.dataset_export import STAGING, export_dataset
+
+    exported = export_dataset(dataset, plan, out_dir / STAGING)
+    summary = exported.summary
+    left = f"; {exported.left_out} episodes with an error left out" if exported.left_out else ""
+    out.print(
+        f"wrote {dataset} (LeRobot v3.0: {summary.episodes} episodes, {summary.frames} frames, "
+        f"{summary.tasks} tasks{left})",
+        markup=False,
+    )

@@ -1,0 +1,119 @@
+"""``openral sim sweep --dataset``: a sweep's episodes as a LeRobot v3.0 dataset, run as a
+user runs it. The dataset passes lerobot-doctor with no failure, holds one episode per seed
+with as many frames as the episode took steps, its actions are the env's (ee_delta_pose for
+scripted_lift), its videos decode; a folder that exists, or holds another robot's
+episodes, is refused in one line."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import av
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from tests.conftest import REPO
+
+OPENRAL = Path(sys.executable).parent / "openral"
+SCENE = REPO / "robots" / "franka_panda" / "scenes" / "tabletop.yaml"
+SEEDS = 3
+
+
+def _sweep(out: Path, dataset: Path, *extra: str) -> subprocess.CompletedProcess[str]:
+    command = [str(OPENRAL), "sim", "sweep", "--config", str(SCENE), "--seeds", f"0:{SEEDS}"]
+    command += ["--policy", "scripted_lift", "--video", "none", "--out", str(out)]
+    return subprocess.run(
+        [*command, "--dataset", str(dataset), *extra],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={**os.environ, "MUJOCO_GL": "egl"},
+    )
+
+
+@pytest.fixture(scope="module")
+def swept(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    root = tmp_path_factory.mktemp("sweep_dataset")
+    done = _sweep(root / "o", root / "o" / "ds")
+    assert done.returncode == 0, done.stderr
+    assert f"wrote {root / 'o' / 'ds'} (LeRobot v3.0: {SEEDS} episodes" in done.stdout
+    return root / "o", root / "o" / "ds"
+
+
+def test_the_dataset_passes_lerobot_doctor(swept: tuple[Path, Path]) -> None:
+    doctor = Path(sys.executable).parent / "lerobot-doctor"
+    run = subprocess.run(
+        [str(doctor), "check", str(swept[1]), "--ci", "--json"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert run.returncode == 0, run.stdout + run.stderr
+    report = json.loads(run.stdout)
+    assert (report["total_episodes"], report["fps"]) == (SEEDS, 20)
+    failures = [
+        f"{check['name']}: {message['message']}"
+        for check in report["checks"]
+        for message in check["messages"]
+        if message["severity"] == "FAIL"
+    ]
+    assert failures == [] and report["overall_severity"] != "FAIL"
+
+
+def test_one_episode_per_seed_with_a_frame_per_step(swept: tuple[Path, Path]) -> None:
+    out, dataset = swept
+    results = [json.loads(line) for line in (out / "episodes.jsonl").read_text().splitlines()]
+    info = json.loads((dataset / "meta" / "info.json").read_text())
+    assert info["robot_type"] == "franka_panda" and info["fps"] == 20
+    assert info["total_episodes"] == SEEDS
+    assert info["total_frames"] == sum(r["steps"] for r in results)
+    names = info["features"]["action"]["names"]
+    assert names == ["dx", "dy", "dz", "rx", "ry", "rz", "gripper"]  # the policy's mode
+    assert set(info["features"]) >= {"observation.images.camera1", "observation.images.camera2"}
+    data = pq.read_table(dataset / "data" / "chunk-000" / "file-000.parquet").to_pydict()
+    episodes = np.array(data["episode_index"])
+    for index, result in enumerate(results):
+        assert (episodes == index).sum() == result["steps"]
+        last = int(np.flatnonzero(episodes == index)[-1])
+        assert bool(data["next.success"][last]) == result["success"]
+    actions = np.array(data["action"])
+    assert np.all(np.abs(actions) <= 1.0) and np.abs(actions).max() > 0.1
+    tasks = pq.read_table(dataset / "meta" / "tasks.parquet").to_pylist()
+    assert [t["task"] for t in tasks] == ["lift the red cube"]
+    assert not (out / "dataset-episodes").exists()  # the staging is gone
+
+
+def test_each_camera_video_decodes_to_a_frame_per_step(swept: tuple[Path, Path]) -> None:
+    _, dataset = swept
+    info = json.loads((dataset / "meta" / "info.json").read_text())
+    for key in ("observation.images.camera1", "observation.images.camera2"):
+        video = dataset / "videos" / key / "chunk-000" / "file-000.mp4"
+        with av.open(str(video)) as container:
+            frames = [f.to_ndarray(format="rgb24") for f in container.decode(video=0)]
+        assert len(frames) == info["total_frames"]
+        assert frames[0].shape == (128, 128, 3) and frames[0].std() > 5.0
+
+
+def test_an_existing_or_foreign_dataset_folder_is_refused(
+    swept: tuple[Path, Path], tmp_path: Path
+) -> None:
+    _, dataset = swept
+    done = _sweep(tmp_path / "o2", dataset)
+    assert done.returncode == 1
+    assert done.stderr.strip().splitlines() == [
+        f"error: {dataset} exists; add --resume to finish that sweep and rebuild it, or "
+        "choose another --dataset"
+    ]
+    info = json.loads((dataset / "meta" / "info.json").read_text())
+    foreign = tmp_path / "so101_ds"
+    (foreign / "meta").mkdir(parents=True)
+    (foreign / "meta" / "info.json").write_text(json.dumps({**info, "robot_type": "so101"}))
+    done = _sweep(tmp_path / "o3", foreign, "--resume")
+    assert done.returncode == 1
+    assert "holds so101 episodes; this sweep's robot is franka_panda" in done.stderr
+    assert not (tmp_path / "o3" / "episodes.jsonl").exists()  # refused before any episode
