@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import json
 import subprocess
+import sys
 from pathlib import Path
+from typing import Any
 
 import imageio_ffmpeg
 import numpy as np
@@ -91,3 +93,36 @@ def _decode(path: Path) -> tuple[npt.NDArray[np.uint8], list[float] | None]:
         frames = list(container.decode(video=0))
         pictures = np.stack([frame.to_ndarray(format="rgb24") for frame in frames]).astype(np.uint8)
         return pictures, [float(frame.time) for frame in frames]
+
+
+DATA_COLUMNS = (
+    "observation.state",
+    "action",
+    "next.success",
+    "timestamp",
+    "frame_index",
+    "episode_index",
+    "index",
+    "task_index",
+)
+"""The data file's columns, in LeRobot's order."""
+
+
+def doctor(folder: Path) -> tuple[dict[str, Any], list[str]]:
+    """lerobot-doctor's JSON report on ``folder`` (it must exit 0) and its FAIL messages."""
+    executable = Path(sys.executable).parent / "lerobot-doctor"
+    run = subprocess.run(
+        [str(executable), "check", str(folder), "--ci", "--json"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert run.returncode == 0, run.stdout + run.stderr
+    report: dict[str, Any] = json.loads(run.stdout)
+    failures = [
+        f"{check['name']}: {message['message']}"
+        for check in report["checks"]
+        for message in check["messages"]
+        if message["severity"] == "FAIL"
+    ]
+    return report, failures

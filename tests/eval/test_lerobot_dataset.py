@@ -6,8 +6,6 @@ The three synthetic episodes (:mod:`tests.eval.lerobot_samples`) are written onc
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +20,7 @@ from openral_eval.lerobot_dataset import (
 )
 
 from tests.eval.lerobot_samples import (
+    DATA_COLUMNS,
     EPISODES,
     FPS,
     HEIGHT,
@@ -33,6 +32,7 @@ from tests.eval.lerobot_samples import (
     _episode_rows,
     _info,
     _video,
+    doctor,
 )
 
 
@@ -105,24 +105,10 @@ def test_info_json_describes_the_dataset(written: tuple[Path, DatasetSummary]) -
 
 
 def test_lerobot_doctor_finds_no_error(written: tuple[Path, DatasetSummary]) -> None:
-    doctor = Path(sys.executable).parent / "lerobot-doctor"
-    run = subprocess.run(
-        [str(doctor), "check", str(written[0]), "--ci", "--json"],
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert run.returncode == 0, run.stderr
-    report = json.loads(run.stdout)
+    report, failures = doctor(written[0])
     assert (report["codebase_version"], report["format_version"]) == ("v3.0", "v3")
     assert (report["total_episodes"], report["total_frames"], report["fps"]) == (3, 36, 10)
     assert report["overall_severity"] != "FAIL"
-    failures = [
-        f"{check['name']}: {message['message']}"
-        for check in report["checks"]
-        for message in check["messages"]
-        if message["severity"] == "FAIL"
-    ]
     assert failures == []
     severity = {check["name"]: check["severity"] for check in report["checks"]}
     for name in ("Metadata & Format Compliance", "Temporal Consistency", "Video Integrity"):
@@ -132,16 +118,7 @@ def test_lerobot_doctor_finds_no_error(written: tuple[Path, DatasetSummary]) -> 
 
 def test_the_frames_read_back_as_written(written: tuple[Path, DatasetSummary]) -> None:
     table = pq.read_table(written[0] / "data/chunk-000/file-000.parquet")
-    assert table.column_names == [
-        "observation.state",
-        "action",
-        "next.success",
-        "timestamp",
-        "frame_index",
-        "episode_index",
-        "index",
-        "task_index",
-    ]
+    assert tuple(table.column_names) == DATA_COLUMNS
     assert table.schema.field("observation.state").type == pa.list_(pa.float32(), 9)
     assert table.schema.field("action").type == pa.list_(pa.float32(), 8)
     states = np.array(table.column("observation.state").to_pylist(), dtype=np.float32)
@@ -222,18 +199,7 @@ def test_episode_stats_match_numpy(written: tuple[Path, DatasetSummary]) -> None
 
 def test_stats_json_matches_numpy_over_the_dataset(written: tuple[Path, DatasetSummary]) -> None:
     stats = json.loads((written[0] / "meta" / "stats.json").read_text())
-    assert set(stats) == {
-        "observation.state",
-        "action",
-        "next.success",
-        "timestamp",
-        "frame_index",
-        "episode_index",
-        "index",
-        "task_index",
-        "observation.images.front",
-        "observation.images.wrist",
-    }
+    assert set(stats) == {*DATA_COLUMNS, "observation.images.front", "observation.images.wrist"}
     for feature, values in (
         ("observation.state", [e.states.astype(np.float64) for e in EPISODES]),
         ("action", [e.actions.astype(np.float64) for e in EPISODES]),

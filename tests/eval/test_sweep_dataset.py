@@ -18,6 +18,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from tests.conftest import REPO
+from tests.eval.lerobot_samples import doctor
 
 OPENRAL = Path(sys.executable).parent / "openral"
 SCENE = REPO / "robots" / "franka_panda" / "scenes" / "tabletop.yaml"
@@ -46,22 +47,8 @@ def swept(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
 
 
 def test_the_dataset_passes_lerobot_doctor(swept: tuple[Path, Path]) -> None:
-    doctor = Path(sys.executable).parent / "lerobot-doctor"
-    run = subprocess.run(
-        [str(doctor), "check", str(swept[1]), "--ci", "--json"],
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert run.returncode == 0, run.stdout + run.stderr
-    report = json.loads(run.stdout)
+    report, failures = doctor(swept[1])
     assert (report["total_episodes"], report["fps"]) == (SEEDS, 20)
-    failures = [
-        f"{check['name']}: {message['message']}"
-        for check in report["checks"]
-        for message in check["messages"]
-        if message["severity"] == "FAIL"
-    ]
     assert failures == [] and report["overall_severity"] != "FAIL"
 
 
