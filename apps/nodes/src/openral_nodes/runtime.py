@@ -32,7 +32,8 @@ from typing import IO, Any, TypeVar
 import rclpy
 from openral_core.errors import OpenralError
 from rclpy.context import Context
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
+from rclpy.experimental.events_executor import EventsExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
@@ -114,9 +115,13 @@ class Spinner:
     :meth:`call`, which runs it on the executor thread.
     """
 
-    def __init__(self, context: Context) -> None:
+    def __init__(self, context: Context, *, events: bool = False) -> None:
+        """``events``: spin with rclpy's EventsExecutor (callbacks queued by the middleware
+        instead of a wait set rebuilt every turn: far less CPU for many fast topics)."""
         self.context = context
-        self.executor = SingleThreadedExecutor(context=context)
+        self.executor: Executor = (
+            EventsExecutor(context=context) if events else SingleThreadedExecutor(context=context)
+        )
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
 
@@ -206,7 +211,7 @@ class Spinner:
 
 
 def spin_until(
-    executor: SingleThreadedExecutor,
+    executor: Executor,
     stop: threading.Event,
     *,
     timeout_s: float | None = None,

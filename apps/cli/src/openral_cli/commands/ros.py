@@ -55,8 +55,9 @@ Timeout = Annotated[
 
 
 @contextmanager
-def _probe_node(domain_id: int | None) -> Iterator[Node]:
-    """A short-lived, spun node on its own rclpy context; Ctrl-C inside ends the command (0)."""
+def _probe_node(domain_id: int | None, *, events: bool = False) -> Iterator[Node]:
+    """A short-lived, spun node on its own rclpy context; Ctrl-C inside ends the command (0).
+    ``events``: spun by rclpy's EventsExecutor (see :class:`~openral_nodes.runtime.Spinner`)."""
     from openral_nodes.runtime import Spinner, ros_session
     from rclpy.node import Node
 
@@ -68,7 +69,7 @@ def _probe_node(domain_id: int | None) -> Iterator[Node]:
             start_parameter_services=False,
         )
         try:
-            with Spinner(context) as spinner:
+            with Spinner(context, events=events) as spinner:
                 spinner.add_node(node)
                 yield node
         finally:

@@ -92,7 +92,7 @@ def _record(
     try:
         writer = BagWriter(folder)
         try:
-            with _probe_node(domain_id) as node:
+            with _probe_node(domain_id, events=True) as node:
                 recorder = BagRecorder(node, writer, topics)
                 err.print(f"recording into {folder}; stop with Ctrl-C", highlight=False)
                 _wait(stop, writer, duration)
