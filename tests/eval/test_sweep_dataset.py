@@ -104,3 +104,56 @@ def test_an_existing_or_foreign_dataset_folder_is_refused(
     assert done.returncode == 1
     assert "holds so101 episodes; this sweep's robot is franka_panda" in done.stderr
     assert not (tmp_path / "o3" / "episodes.jsonl").exists()  # refused before any episode
+
+
+def test_replaying_an_episode_gives_the_sweeps_trajectory(swept: tuple[Path, Path]) -> None:
+    out, dataset = swept
+    results = [json.loads(line) for line in (out / "episodes.jsonl").read_text().splitlines()]
+    done = subprocess.run(
+        [str(OPENRAL), "sim", "replay", str(dataset), "--episode", "2"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "MUJOCO_GL": "egl"},
+    )
+    assert done.returncode == 0, done.stderr
+    steps = results[2]["steps"]
+    assert f"episode 2 ({SCENE}, seed 2): {steps} steps replayed; the trajectory matches" in (
+        done.stdout
+    )
+    assert results[2]["trajectory_sha256"][:12] in done.stdout
+
+
+def test_a_changed_action_no_longer_replays_the_sweep(
+    swept: tuple[Path, Path], tmp_path: Path
+) -> None:
+    import shutil
+
+    import pyarrow as pa
+
+    copy = tmp_path / "ds"
+    shutil.copytree(swept[1], copy)
+    path = copy / "data" / "chunk-000" / "file-000.parquet"
+    table = pq.read_table(path)
+    actions = table.column("action").to_pylist()
+    first = table.column("episode_index").to_pylist().index(1)
+    actions[first + 5][0] += 0.5  # episode 1, step 5, dx
+    column = pa.array(actions, type=table.schema.field("action").type)
+    pq.write_table(table.set_column(table.schema.get_field_index("action"), "action", column), path)
+    done = subprocess.run(
+        [str(OPENRAL), "sim", "replay", str(copy), "--episode", "1"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "MUJOCO_GL": "egl"},
+    )
+    assert done.returncode == 1
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "the trajectory differs from the sweep's" in lines[0], done.stderr
+    done = subprocess.run(
+        [str(OPENRAL), "sim", "replay", str(copy), "--episode", "9"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 1 and "holds episodes 0 to 2" in done.stderr

@@ -32,6 +32,7 @@ from openral_eval.lerobot_dataset import (
 )
 from openral_eval.policies import make_policy
 from openral_eval.policy import action_mode
+from openral_eval.replay import PROVENANCE
 
 STAGING = "dataset-episodes"
 """Folder under the sweep's ``--out`` where episodes keep their steps until the export."""
@@ -87,9 +88,12 @@ def layout_of(spec: EpisodeSpec) -> DatasetLayout:
     )
 
 
-def export_dataset(folder: Path, plan: Sequence[EpisodeSpec], staging: Path) -> Exported:
+def export_dataset(
+    folder: Path, plan: Sequence[EpisodeSpec], staging: Path, digests: dict[tuple[str, int], str]
+) -> Exported:
     """Write the kept episodes of ``plan`` as a LeRobot dataset at ``folder`` (replacing
-    one a resumed sweep wrote before), then remove ``staging``.
+    one a resumed sweep wrote before) with their origins in ``meta/openral.json``
+    (``digests``: each (scene, seed)'s trajectory digest), then remove ``staging``.
 
     Raises:
         OpenralError: No episode kept anything (every one errored), or the dataset writer
@@ -102,6 +106,7 @@ def export_dataset(folder: Path, plan: Sequence[EpisodeSpec], staging: Path) -> 
     if folder.exists():  # checked by check_dataset_folder: a resumed sweep's own dataset
         shutil.rmtree(folder)
     summary = write_dataset(folder, layout_of(kept[0]), _episodes(kept, tasks))
+    _write_provenance(folder, kept, digests)
     shutil.rmtree(staging, ignore_errors=True)
     return Exported(summary, len(plan) - len(kept))
 
@@ -116,3 +121,25 @@ def _task(scene: str) -> str:
     """The scene file's ``task`` text, else its scene id."""
     described = load_scene(Path(scene))
     return described.task or described.scene.id
+
+
+def _write_provenance(
+    folder: Path, kept: Sequence[EpisodeSpec], digests: dict[tuple[str, int], str]
+) -> None:
+    """``meta/openral.json``: per dataset episode, the scene, seed, policy, action mode and
+    the sweep's trajectory digest (what ``openral sim replay`` checks)."""
+    mode = action_mode(make_policy(kept[0].policy, dict(kept[0].params)))
+    episodes = [
+        {
+            "episode_index": index,
+            "scene": spec.scene,
+            "seed": spec.seed,
+            "policy": spec.policy,
+            "params": dict(spec.params),
+            "action_mode": mode,
+            "trajectory_sha256": digests.get((spec.scene, spec.seed), ""),
+        }
+        for index, spec in enumerate(kept)
+    ]
+    text = json.dumps({"format": 1, "episodes": episodes}, indent=1) + "\n"
+    (folder / PROVENANCE).write_text(text)

@@ -184,6 +184,8 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> _Run:
             video.add(hal.last_observation())
             obs = inputs.observation(state.positions, run.steps, env.tcp_pose())
             action = env.clipped(policy.act(obs))
+            if keep is not None:  # the dataset stores float32: apply exactly what it holds
+                action = action.astype(np.float32).astype(np.float64)
             seen = hal.read_images() if keep is not None else {}
             _, _, terminated, truncated, info = env.step(action)
             run.steps += 1

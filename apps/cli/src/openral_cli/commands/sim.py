@@ -28,6 +28,7 @@ import typer
 
 from openral_cli.commands.policies import policies
 from openral_cli.commands.sim_policy import run_policy
+from openral_cli.commands.sim_replay import replay
 from openral_cli.commands.sweep import sweep
 from openral_cli.console import out, progress
 from openral_cli.help_text import PARAM_HELP, command_group
@@ -38,6 +39,7 @@ if TYPE_CHECKING:
 app = command_group("Run simulated scenes, or sweep a policy over scenes and seeds.")
 app.command("sweep")(sweep)
 app.command("policies")(policies)
+app.command("replay")(replay)
 
 SWAY_RAD = 0.15
 """Amplitude of the demo motion around the start pose."""

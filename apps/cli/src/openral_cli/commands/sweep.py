@@ -162,9 +162,10 @@ def sweep(
     where = (workers or os.cpu_count() or 1, ray, episode_timeout)
     clock = SweepClock()
     _run_plan(plan, log, where, video, out_dir, clock)
-    _report(log.sort(plan), policy, out_dir, clock)
+    lines = log.sort(plan)
+    _report(lines, policy, out_dir, clock)
     if dataset is not None:
-        export(dataset, plan, out_dir)
+        export(dataset, plan, out_dir, lines)
 
 
 def _check_arguments(config: list[Path], out_dir: Path, video: str) -> None:

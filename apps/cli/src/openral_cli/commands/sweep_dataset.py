@@ -47,11 +47,15 @@ def with_dataset(
     ]
 
 
-def export(dataset: Path, plan: list[EpisodeSpec], out_dir: Path) -> None:
-    """Write the dataset from the kept episodes and say what it holds."""
+def export(
+    dataset: Path, plan: list[EpisodeSpec], out_dir: Path, lines: list[dict[str, object]]
+) -> None:
+    """Write the dataset from the kept episodes (``lines``: the sweep's results, for their
+    trajectory digests) and say what it holds."""
     from openral_eval.dataset_export import STAGING, export_dataset
 
-    exported = export_dataset(dataset, plan, out_dir / STAGING)
+    digests = {(str(r["scene"]), int(str(r["seed"]))): str(r["trajectory_sha256"]) for r in lines}
+    exported = export_dataset(dataset, plan, out_dir / STAGING, digests)
     summary = exported.summary
     left = f"; {exported.left_out} episodes with an error left out" if exported.left_out else ""
     out.print(
