@@ -157,3 +157,45 @@ def test_a_changed_action_no_longer_replays_the_sweep(
         timeout=300,
     )
     assert done.returncode == 1 and "holds episodes 0 to 2" in done.stderr
+
+
+def test_stored_actions_are_float32_inside_their_bounds() -> None:
+    from hypothesis import given
+    from hypothesis import strategies as st
+    from openral_eval.episode_frames import as_stored
+
+    low, high = np.array([-3.0718, -0.0698, -1.0]), np.array([-0.0698, 2.5, 1.0])
+
+    @given(st.lists(st.floats(0.0, 1.0), min_size=3, max_size=3), st.sampled_from([0, 1]))
+    def check(shares: list[float], edge: int) -> None:
+        action = low + np.array(shares) * (high - low)
+        action[0] = (low, high)[edge][0]  # a value on its bound, as a clamp leaves it
+        stored = as_stored(action, low, high)
+        assert np.all(stored >= low) and np.all(stored <= high)
+        assert np.array_equal(stored.astype(np.float32).astype(np.float64), stored)
+        assert np.all(np.abs(stored - action) <= 1e-6 * np.maximum(1.0, np.abs(action)))
+
+    check()
+
+
+def test_a_joint_mode_dataset_clamped_at_a_limit_replays(tmp_path: Path) -> None:
+    """``wave`` commands joint 4 at its upper limit (-0.0698 rad, clamped), which float32
+    rounds past the limit: the sweep stores a value inside it, and the replay matches."""
+    command = [str(OPENRAL), "sim", "sweep", "--config", str(SCENE), "--seeds", "0"]
+    command += ["--policy", "wave", "--steps", "15", "--video", "none", "--out", str(tmp_path)]
+    env = {**os.environ, "MUJOCO_GL": "egl"}
+    dataset = tmp_path / "ds"
+    done = subprocess.run(
+        [*command, "--dataset", str(dataset)], capture_output=True, text=True, env=env, timeout=300
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    result = json.loads((tmp_path / "episodes.jsonl").read_text())
+    assert result["error"] is None and result["steps"] == 15
+    done = subprocess.run(
+        [str(OPENRAL), "sim", "replay", str(dataset), "--episode", "0"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+    )
+    assert done.returncode == 0 and "the trajectory matches" in done.stdout, done.stderr

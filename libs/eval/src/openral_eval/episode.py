@@ -40,7 +40,7 @@ from openral_sim.rollout import SceneRollout
 from openral_sim.sensor_schedule import sensor_rates
 
 from openral_eval.env_actions import ActionMode
-from openral_eval.episode_frames import EpisodeFrames, dataset_cameras
+from openral_eval.episode_frames import EpisodeFrames, as_stored, dataset_cameras
 from openral_eval.policies import make_policy
 from openral_eval.policy import Observation, PolicyAdapter, action_mode
 from openral_eval.privileged import Pose, Privileged, PrivilegedGripper
@@ -185,7 +185,7 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> _Run:
             obs = inputs.observation(state.positions, run.steps, env.tcp_pose())
             action = env.clipped(policy.act(obs))
             if keep is not None:  # the dataset stores float32: apply exactly what it holds
-                action = action.astype(np.float32).astype(np.float64)
+                action = as_stored(action, env.box.low, env.box.high)
             seen = hal.read_images() if keep is not None else {}
             _, _, terminated, truncated, info = env.step(action)
             run.steps += 1

@@ -20,6 +20,21 @@ from openral_core.loaded import LoadedRobot
 from openral_eval.lerobot_dataset import DatasetEpisode
 
 
+def as_stored(
+    action: npt.NDArray[np.float64],
+    low: npt.NDArray[np.float64],
+    high: npt.NDArray[np.float64],
+) -> npt.NDArray[np.float64]:
+    """``action`` as the dataset stores it (float32), still inside [``low``, ``high``]: a
+    value that rounding pushed past its bound is moved one float32 step back inside (a
+    joint target clamped to its limit, -0.0698 rad, rounds to just above it)."""
+    stored = action.astype(np.float32)
+    up, down = stored > high, stored < low
+    stored[up] = np.nextafter(stored[up], np.float32(-np.inf))
+    stored[down] = np.nextafter(stored[down], np.float32(np.inf))
+    return stored.astype(np.float64)
+
+
 def dataset_cameras(robot: LoadedRobot, rendered: tuple[str, ...]) -> dict[str, str]:
     """The robot's VLA slots whose camera the scene renders: slot → camera (sensor) name."""
     return {s.slot: s.sensor for s in robot.tables.vla_slots if s.sensor in rendered}
