@@ -94,12 +94,6 @@ class BagRecorder:
         seen = self.subscriptions.keys() | self.writer.skipped.keys()
         return [t for t in self.topics if t not in seen]
 
-    def stop(self) -> None:
-        """Stop taking messages (the writer is closed by its owner)."""
-        self.node.destroy_timer(self._timer)
-        for subscription in self.subscriptions.values():
-            self.node.destroy_subscription(subscription)
-
 
 _RELIABILITY = {
     ReliabilityPolicy.RELIABLE: QosReliability.RELIABLE,

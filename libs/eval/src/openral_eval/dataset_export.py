@@ -73,11 +73,10 @@ def check_dataset_folder(folder: Path, robot: str, resume: bool) -> None:
         )
 
 
-def layout_of(spec: EpisodeSpec) -> DatasetLayout:
-    """The dataset's features for the sweep's first episode (every scene of a dataset has
-    the same robot and the policy one action mode)."""
+def layout_of(spec: EpisodeSpec, mode: str) -> DatasetLayout:
+    """The dataset's features for the sweep's first episode, whose policy acts in ``mode``
+    (every scene of a dataset has the same robot and the policy one action mode)."""
     hal, robot = scene_for(spec.scene)
-    mode = action_mode(make_policy(spec.policy, dict(spec.params)))
     env = env_for(spec, (), mode)
     return DatasetLayout(
         fps=1.0 / hal.control_period_s,
@@ -105,8 +104,9 @@ def export_dataset(
     tasks = {spec.scene: _task(spec.scene) for spec in kept}
     if folder.exists():  # checked by check_dataset_folder: a resumed sweep's own dataset
         shutil.rmtree(folder)
-    summary = write_dataset(folder, layout_of(kept[0]), _episodes(kept, tasks))
-    _write_provenance(folder, kept, digests)
+    mode = action_mode(make_policy(kept[0].policy, dict(kept[0].params)))
+    summary = write_dataset(folder, layout_of(kept[0], mode), _episodes(kept, tasks))
+    _write_provenance(folder, kept, mode, digests)
     shutil.rmtree(staging, ignore_errors=True)
     return Exported(summary, len(plan) - len(kept))
 
@@ -124,11 +124,10 @@ def _task(scene: str) -> str:
 
 
 def _write_provenance(
-    folder: Path, kept: Sequence[EpisodeSpec], digests: dict[tuple[str, int], str]
+    folder: Path, kept: Sequence[EpisodeSpec], mode: str, digests: dict[tuple[str, int], str]
 ) -> None:
-    """``meta/openral.json``: per dataset episode, the scene, seed, policy, action mode and
-    the sweep's trajectory digest (what ``openral sim replay`` checks)."""
-    mode = action_mode(make_policy(kept[0].policy, dict(kept[0].params)))
+    """``meta/openral.json``: per dataset episode, the scene, seed, policy, action ``mode``
+    and the sweep's trajectory digest (what ``openral sim replay`` checks)."""
     episodes = [
         {
             "episode_index": index,

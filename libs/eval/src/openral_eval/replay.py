@@ -20,6 +20,7 @@ import pyarrow.parquet as pq
 from openral_core.errors import OpenralError
 
 from openral_eval.env_actions import ActionMode
+from openral_eval.lerobot_dataset import DATA_PATH
 from openral_eval.scene_env import EnvConfig, SceneEnv
 
 PROVENANCE = Path("meta") / "openral.json"
@@ -71,7 +72,8 @@ def replay(dataset: Path, index: int) -> Replayed:
         raise OpenralError(f"--episode {index}: {dataset} holds episodes 0 to {len(episodes) - 1}")
     origin = episodes[index]
     data = pq.read_table(
-        dataset / "data" / "chunk-000" / "file-000.parquet", columns=["episode_index", "action"]
+        dataset / DATA_PATH.format(chunk_index=0, file_index=0),
+        columns=["episode_index", "action"],
     )
     mine = np.asarray(data.column("episode_index").to_numpy()) == index
     actions = np.asarray(data.column("action").to_pylist(), dtype=np.float32)[mine]

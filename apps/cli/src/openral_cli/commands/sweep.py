@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 from openral_core.errors import OpenralError
 
-from openral_cli.commands.sweep_dataset import export, with_dataset
+from openral_cli.commands.sweep_dataset import dataset_staging, export
 from openral_cli.console import err, out, progress
 from openral_cli.help_text import PARAM_HELP
 
@@ -155,9 +155,8 @@ def sweep(
         _build_scene(path)
     if ray not in (None, "local"):
         check_ray_address(ray)  # before the results file is touched
-    plan = _plan(config, parse_seeds(seeds), policy, pairs, steps, video, out_dir)
-    if dataset is not None:
-        plan = with_dataset(plan, config, dataset, (out_dir, resume, ray))
+    staging = None if dataset is None else dataset_staging(config, dataset, (out_dir, resume, ray))
+    plan = _plan(config, parse_seeds(seeds), policy, pairs, steps, (video, out_dir, staging))
     log = _open_log(out_dir / "episodes.jsonl", resume=resume)
     where = (workers or os.cpu_count() or 1, ray, episode_timeout)
     clock = SweepClock()
@@ -261,12 +260,14 @@ def _plan(
     policy: str,
     pairs: tuple[tuple[str, str], ...],
     steps: int | None,
-    video: str,
-    out_dir: Path,
+    files: tuple[str, Path, Path | None],
 ) -> list[EpisodeSpec]:
-    """Every episode, scene by scene, seed by seed (with its video path, if any)."""
+    """Every episode, scene by scene, seed by seed, with the files it writes: ``files`` is
+    (``--video``, ``--out``, the folder where episodes keep their steps for a dataset or
+    None); its video path, if it is filmed, and its dataset steps, if kept."""
     from openral_eval.episode import EpisodeSpec
 
+    video, out_dir, staging = files
     if len(config) * len(seeds) > MAX_EPISODES:
         raise typer.BadParameter(f"at most {MAX_EPISODES} episodes", param_hint="--seeds")
     plan = []
@@ -275,7 +276,8 @@ def _plan(
         for index, seed in enumerate(seeds):
             wanted = video in ("all", "failures") or (video == "first" and index == 0)
             movie = str(out_dir / "videos" / f"{slug}_seed{seed}.mp4") if wanted else None
-            plan.append(EpisodeSpec(str(path), seed, policy, pairs, steps, movie))
+            kept = None if staging is None else str(staging / f"{slug}_seed{seed}.npz")
+            plan.append(EpisodeSpec(str(path), seed, policy, pairs, steps, movie, kept))
     return plan
 
 

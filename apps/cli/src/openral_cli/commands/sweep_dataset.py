@@ -1,5 +1,6 @@
-"""``openral sim sweep --dataset DIR``: the plan's episodes keep their steps, and the sweep
-ends by writing them as one LeRobot v3.0 dataset (:mod:`openral_eval.dataset_export`)."""
+"""``openral sim sweep --dataset DIR``: checked before anything runs; the plan's episodes
+keep their steps, and the sweep ends by writing them as one LeRobot v3.0 dataset
+(:mod:`openral_eval.dataset_export`)."""
 
 from __future__ import annotations
 
@@ -14,17 +15,10 @@ if TYPE_CHECKING:
     from openral_eval.episode import EpisodeSpec
 
 
-def with_dataset(
-    plan: list[EpisodeSpec],
-    config: list[Path],
-    dataset: Path,
-    run: tuple[Path, bool, str | None],
-) -> list[EpisodeSpec]:
-    """``plan`` with each episode keeping its steps for ``dataset`` (checked first: a local
-    sweep, one robot, a folder that is new or this sweep's own when resuming); ``run`` is
-    (``--out``, ``--resume``, ``--ray``)."""
-    from dataclasses import replace
-
+def dataset_staging(config: list[Path], dataset: Path, run: tuple[Path, bool, str | None]) -> Path:
+    """Check ``--dataset`` (a local sweep, one robot, a folder that is new or this sweep's
+    own when resuming) and return the folder where episodes keep their steps until the
+    export; ``run`` is (``--out``, ``--resume``, ``--ray``)."""
     from openral_core.loader import load_scene, scene_folder_robot
     from openral_eval.dataset_export import STAGING, check_dataset_folder
 
@@ -39,12 +33,7 @@ def with_dataset(
             param_hint="--dataset",
         )
     check_dataset_folder(dataset, robots[0], resume)
-    staging = out_dir / STAGING
-    slug = {p: "_".join(Path(p).with_suffix("").parts[-3:]).replace(".", "") for p in config}
-    return [
-        replace(spec, dataset=str(staging / f"{slug[Path(spec.scene)]}_seed{spec.seed}.npz"))
-        for spec in plan
-    ]
+    return out_dir / STAGING
 
 
 def export(
