@@ -75,7 +75,7 @@ def _bad(client: Client) -> dict[str, tuple[object, str]]:
             "'panda_jiont4' is not a joint of this robot (did you mean panda_joint4?)",
         ),
         "repeated": (repeated, "panda_joint1 named more than once"),
-        "1e5 names": (names, "joint_names: panda_joint1 named more than once"),
+        "1e5 names": (names, "the trajectory names 100000 joints; the robot has 8"),
         "1e5 points": (points, "the trajectory has 100000 points; at most 10000"),
         "backwards": (backwards, "points[1].time_from_start (0.5 s) is not after points[0]'s"),
         "nanosec": (nanosec, "time_from_start.nanosec is 2000000000"),

@@ -50,6 +50,7 @@ from trajectory_msgs.msg import JointTrajectory
 from openral_nodes.safety_services import SafetyServices
 from openral_nodes.trajectory_action import TrajectoryAction
 from openral_nodes.trajectory_request import request_from_msg
+from openral_nodes.trajectory_wire import trajectory_from_wire
 
 if TYPE_CHECKING:
     from rclpy.node import Node
@@ -116,7 +117,7 @@ class CommandInterfaces:
             (
                 "subscription",
                 node.create_subscription(
-                    JointTrajectory, JOINT_TRAJECTORY, self._on_trajectory, 10
+                    JointTrajectory, JOINT_TRAJECTORY, self._on_trajectory, 10, raw=True
                 ),
             ),
         ]
@@ -171,7 +172,7 @@ class CommandInterfaces:
             return
         self.accepted += 1
 
-    def _on_trajectory(self, msg: Any) -> None:
+    def _on_trajectory(self, data: bytes) -> None:
         loop = self.loop
         try:
             follower = loop.follower if loop is not None else None
@@ -179,6 +180,7 @@ class CommandInterfaces:
                 raise PathRefused(self._why_no_trajectories())
             if self.hal.estopped:
                 raise PathRefused("the E-stop is latched")
+            msg = trajectory_from_wire(data, len(self.hal.action_names))
             request = request_from_msg(msg, TOPIC_SOURCE)
             with self.lock:
                 hold = np.asarray(self.hal.hold_action(), dtype=np.float64)
