@@ -106,11 +106,14 @@ def test_an_existing_or_foreign_dataset_folder_is_refused(
     assert not (tmp_path / "o3" / "episodes.jsonl").exists()  # refused before any episode
 
 
-def test_replaying_an_episode_gives_the_sweeps_trajectory(swept: tuple[Path, Path]) -> None:
+def test_replaying_an_episode_gives_the_sweeps_trajectory_and_its_video(
+    swept: tuple[Path, Path], tmp_path: Path
+) -> None:
     out, dataset = swept
     results = [json.loads(line) for line in (out / "episodes.jsonl").read_text().splitlines()]
+    video = tmp_path / "ep2.mp4"
     done = subprocess.run(
-        [str(OPENRAL), "sim", "replay", str(dataset), "--episode", "2"],
+        [str(OPENRAL), "sim", "replay", str(dataset), "--episode", "2", "--video", str(video)],
         capture_output=True,
         text=True,
         timeout=300,
@@ -122,6 +125,11 @@ def test_replaying_an_episode_gives_the_sweeps_trajectory(swept: tuple[Path, Pat
         done.stdout
     )
     assert results[2]["trajectory_sha256"][:12] in done.stdout
+    with av.open(str(video)) as container:
+        frames = [f.to_ndarray(format="rgb24") for f in container.decode(video=0)]
+    assert f"video: {video} ({len(frames)} frames)" in done.stdout
+    assert 0 < len(frames) <= steps + 1
+    assert all(frame.std() > 10 for frame in frames)  # pictures, not a blank stream
 
 
 def test_a_changed_action_no_longer_replays_the_sweep(

@@ -11,7 +11,7 @@ import os
 import subprocess
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -153,15 +153,18 @@ def outside_client(domain_id: int, target: str, name: str) -> Iterator[Lifecycle
 
 
 @contextmanager
-def deploy_sim(config: Path, domain_id: int, logs: Path) -> Iterator[subprocess.Popen[str]]:
-    """``openral deploy sim --config CONFIG --no-viewer`` in ``domain_id`` as a subprocess.
+def deploy_sim(
+    config: Path, domain_id: int, logs: Path, extra: Sequence[str] = ()
+) -> Iterator[subprocess.Popen[str]]:
+    """``openral deploy sim --config CONFIG --no-viewer [EXTRA…]`` in ``domain_id`` as a
+    subprocess.
 
     Its stdout and stderr go to ``logs/deploy.out`` and ``logs/deploy.err`` (files, not
     pipes, so a chatty process never blocks on a full pipe). Still alive on exit, it gets
     SIGTERM, then SIGKILL after :data:`STOP_WAIT_S`.
     """
     command = [str(OPENRAL), "deploy", "sim", "--config", str(config), "--no-viewer"]
-    command += ["--domain-id", str(domain_id)]
+    command += ["--domain-id", str(domain_id), *extra]
     with (logs / "deploy.out").open("w") as out, (logs / "deploy.err").open("w") as err:
         process = subprocess.Popen(command, stdout=out, stderr=err, text=True, env=DEPLOY_ENV)
         try:

@@ -7,7 +7,9 @@ Parameters (all read at configure):
   repository's manifest of the same id); a scene naming another robot is refused;
 - ``hal_mode`` (``sim`` | ``real``), ``sim_env_yaml`` (a deploy-scene file, ``""`` for none);
 - ``viewer_enabled`` (bool); ``joint_state_rate_hz`` (float) within :data:`RATE_RANGE_HZ`;
-  ``camera_publish_rate_hz`` (float) within it too, or 0 for each sensor's own ``rate_hz``.
+  ``camera_publish_rate_hz`` (float) within it too, or 0 for each sensor's own ``rate_hz``;
+  ``view_port`` (int): serve the browser view's page on it and its data on the next port
+  (0: no view).
 
 Transitions:
 
@@ -202,6 +204,7 @@ class ManifestLifecycleNode(LifecycleNode):
             odom_rate_hz=float(self._param("joint_state_rate_hz")),
             loop=self.loop,
             robot=self._loaded,
+            view_port=int(self._param("view_port")),
         )
         self.bridge.setup()
         if self.loop is not None:  # the pace is judged from here on, not over the start-up

@@ -21,6 +21,7 @@ PARAMETERS: dict[str, Any] = {
     "camera_publish_rate_hz": 0.0,
     "joint_state_rate_hz": 50.0,
     "publish_tf": True,
+    "view_port": 0,
 }
 """Every parameter and its default."""
 

@@ -9,7 +9,9 @@
   (:class:`~openral_bridge.base_bridge.BaseBridge`, at the joint-state rate);
 - for a robot with a tool centre point in a native scene, ``/openral/ee_target`` in and
   ``/openral/tcp_pose`` out (:class:`~openral_bridge.ee_bridge.EeBridge`, at the
-  joint-state rate).
+  joint-state rate);
+- with a ``view_port``, the browser view (:class:`~openral_bridge.view_bridge.ViewBridge`):
+  the scene's bodies, joints and camera frames in Rerun's web viewer.
 
 Every sensor's rate comes from one rule (:func:`~openral_sim.sensor_schedule.sensor_rates`):
 its manifest rate, the ``camera_rate_hz`` override applied to RGB, depth and lidar alike,
@@ -31,13 +33,20 @@ from openral_bridge.range_bridge import RangeBridge
 from openral_bridge.sim_sensor_bridge import SimSensorBridge
 from openral_bridge.state_sensor_bridge import StateSensorBridge
 from openral_bridge.topics import TopicInfo
+from openral_bridge.view_bridge import ViewBridge
 from openral_core.loaded import LoadedRobot
 from openral_hal.factory import can_tick
-from openral_hal.protocol import MobileBaseHal, RobotHal
+from openral_hal.protocol import MobileBaseHal, MujocoBacked, RobotHal
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_hal.tool_centre import ee_command
+from openral_hal.view_feed import ViewFeed
 from openral_sim.sensor_schedule import sensor_rates
-from openral_sim.sensor_sources import DepthSource, LidarSource, StateSensorSource
+from openral_sim.sensor_sources import (
+    CameraSource,
+    DepthSource,
+    LidarSource,
+    StateSensorSource,
+)
 
 if TYPE_CHECKING:
     from rclpy.node import Node
@@ -58,6 +67,7 @@ class SceneBridges:
         odom_rate_hz: float,
         loop: ControlLoop | None = None,
         robot: LoadedRobot | None = None,
+        view_port: int = 0,
     ) -> None:
         """Nothing is created until :meth:`setup` (see the bridges for the arguments)."""
         control_hz = 1.0 / hal.control_period_s if can_tick(hal) else None
@@ -85,9 +95,16 @@ class SceneBridges:
             served_elsewhere=served,
         )
         self.pacer = pacer
+        self.view_port = view_port
+        self.view: ViewBridge | None = None
+        self._view_args = (node, hal, lock)
 
     def setup(self) -> None:
         """Start every bridge; each publishes once now."""
+        self.view = _view_bridge(*self._view_args, self.view_port) if self.view_port else None
+        if self.view is not None:
+            self.sensors.on_frame = self.view.frame
+            self.view.start(self.pacer)
         self.sensors.setup()
         if self.range is not None:
             self.range.start(self.pacer)
@@ -109,6 +126,8 @@ class SceneBridges:
 
     def teardown(self) -> None:
         """Stop every bridge (idempotent)."""
+        if self.view is not None:
+            self.view.stop()
         if self.ee is not None:
             self.ee.stop()
         if self.base is not None:
@@ -145,3 +164,27 @@ def _ee_bridge(
     with lock:
         ee = ee_command(hal, robot)
     return EeBridge(node, hal, ee, loop, rate_hz, lock) if ee is not None else None
+
+
+def _view_bridge(node: Node, hal: RobotHal, lock: threading.Lock, port: int) -> ViewBridge | None:
+    """The browser view on ``port`` (its data on the next one), or None with the reason
+    logged: no MuJoCo model, rerun-sdk missing, a port taken. The robot runs either way."""
+    log = node.get_logger()  # type: ignore[no-untyped-call]
+    handles = hal.mujoco_handles() if isinstance(hal, MujocoBacked) else None
+    if handles is None:
+        log.error("view: the HAL has no MuJoCo model to draw; running without the view")
+        return None
+    try:
+        from openral_sim.browser_view import BrowserView, ViewPorts, ViewUnavailable
+    except ImportError:
+        log.error("view: rerun-sdk is missing (pip install 'openral[view]'); running without it")
+        return None
+    cameras = tuple(hal.camera_sensors()) if isinstance(hal, CameraSource) else ()
+    title = f"deploy sim · {hal.description.name}"
+    try:
+        with lock:
+            view = BrowserView(handles[0], title=title, cameras=cameras, ports=ViewPorts(port))
+    except ViewUnavailable as error:
+        log.error(f"view: {error}; running without the view")
+        return None
+    return ViewBridge(hal, ViewFeed(view, hal), lock)

@@ -8,7 +8,9 @@ can do:
   ``/openral/cameras/<name>/camera_info``, frame id from the manifest, at the rate
   :func:`~openral_sim.sensor_schedule.sensor_rates` gives it (one job per sensor on the
   node's :class:`~openral_bridge.pacer.Pacer`);
-- the MuJoCo passive viewer when enabled and a display exists (synced by a pacer job).
+- the MuJoCo passive viewer when enabled and a display exists (synced by a pacer job);
+- every published frame also to :attr:`SimSensorBridge.on_frame` when set (the browser
+  view).
 
 A HAL that is a :class:`~openral_sim.sensor_sources.CameraSource` (a native scene's, or
 any driver's) has a camera rendered only when its frame is due, off the control path: the
@@ -30,7 +32,7 @@ reported, not published.
 from __future__ import annotations
 
 import threading
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import partial
 from typing import TYPE_CHECKING, Any
@@ -129,6 +131,8 @@ class SimSensorBridge:
         self._frames: FrameRenderer[ImageArray] | None = None
         self._viewer: Any = None
         self._viewer_job: PacedJob | None = None
+        self.on_frame: Callable[[str, ImageArray, float], None] | None = None
+        """Called with (camera, frame, stamp [s]) after each frame is published."""
 
     # -- lifecycle -------------------------------------------------------------------------
 
@@ -289,6 +293,8 @@ class SimSensorBridge:
             camera.info_pub.publish(info_msg)
         with self._count_lock:
             camera.published += 1
+        if self.on_frame is not None:
+            self.on_frame(name, image, sim_time_s)
 
     def _camera_failed(self, error: BaseException) -> None:
         """Report a render thread that stopped, once, and publish no more frames (the

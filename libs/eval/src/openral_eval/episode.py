@@ -28,11 +28,13 @@ import atexit
 import hashlib
 import time
 import traceback
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_sim.observation import Observation as SceneObservation
@@ -128,13 +130,18 @@ def close_scenes() -> None:
         hal.disconnect()
 
 
-def run_episode(spec: EpisodeSpec) -> EpisodeResult:
-    """Run one episode (see the module doc); errors become the result's ``error``."""
+StepWatch = Callable[[npt.NDArray[np.float64] | None], None]
+"""Called after the reset (None) and after each step (its action): a browser view's feed."""
+
+
+def run_episode(spec: EpisodeSpec, watch: StepWatch | None = None) -> EpisodeResult:
+    """Run one episode (see the module doc); errors become the result's ``error``. A
+    ``watch`` sees every step, and every camera of the scene is rendered for it."""
     started = time.perf_counter()
     digest = hashlib.sha256()
     run, error = _Run(), None
     try:
-        run = _drive(spec, digest)
+        run = _drive(spec, digest, watch)
     except Exception as failure:  # the sweep goes on; the result says what happened
         frame = traceback.extract_tb(failure.__traceback__)[-1]
         error = f"{type(failure).__name__}: {failure} ({Path(frame.filename).name}:{frame.lineno})"
@@ -164,17 +171,20 @@ class _Run:
     frames: int = 0
 
 
-def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> _Run:
+def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None) -> _Run:
     """Steps, success, simulated time [s] and frames of one episode; may raise."""
     hal, robot = scene_for(spec.scene)
     policy = make_policy(spec.policy, dict(spec.params))
     inputs = _Inputs(hal, robot, policy)
     camera = inputs.video_camera(spec.video)
-    video = VideoWriter.for_camera(spec.video, camera, _frame_rate_hz(hal, robot, camera))
+    video = VideoWriter.for_camera(spec.video, camera, camera_rate_hz(hal, robot, camera))
     keep = _kept(spec, robot, hal.env.camera_names)
-    sensors = tuple(sorted({*inputs.sensors(camera), *(keep.cameras.values() if keep else ())}))
+    wanted = {*inputs.sensors(camera), *(keep.cameras.values() if keep else ())}
+    sensors = tuple(sorted(wanted | (set(hal.env.camera_names) if watch else set())))
     env = env_for(spec, sensors, action_mode(policy))
     env.reset(seed=spec.seed)
+    if watch is not None:
+        watch(None)
     run, started = _Run(frames=len(hal.last_observation().images)), hal.read_state().sim_time_s
     try:
         done = False
@@ -188,6 +198,8 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash) -> _Run:
                 action = as_stored(action, env.box.low, env.box.high)
             seen = hal.read_images() if keep is not None else {}
             _, _, terminated, truncated, info = env.step(action)
+            if watch is not None:
+                watch(action)
             run.steps += 1
             run.frames += len(hal.last_observation().images)
             run.success = bool(info["success"])
@@ -226,8 +238,9 @@ def env_for(spec: EpisodeSpec, sensors: tuple[str, ...], mode: str) -> SceneEnv:
     return _ENVS[key]
 
 
-def _frame_rate_hz(hal: SimAttachedHAL, robot: LoadedRobot, camera: str | None) -> float:
-    """The rate ``camera``'s frames come at in the scene's observations [Hz]."""
+def camera_rate_hz(hal: SimAttachedHAL, robot: LoadedRobot, camera: str | None) -> float:
+    """The rate ``camera``'s frames come at in the scene's observations [Hz] (1 without a
+    camera)."""
     if camera is None:
         return 1.0
     control_hz = 1.0 / hal.control_period_s

@@ -5,23 +5,29 @@ A sweep with ``--dataset`` stores, beside the LeRobot files, where each episode 
 :func:`replay` resets that scene with that seed and steps the env with the dataset's own
 ``action`` column, as a trainer reads it (the sweep applied those float32 values, so they
 are exact), hashing every joint position as the sweep's episode does. A matching digest
-means the dataset's actions reproduce the run joint for joint.
+means the dataset's actions reproduce the run joint for joint. ``video`` renders the
+replay's first camera to an MP4 and ``view`` (given the replay's HAL, it returns a browser
+view's feed) sees every step; both render the scene's cameras, which changes no joint.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
 from openral_core.errors import OpenralError
+from openral_hal.sim_attached import SimAttachedHAL
 
 from openral_eval.env_actions import ActionMode
+from openral_eval.episode import StepWatch, camera_rate_hz
 from openral_eval.lerobot_dataset import DATA_PATH
 from openral_eval.scene_env import EnvConfig, SceneEnv
+from openral_eval.video import VideoWriter
 
 PROVENANCE = Path("meta") / "openral.json"
 """Where a dataset says which scene, seed and policy each episode came from."""
@@ -36,6 +42,8 @@ class Replayed:
     steps: int
     digest: str
     expected: str
+    frames: int = 0
+    """Frames written to the video (0: no video)."""
 
     @property
     def matches(self) -> bool:
@@ -61,7 +69,13 @@ def provenance(dataset: Path) -> list[dict[str, object]]:
     return episodes
 
 
-def replay(dataset: Path, index: int) -> Replayed:
+def replay(
+    dataset: Path,
+    index: int,
+    *,
+    video: Path | None = None,
+    view: Callable[[SimAttachedHAL], StepWatch] | None = None,
+) -> Replayed:
     """Replay episode ``index`` of ``dataset`` (see the module doc).
 
     Raises:
@@ -79,22 +93,44 @@ def replay(dataset: Path, index: int) -> Replayed:
     actions = np.asarray(data.column("action").to_pylist(), dtype=np.float32)[mine]
     scene, seed = str(origin["scene"]), int(str(origin["seed"]))
     mode = ActionMode(str(origin["action_mode"]))
-    config = EnvConfig(scene, sensors=(), max_steps=len(actions) + 1, action_mode=mode)
+    sensors: bool | tuple[str, ...] = video is not None or view is not None or ()
+    config = EnvConfig(scene, sensors=sensors, max_steps=len(actions) + 1, action_mode=mode)
     env = SceneEnv(config)
+    camera = next(iter(env.hal.env.camera_names), None) if video is not None else None
+    fps = camera_rate_hz(env.hal, env.robot, camera)
+    writer = VideoWriter(video, camera, fps) if camera is not None else VideoWriter(None, None, 1)
     try:
-        digest = _digest(env, seed, actions)
+        watch = view(env.hal) if view is not None else None
+        digest = _digest(env, seed, actions, _Watchers(writer, watch))
     finally:
+        writer.close()
         env.close()
-    return Replayed(scene, seed, len(actions), digest, str(origin["trajectory_sha256"]))
+    expected = str(origin["trajectory_sha256"])
+    return Replayed(scene, seed, len(actions), digest, expected, writer.frames)
 
 
-def _digest(env: SceneEnv, seed: int, actions: np.ndarray) -> str:
+class _Watchers:
+    """The video and the view, after the reset and after each step."""
+
+    def __init__(self, video: VideoWriter, watch: StepWatch | None) -> None:
+        self.video, self.watch = video, watch
+
+    def __call__(self, env: SceneEnv, action: np.ndarray | None) -> None:
+        self.video.add(env.hal.last_observation())
+        if self.watch is not None:
+            self.watch(action)
+
+
+def _digest(env: SceneEnv, seed: int, actions: np.ndarray, watchers: _Watchers) -> str:
     """The trajectory digest of stepping ``actions`` from the reset of ``seed``: every
     joint position before each step, then the last (as a sweep's episode hashes them)."""
     digest = hashlib.sha256()
     env.reset(seed=seed)
+    watchers(env, None)
     for action in actions:
         digest.update(env.hal.read_state().positions.tobytes())
-        env.step(action.astype(np.float64))
+        applied = action.astype(np.float64)
+        env.step(applied)
+        watchers(env, applied)
     digest.update(env.hal.read_state().positions.tobytes())
     return digest.hexdigest()

@@ -77,10 +77,7 @@ class FrameSample:
 
     def relative(self, tree: FrameTree, which: IntArray) -> tuple[FloatArray, FloatArray]:
         """(positions, quaternions) of frames ``which`` in their parents' frames."""
-        parents = tree.parent_index[which]
-        inverse = _conjugate(self.quats[parents])
-        offset = self.positions[which] - self.positions[parents]
-        return _rotate(inverse, offset), _multiply(inverse, self.quats[which])
+        return in_parent_frames(self.positions, self.quats, which, tree.parent_index[which])
 
 
 class FrameTree:
@@ -262,6 +259,16 @@ def pose_in_frame(
     mujoco.mju_rotVecQuat(position, np.asarray(pose[0]) - frame[0], inverse)
     mujoco.mju_mulQuat(quat, inverse, np.asarray(pose[1]))
     return position, quat
+
+
+def in_parent_frames(
+    positions: FloatArray, quats: FloatArray, children: IntArray, parents: IntArray
+) -> tuple[FloatArray, FloatArray]:
+    """(positions [m], quaternions w, x, y, z) of the world poses in rows ``children`` of
+    ``positions``/``quats``, each in the frame of the same entry of ``parents``."""
+    inverse = _conjugate(quats[parents])
+    offset = positions[children] - positions[parents]
+    return _rotate(inverse, offset), _multiply(inverse, quats[children])
 
 
 # -- quaternions (w, x, y, z), one per row ---------------------------------------------------

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 from openral_core.errors import OpenralError
 
+from openral_cli.browser_view import DEFAULT_VIEW_PORT, View, ViewPort
 from openral_cli.commands.recording import start_recording, stop_recording
 from openral_cli.console import out
 from openral_cli.help_text import command_group
@@ -90,10 +91,13 @@ def sim(
     overwrite: Annotated[
         bool, typer.Option("--overwrite", help="Replace --record's folder if it holds a bag.")
     ] = False,
+    view: View = False,
+    view_port: ViewPort = DEFAULT_VIEW_PORT,
 ) -> None:
     """Bring SCENE's robot up as a ROS 2 graph: joint states, cameras, actions, E-stop."""
     parameters = _node_parameters(config, manifest, not no_viewer, camera_rate, joint_state_rate)
     parameters["publish_tf"] = not no_tf
+    parameters["view_port"] = view_port if view else 0
     require_ros()
     from openral_nodes.runtime import ros_session
 
@@ -253,6 +257,9 @@ def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
     out.print(f"E-stop:   {ESTOP}, {RELEASE_ESTOP} (std_srvs/srv/Trigger)", soft_wrap=False)
     if node.loop is not None:
         out.print(f"reset:    {RESET} (std_srvs/srv/Trigger)", soft_wrap=False)
+    view = node.bridge.view if node.bridge is not None else None
+    if view is not None:
+        out.print(f"view:     {view.feed.view.ports.url}", soft_wrap=True, markup=False)
     out.print(
         "running; stop with Ctrl-C. In a second terminal: openral ros topics", soft_wrap=False
     )

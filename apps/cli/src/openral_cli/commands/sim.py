@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from openral_cli.browser_view import DEFAULT_VIEW_PORT, View, ViewPort
 from openral_cli.commands.policies import policies
 from openral_cli.commands.sim_policy import run_policy
 from openral_cli.commands.sim_replay import replay
@@ -35,6 +36,7 @@ from openral_cli.help_text import PARAM_HELP, command_group
 
 if TYPE_CHECKING:
     from openral_hal.protocol import ObservingHal, RobotHal
+    from openral_hal.view_feed import ViewFeed
 
 app = command_group("Run simulated scenes, or sweep a policy over scenes and seeds.")
 app.command("sweep")(sweep)
@@ -85,6 +87,8 @@ def run(
     ] = None,
     params: Annotated[list[str] | None, typer.Option("--param", "-p", help=PARAM_HELP)] = None,
     seed: Annotated[int, typer.Option("--seed", help="The episode's seed (with --policy).")] = 0,
+    view: View = False,
+    view_port: ViewPort = DEFAULT_VIEW_PORT,
 ) -> None:
     """Run SCENE headless for N control steps; save every camera frame and joint state.
 
@@ -99,9 +103,10 @@ def run(
                 "--policy runs the scene's own robot, as a sweep does; drop --robot/--manifest",
                 param_hint="--policy",
             )
-        run_policy(config, policy, params or [], seed, steps, out_dir)
+        run_policy(config, policy, params or [], seed, steps, out_dir, view_port if view else None)
         return
-    _run_motion(config, steps or DEFAULT_STEPS, out_dir, (robot, manifest), motion)
+    who = (robot, manifest)
+    _run_motion(config, steps or DEFAULT_STEPS, out_dir, who, motion, view_port if view else None)
 
 
 def _run_motion(
@@ -110,14 +115,18 @@ def _run_motion(
     out_dir: Path | None,
     who: tuple[str | None, Path | None],
     motion: str,
+    view_port: int | None = None,
 ) -> None:
     """The ``--motion`` run: the scene's robot (or ``who``: a robot id, a manifest) swaying
-    or holding for ``steps`` steps, every frame and joint state recorded."""
+    or holding for ``steps`` steps, every frame and joint state recorded; with a
+    ``view_port``, drawn in the browser view, which stays up after the run."""
     from openral_core import open_robot
     from openral_core.loader import load_scene
     from openral_hal.factory import HalMode, build_hal
     from openral_sim.scene import build_scene, check_scene_robot, scene_robot
     from rich.table import Table
+
+    from openral_cli.browser_view import open_view, serve_until_interrupted
 
     robot, manifest = who
     if motion not in MOTIONS:
@@ -131,12 +140,15 @@ def _run_motion(
     every_step = partial(build_scene, frame_rate_hz=math.inf)  # a frame of each camera per step
     hal = build_hal(loaded, mode=HalMode.SIM, scene=scene, env_builder=every_step)
     hal.connect()
+    feed = None
     try:
+        if view_port is not None:
+            feed = open_view(hal, f"{scene.scene.id} · {loaded.name}", view_port)
         if out_dir:
             out_dir.mkdir(parents=True, exist_ok=True)
         with progress() as bar:
             task = bar.add_task(f"{scene.scene.id} · {loaded.name}", total=steps)
-            seen = _drive(hal, steps, motion, out_dir, lambda: bar.advance(task))
+            seen = _drive(hal, steps, motion, out_dir, lambda: bar.advance(task), feed)
     finally:
         hal.disconnect()
     if out_dir:
@@ -149,6 +161,8 @@ def _run_motion(
     backend = scene.scene.backend.value
     table.add_row(loaded.name, backend, str(steps), *sensors, str(out_dir or "-"))
     out.print(table, soft_wrap=False)  # centred title, as this command always printed it
+    if feed is not None:
+        serve_until_interrupted(feed)
 
 
 def _drive(
@@ -157,16 +171,21 @@ def _drive(
     motion: str,
     out_dir: Path | None,
     advance: Callable[[], None],
+    feed: ViewFeed | None = None,
 ) -> Recording:
     """Step a connected HAL from its hold action, recording joints (manifest names) and the
-    sensor frames of each step's observation (files in ``out_dir``)."""
+    sensor frames of each step's observation (files in ``out_dir``), each step shown in
+    the view when there is a ``feed``."""
     from openral_hal.protocol import ObservingHal
 
     hold = hal.hold_action()
     seen = Recording()
     for step in range(steps):
         phase = math.sin(2 * math.pi * step / max(steps, 20))
-        hal.send_action(hold + (SWAY_RAD * phase if motion == "sway" else 0.0))
+        action = hold + (SWAY_RAD * phase if motion == "sway" else 0.0)
+        hal.send_action(action)
+        if feed is not None:
+            feed(action)
         state = hal.read_state()
         positions = zip(state.names, state.positions.tolist(), strict=True)
         seen.records.append({"step": step, "time": state.sim_time_s, "positions": dict(positions)})

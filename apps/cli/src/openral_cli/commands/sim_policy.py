@@ -15,6 +15,7 @@ from pathlib import Path
 
 import typer
 
+from openral_cli.browser_view import open_view, serve_until_interrupted
 from openral_cli.commands.sweep import check_out_dir
 from openral_cli.console import out
 
@@ -26,9 +27,11 @@ def run_policy(
     seed: int,
     steps: int | None,
     out_dir: Path | None,
+    view_port: int | None = None,
 ) -> None:
-    """Run one episode and print what it did (exit 1 when it ended with an error)."""
-    from openral_eval.episode import EpisodeSpec, close_scenes, run_episode
+    """Run one episode and print what it did (exit 1 when it ended with an error); with a
+    ``view_port``, draw it in the browser view and keep that up afterwards."""
+    from openral_eval.episode import EpisodeSpec, close_scenes, run_episode, scene_for
     from openral_eval.policies import make_policy, parse_params
     from rich.table import Table
 
@@ -39,8 +42,13 @@ def run_policy(
     video = None if out_dir is None else str(out_dir / "episode.mp4")
     if out_dir is not None:
         out_dir.mkdir(parents=True, exist_ok=True)
+    feed = None
     try:
-        result = run_episode(EpisodeSpec(str(config), seed, policy, pairs, steps, video))
+        if view_port is not None:
+            feed = open_view(
+                scene_for(str(config))[0], f"{config} · {policy} · seed {seed}", view_port
+            )
+        result = run_episode(EpisodeSpec(str(config), seed, policy, pairs, steps, video), feed)
     finally:
         close_scenes()
     if out_dir is not None:
@@ -60,4 +68,7 @@ def run_policy(
     out.print(table, soft_wrap=False)
     if result.error is not None:
         out.print(f"the episode ended with an error: {result.error}", markup=False)
+    if feed is not None:
+        serve_until_interrupted(feed)
+    if result.error is not None:
         raise typer.Exit(1)

@@ -4,12 +4,23 @@ it against the sweep (:mod:`openral_eval.replay`)."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from openral_core.errors import OpenralError
 
+from openral_cli.browser_view import (
+    DEFAULT_VIEW_PORT,
+    View,
+    ViewPort,
+    open_view,
+    serve_until_interrupted,
+)
 from openral_cli.console import out
+
+if TYPE_CHECKING:
+    from openral_hal.protocol import RobotHal
+    from openral_hal.view_feed import ViewFeed
 
 
 def replay(
@@ -17,6 +28,12 @@ def replay(
         Path, typer.Argument(help="Dataset folder written by `sim sweep --dataset`.")
     ],
     episode: Annotated[int, typer.Option("--episode", min=0, help="Episode index to replay.")],
+    video: Annotated[
+        Path | None,
+        typer.Option("--video", help="Render the replay's first camera to this MP4 file."),
+    ] = None,
+    view: View = False,
+    view_port: ViewPort = DEFAULT_VIEW_PORT,
 ) -> None:
     """Replay EPISODE of DATASET: reset its scene with its seed, step the dataset's actions,
     and compare the joint trajectory's digest with the one the sweep recorded. Exits 1 when
@@ -24,11 +41,19 @@ def replay(
 
     Example:
 
-        openral sim replay o/ds --episode 3
+        openral sim replay o/ds --episode 3 --video o/ep3.mp4
     """
     from openral_eval.replay import replay as replay_episode
 
-    done = replay_episode(dataset, episode)
+    feeds: list[ViewFeed] = []
+
+    def open_feed(hal: RobotHal) -> ViewFeed:
+        feeds.append(open_view(hal, f"{dataset} · episode {episode}", view_port))
+        return feeds[-1]
+
+    done = replay_episode(dataset, episode, video=video, view=open_feed if view else None)
+    if video is not None:
+        out.print(f"video: {video} ({done.frames} frames)", markup=False)
     where = f"episode {episode} ({done.scene}, seed {done.seed}): {done.steps} steps replayed"
     if not done.matches:
         raise OpenralError(
@@ -37,3 +62,5 @@ def replay(
         )
     same = f"the trajectory matches the sweep's (digest {done.digest[:12]}…)"
     out.print(f"{where}; {same}", markup=False)
+    for feed in feeds:
+        serve_until_interrupted(feed)
