@@ -13,6 +13,7 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -101,16 +102,17 @@ def _free(port: int) -> bool:
     return True
 
 
-def photograph(url: str, out: Path) -> Looks:
-    """Screenshots of ``url`` every 3 s until one is drawn (or :data:`DRAW_WAIT_S`); the
-    last is at ``out``."""
+def photograph(url: str, out: Path, done: Callable[[Path], bool] | None = None) -> Looks:
+    """Screenshots of ``url`` every 3 s until one is drawn (``done``, else
+    :meth:`Looks.drawn`) or :data:`DRAW_WAIT_S` passed; the last is at ``out``."""
     deadline = time.monotonic() + DRAW_WAIT_S
     with open_page(url) as page:
         while True:
             time.sleep(3.0)
             page.screenshot(out)
             seen = looks(out)
-            if seen.drawn() or time.monotonic() > deadline:
+            finished = done(out) if done is not None else seen.drawn()
+            if finished or time.monotonic() > deadline:
                 return seen
 
 

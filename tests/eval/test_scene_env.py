@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 from openral_eval.episode import EpisodeSpec, close_scenes, run_episode
+from openral_eval.episode_frames import as_stored
 from openral_eval.policies import POLICIES, PolicyEntry
 from openral_eval.policy import Observation
 from openral_eval.scene_env import ENV_ID, SceneEnv, make_env
@@ -192,7 +193,8 @@ def test_a_sweep_episode_is_the_env_stepped_with_the_same_actions(
         obs, _ = env.reset(seed=4)
         digest = hashlib.sha256(obs["joint_positions"].tobytes())
         for action in _Recorder.actions:
-            obs, *_ = env.step(np.clip(action, env.box.low, env.box.high))
+            clipped = np.clip(action, env.box.low, env.box.high)
+            obs, *_ = env.step(as_stored(clipped, env.box.low, env.box.high))  # float32, as applied
             digest.update(obs["joint_positions"].tobytes())
     finally:
         env.close()

@@ -207,3 +207,51 @@ def test_a_joint_mode_dataset_clamped_at_a_limit_replays(tmp_path: Path) -> None
         timeout=300,
     )
     assert done.returncode == 0 and "the trajectory matches" in done.stdout, done.stderr
+
+
+def _export(results: Path, dataset: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [str(OPENRAL), "sim", "export", str(results), str(dataset)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={**os.environ, "MUJOCO_GL": "egl", "COLUMNS": "200"},
+    )
+
+
+def test_exporting_the_sweeps_results_writes_the_dataset_it_wrote(
+    swept: tuple[Path, Path], tmp_path: Path
+) -> None:
+    out, dataset = swept
+    done = _export(out, tmp_path / "again")
+    assert done.returncode == 0, done.stderr
+    assert f"{SEEDS} episodes rerun, each as the sweep ran it" in done.stdout
+    data = Path("data") / "chunk-000" / "file-000.parquet"
+    assert pq.read_table(tmp_path / "again" / data).equals(pq.read_table(dataset / data))
+    for meta in ("info.json", "openral.json"):
+        mine = json.loads((tmp_path / "again" / "meta" / meta).read_text())
+        assert mine == json.loads((dataset / "meta" / meta).read_text()), meta
+    assert not (out / ".export").exists()
+
+
+def test_an_export_that_does_not_rerun_as_recorded_writes_nothing(
+    swept: tuple[Path, Path], tmp_path: Path
+) -> None:
+    results = tmp_path / "o"
+    results.mkdir()
+    lines = (swept[0] / "episodes.jsonl").read_text().splitlines()
+    tampered = json.loads(lines[1]) | {"trajectory_sha256": "0" * 64}
+    lines[1] = json.dumps(tampered)
+    (results / "episodes.jsonl").write_text("\n".join(lines) + "\n")
+    done = _export(results, tmp_path / "ds")
+    assert done.returncode == 1
+    assert "seed 1 did not rerun as the sweep ran it (its trajectory differs" in done.stderr
+    assert not (tmp_path / "ds").exists() and not (results / ".export").exists()
+    missing = _export(tmp_path / "nowhere", tmp_path / "ds")
+    assert missing.returncode == 1
+    assert "nowhere/episodes.jsonl: No such file or directory; expected a sweep's results" in (
+        missing.stderr
+    )
+    (results / "episodes.jsonl").write_text('{"seed": 1}\n')
+    broken = _export(results, tmp_path / "ds")
+    assert broken.returncode == 1 and "episodes.jsonl:1: not a sweep's result line" in broken.stderr

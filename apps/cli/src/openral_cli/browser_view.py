@@ -17,8 +17,11 @@ from openral_core.errors import OpenralError
 from openral_cli.console import out
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from openral_hal.protocol import RobotHal
     from openral_hal.view_feed import ViewFeed
+    from openral_sim.browser_view import BrowserView
 
 View = Annotated[
     bool,
@@ -69,16 +72,59 @@ def open_view(hal: RobotHal, title: str, port: int) -> ViewFeed:
 
 def serve_until_interrupted(feed: ViewFeed) -> None:
     """Keep the finished run's view up until Ctrl-C (or SIGTERM), then close it."""
+    wait_for_stop(feed.view)
+
+
+def wait_for_stop(view: BrowserView) -> None:
+    """Serve ``view`` until Ctrl-C (or SIGTERM), then close it."""
     stop = threading.Event()
     handlers = {
         sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)
     }
     out.print(
-        f"serving the view at {feed.view.ports.url} until Ctrl-C", markup=False, soft_wrap=True
+        f"serving the view at {view.ports.url} until Ctrl-C", markup=False, soft_wrap=True
     )
     try:
         stop.wait()
     finally:
         for sig, handler in handlers.items():
             signal.signal(sig, handler)
-        feed.view.close()
+        view.close()
+
+
+def serve_bag_view(bag: Path, port: int) -> None:
+    """Draw a recorded bag in a new browser view and serve it until Ctrl-C.
+
+    Raises:
+        OpenralError: rerun-sdk or rosbags missing, a port taken, or a bag rosbags cannot
+            read.
+    """
+    try:
+        from openral_nodes.bag_view import show, survey
+        from openral_sim.browser_view import BrowserView, ViewPorts, ViewUnavailable
+    except ImportError as error:
+        raise OpenralError(
+            f"ros view needs rerun-sdk and rosbags ({error.name} is missing)"
+        ) from None
+    from rosbags.rosbag2 import ReaderError
+
+    try:
+        contents = survey(bag)
+        ports = ViewPorts(web=port)
+        view = BrowserView(
+            None, title=str(bag), cameras=tuple(contents.cameras.values()), ports=ports
+        )
+        out.print(f"view: {ports.url}", markup=False, soft_wrap=True)
+        show(bag, view, contents)
+    except ViewUnavailable as error:
+        raise OpenralError(f"--view-port: {error}") from None
+    except ReaderError as error:
+        raise OpenralError(f"{bag}: not a readable bag ({error})") from None
+    left = ", ".join(f"{topic} ({count})" for topic, count in sorted(contents.skipped.items()))
+    out.print(
+        f"drew {contents.frames} transforms, {contents.joint_states} joint states and "
+        f"{contents.images} images" + (f"; left out {left}" if left else ""),
+        markup=False,
+        soft_wrap=True,
+    )
+    wait_for_stop(view)

@@ -193,9 +193,9 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None) ->
             digest.update(state.positions.tobytes())
             video.add(hal.last_observation())
             obs = inputs.observation(state.positions, run.steps, env.tcp_pose())
-            action = env.clipped(policy.act(obs))
-            if keep is not None:  # the dataset stores float32: apply exactly what it holds
-                action = as_stored(action, env.box.low, env.box.high)
+            # float32, as a dataset stores it, in every episode: a sweep with --dataset, one
+            # without and `sim export`'s rerun of it apply the same values (same digest)
+            action = as_stored(env.clipped(policy.act(obs)), env.box.low, env.box.high)
             seen = hal.read_images() if keep is not None else {}
             _, _, terminated, truncated, info = env.step(action)
             if watch is not None:

@@ -26,8 +26,11 @@ import numpy.typing as npt
 import rerun as rr  # an optional extra (`openral[view]`): import this module only for a view
 import rerun.blueprint as rrb
 
-from openral_sim.view_geometry import BodyTree, Geom, GeomShape, body_tree, relative_poses
+from openral_sim.view_geometry import WORLD, BodyTree, Geom, GeomShape, body_tree, relative_poses
 from openral_sim.view_geometry import visible_geoms as _visible_geoms
+
+AXIS_LENGTH_M = 0.1
+"""Length of the axes drawn at a frame of :meth:`BrowserView.transform` [m]."""
 
 
 class ViewUnavailable(RuntimeError):
@@ -58,7 +61,7 @@ class BrowserView:
 
     def __init__(
         self,
-        model: mujoco.MjModel,
+        model: mujoco.MjModel | None,
         *,
         title: str,
         cameras: Sequence[str] = (),
@@ -68,7 +71,8 @@ class BrowserView:
         """Start serving and draw the model's geometry.
 
         Args:
-            model: The scene's model (the view keeps its body tree and geometry).
+            model: The scene's model (the view keeps its body tree and geometry); None
+                for a view without one (a recorded bag: frames by :meth:`transform`).
             title: Shown as the recording's name.
             cameras: Camera names whose images get a panel, in this order.
             ports: Where to listen (default :class:`ViewPorts`).
@@ -78,7 +82,9 @@ class BrowserView:
             ViewUnavailable: A port is taken.
         """
         self.ports = ports or ViewPorts()
-        self.tree = body_tree(model)
+        self.tree = (
+            body_tree(model) if model is not None else BodyTree((WORLD,), np.zeros(1, np.int32), ())
+        )
         self._period_s = 1.0 / max_rate_hz
         self._last_s = -np.inf
         self._posed_static = False
@@ -92,9 +98,9 @@ class BrowserView:
             rr.serve_web_viewer(web_port=self.ports.web, open_browser=False, connect_to=sink.uri)
         except Exception as error:  # Rerun raises plain errors for a port in use
             raise ViewUnavailable(f"the view cannot listen: {error}") from None
-        self.stream.send_blueprint(_layout(cameras, _eye(model)))
-        self.stream.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
-        for geom in _visible_geoms(model, self.tree):
+        self.stream.send_blueprint(_layout(cameras, _eye(model) if model is not None else None))
+        self.stream.log(WORLD, rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+        for geom in _visible_geoms(model, self.tree) if model is not None else ():
             self.stream.log(geom.path, *_archetypes(geom), static=True)
 
     def pose(self, data: mujoco.MjData, time_s: float) -> bool:
@@ -118,6 +124,21 @@ class BrowserView:
         for body, t, q in zip(bodies, translations, quaternions, strict=True):
             transform = rr.Transform3D(translation=t, quaternion=rr.Quaternion(xyzw=q))
             self.stream.log(self.tree.paths[body], transform, static=static)
+
+    def transform(
+        self,
+        path: str,
+        translation: Sequence[float],
+        quaternion_xyzw: Sequence[float],
+        time_s: float | None,
+    ) -> None:
+        """A frame's pose in its parent (the entity above ``path``), drawn as axes; at
+        ``time_s`` on the time line, or for good when it is None (a static transform)."""
+        if time_s is not None:
+            self.stream.set_time("sim_time", duration=time_s)
+        rotation = rr.Quaternion(xyzw=quaternion_xyzw)
+        placed = rr.Transform3D(translation=translation, quaternion=rotation)
+        self.stream.log(path, placed, rr.TransformAxes3D(AXIS_LENGTH_M), static=time_s is None)
 
     def plot(self, group: str, values: Mapping[str, float], time_s: float) -> None:
         """One point per name on the plot ``group`` (``joints``, ``action``)."""
@@ -170,7 +191,7 @@ def _eye(model: mujoco.MjModel) -> rrb.EyeControls3D:
     return rrb.EyeControls3D(position=position, look_target=centre, eye_up=[0.0, 0.0, 1.0])
 
 
-def _layout(cameras: Sequence[str], eye: rrb.EyeControls3D) -> rrb.Blueprint:
+def _layout(cameras: Sequence[str], eye: rrb.EyeControls3D | None) -> rrb.Blueprint:
     """The 3-D scene on the left; camera panels and the plots on the right."""
     panels = [rrb.Spatial2DView(origin=f"cameras/{c}", name=c) for c in cameras]
     plots = [rrb.TimeSeriesView(origin=g, name=g) for g in ("joints", "action")]

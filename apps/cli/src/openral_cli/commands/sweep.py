@@ -190,7 +190,7 @@ def _run_plan(
     done = log.done()
     todo = [spec for spec in plan if spec.key not in done]
     try:
-        _run(todo, (len(plan) - len(todo), len(plan)), where, log, video, out_dir, clock)
+        run_episodes(todo, (len(plan) - len(todo), len(plan)), where, log, video, out_dir, clock)
     except KeyboardInterrupt:
         err.print(
             f"interrupted: {len(log.done())} of {len(plan)} episodes are in {log.path}; the "
@@ -272,16 +272,26 @@ def _plan(
         raise typer.BadParameter(f"at most {MAX_EPISODES} episodes", param_hint="--seeds")
     plan = []
     for path in config:
-        slug = "_".join(Path(path).with_suffix("").parts[-3:]).replace(".", "")
         for index, seed in enumerate(seeds):
             wanted = video in ("all", "failures") or (video == "first" and index == 0)
-            movie = str(out_dir / "videos" / f"{slug}_seed{seed}.mp4") if wanted else None
-            kept = None if staging is None else str(staging / f"{slug}_seed{seed}.npz")
+            movie = str(out_dir / "videos" / f"{episode_slug(path, seed)}.mp4") if wanted else None
+            kept = None if staging is None else kept_steps(staging, path, seed)
             plan.append(EpisodeSpec(str(path), seed, policy, pairs, steps, movie, kept))
     return plan
 
 
-def _run(
+def episode_slug(scene: Path | str, seed: int) -> str:
+    """An episode's file name stem: the scene path's last three parts, then the seed."""
+    slug = "_".join(Path(scene).with_suffix("").parts[-3:]).replace(".", "")
+    return f"{slug}_seed{seed}"
+
+
+def kept_steps(staging: Path, scene: Path | str, seed: int) -> str:
+    """Where an episode of a dataset sweep keeps its steps until the export."""
+    return str(staging / f"{episode_slug(scene, seed)}.npz")
+
+
+def run_episodes(
     todo: list[EpisodeSpec],
     counts: tuple[int, int],
     where: tuple[int, str | None, float],
