@@ -58,6 +58,10 @@ docs-serve:
 docs-images *IDS:
     python -m openral_codegen images {{IDS}}
 
+# Retake docs/images/browser-view.png: `sim run --view` photographed in headless Chromium.
+docs-view-image:
+    python -m tests.docs.view_screenshot docs/images/browser-view.png
+
 # Fuzz manifests and scenes through load, robot check and the HAL: N cases, counts by outcome, reproducers in fuzz-findings/.
 fuzz N *ARGS:
     python -m tests.fuzz.campaign {{N}} {{ARGS}}

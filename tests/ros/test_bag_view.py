@@ -68,6 +68,8 @@ def write_bag(folder: Path) -> None:
             "/openral/cameras/wrist/image": "sensor_msgs/msg/Image",
             "/side/image_raw": "sensor_msgs/msg/Image",
             "/chatter": "std_msgs/msg/String",
+            "/openral/cameras/wrist/depth": "sensor_msgs/msg/Image",
+            "/odd/image": "sensor_msgs/msg/Image",
         }
         conn = {t: writer.add_connection(t, k, typestore=TYPES) for t, k in kinds.items()}
 
@@ -87,6 +89,14 @@ def write_bag(folder: Path) -> None:
             put("/openral/cameras/wrist/image", s, _image(s, "rgb8", 255))
             put("/side/image_raw", s, _image(s, "bgr8", 255))
             put("/chatter", s, T["std_msgs/msg/String"](data="hi"))
+        depth = np.full((48, 64), 1.25, dtype="<f4")
+        put("/openral/cameras/wrist/depth", 0.5, T["sensor_msgs/msg/Image"](
+            header=_header(0.5, "cam"), height=48, width=64, encoding="32FC1",
+            is_bigendian=0, step=64 * 4, data=depth.view(np.uint8).reshape(-1),
+        ))  # fmt: skip
+        odd = _image(0.5, "rgb8", 0)
+        odd.encoding = "yuv422"
+        put("/odd/image", 0.5, odd)
 
 
 class RecordingView:
@@ -96,6 +106,7 @@ class RecordingView:
         self.transforms: list[tuple[str, tuple[float, ...], float | None]] = []
         self.plots: list[tuple[str, dict[str, float], float]] = []
         self.images: list[tuple[str, np.ndarray, float]] = []
+        self.depths: list[tuple[str, np.ndarray, float]] = []
 
     def transform(self, path: str, translation: Any, quaternion: Any, time_s: float | None) -> None:
         self.transforms.append((path, tuple(translation), time_s))
@@ -105,6 +116,9 @@ class RecordingView:
 
     def image(self, camera: str, rgb: np.ndarray, time_s: float) -> None:
         self.images.append((camera, rgb, time_s))
+
+    def depth(self, camera: str, depth_m: np.ndarray, time_s: float) -> None:
+        self.depths.append((camera, depth_m, time_s))
 
 
 @pytest.fixture(scope="module")
@@ -119,6 +133,8 @@ def test_every_message_lands_where_the_view_draws_it(bag: Path) -> None:
     assert contents.cameras == {
         "/openral/cameras/wrist/image": "wrist",
         "/side/image_raw": "side_image_raw",
+        "/openral/cameras/wrist/depth": "wrist",
+        "/odd/image": "odd_image",
     }
     assert contents.skipped == {"/chatter": 10}
     view = RecordingView()
@@ -129,7 +145,7 @@ def test_every_message_lands_where_the_view_draws_it(bag: Path) -> None:
     assert [round(t[1][0], 9) for t in moving] == [round(0.1 * k, 9) for k in range(10)]
     assert [round(t[2], 9) for t in moving] == [round(0.1 * (k + 1), 9) for k in range(10)]
     assert view.plots[3] == (
-        "joints",
+        "joints/joint_states",
         {"j1": pytest.approx(0.4), "j2": pytest.approx(-0.4)},
         pytest.approx(0.4),
     )
@@ -138,7 +154,11 @@ def test_every_message_lands_where_the_view_draws_it(bag: Path) -> None:
     assert len(wrist) == len(side) == 10
     assert wrist[0][1].shape == (48, 64, 3) and (wrist[0][1][..., 0] == 255).all()
     assert (side[0][1][..., 2] == 255).all() and (side[0][1][..., 0] == 0).all()  # bgr8 → RGB
-    assert (contents.frames, contents.joint_states, contents.images) == (11, 10, 20)
+    [(camera, depth, stamp)] = view.depths
+    assert camera == "wrist" and stamp == 0.5 and depth.shape == (48, 64)
+    assert np.allclose(depth, 1.25)
+    assert contents.skipped == {"/chatter": 10, "/odd/image": 1}  # an encoding not drawn
+    assert (contents.frames, contents.joint_states, contents.images) == (11, 10, 21)
 
 
 def _red_camera(png: Path) -> bool:
@@ -172,8 +192,9 @@ def test_ros_view_serves_the_bag_to_a_browser(bag: Path, tmp_path: Path) -> None
         lines.append(line)
         if line.startswith("serving the view"):
             break
-    assert "drew 11 transforms, 10 joint states and 20 images; left out /chatter (10)" in "".join(
-        lines
+    assert (
+        "drew 11 transforms, 10 joint states and 21 images; left out /chatter (10), /odd/image (1)"
+        in "".join(lines)
     )
     try:
         url = f"http://127.0.0.1:{port}/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A{port + 1}%2Fproxy"

@@ -81,9 +81,7 @@ def wait_for_stop(view: BrowserView) -> None:
     handlers = {
         sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)
     }
-    out.print(
-        f"serving the view at {view.ports.url} until Ctrl-C", markup=False, soft_wrap=True
-    )
+    out.print(f"serving the view at {view.ports.url} until Ctrl-C", markup=False, soft_wrap=True)
     try:
         stop.wait()
     finally:
@@ -112,7 +110,10 @@ def serve_bag_view(bag: Path, port: int) -> None:
         contents = survey(bag)
         ports = ViewPorts(web=port)
         view = BrowserView(
-            None, title=str(bag), cameras=tuple(contents.cameras.values()), ports=ports
+            None,
+            title=str(bag),
+            cameras=tuple(dict.fromkeys(contents.cameras.values())),
+            ports=ports,
         )
         out.print(f"view: {ports.url}", markup=False, soft_wrap=True)
         show(bag, view, contents)

@@ -4,9 +4,12 @@ A bag holds messages, not a model, so the view draws what the messages say:
 
 - every frame of ``/tf_static`` and ``/tf`` as axes, along the tree the transforms form
   (``world/<root>/…/<child>``), static ones once and the others at their stamps;
-- each ``sensor_msgs/JointState`` topic's positions on the ``joints`` plot;
+- each ``sensor_msgs/JointState`` topic's positions on the ``joints`` plot, under the
+  topic's name (``/joint_states`` and ``/openral/manifest_joint_states`` differ in units);
 - each ``sensor_msgs/Image`` topic in rgb8, bgr8 or mono8 in a panel named after its
-  camera (``/openral/cameras/<name>/image`` → ``<name>``), at its stamps.
+  camera (``/openral/cameras/<name>/image`` → ``<name>``), and depth images (32FC1 in
+  metres, 16UC1 in millimetres, ``/openral/cameras/<name>/depth``) in that camera's panel,
+  at their stamps.
 
 Times are the messages' header stamps (simulated time for a deploy-sim recording). Other
 topics are counted and left out. Reading is one pass per kind over the bag with rosbags;
@@ -32,7 +35,9 @@ TF_TYPE = "tf2_msgs/msg/TFMessage"
 JOINTS_TYPE = "sensor_msgs/msg/JointState"
 IMAGE_TYPE = "sensor_msgs/msg/Image"
 CHANNELS = {"rgb8": 3, "bgr8": 3, "mono8": 1}
-"""Image encodings drawn, by channel count."""
+"""Colour image encodings drawn, by channel count."""
+DEPTH = {"32FC1": ("<f4", 1.0), "16UC1": ("<u2", 1e-3)}
+"""Depth image encodings drawn: (dtype, metres per unit)."""
 
 
 @dataclass
@@ -54,7 +59,7 @@ def survey(bag: Path) -> BagContents:
     with Reader(bag) as reader:
         for connection in reader.connections:
             if connection.msgtype == IMAGE_TYPE:
-                match = re.fullmatch(r"/openral/cameras/([^/]+)/image", connection.topic)
+                match = re.fullmatch(r"/openral/cameras/([^/]+)/(image|depth)", connection.topic)
                 name = match.group(1) if match else connection.topic.strip("/").replace("/", "_")
                 contents.cameras[connection.topic] = name
             elif connection.msgtype not in (TF_TYPE, JOINTS_TYPE):
@@ -73,11 +78,26 @@ def show(bag: Path, view: BrowserView, contents: BagContents) -> None:
                 contents.frames += _send_transform(view, paths, transform, topic == "/tf_static")
         elif msgtype == JOINTS_TYPE:
             positions = dict(zip(msg.name, np.asarray(msg.position).tolist(), strict=False))
-            view.plot("joints", positions, _stamp_s(msg.header.stamp))
+            group = f"joints/{topic.strip('/').replace('/', '_')}"  # one line per topic
+            view.plot(group, positions, _stamp_s(msg.header.stamp))
             contents.joint_states += 1
-        elif msgtype == IMAGE_TYPE and msg.encoding in CHANNELS:
-            view.image(contents.cameras[topic], _pixels(msg), _stamp_s(msg.header.stamp))
-            contents.images += 1
+        elif msgtype == IMAGE_TYPE:
+            _send_image(view, contents, topic, msg)
+
+
+def _send_image(view: BrowserView, contents: BagContents, topic: str, msg: Any) -> None:
+    camera, time_s = contents.cameras[topic], _stamp_s(msg.header.stamp)
+    if msg.encoding in CHANNELS:
+        view.image(camera, _pixels(msg), time_s)
+    elif msg.encoding in DEPTH:
+        dtype, scale = DEPTH[msg.encoding]
+        rows = np.frombuffer(bytes(msg.data), dtype=np.uint8).reshape(msg.height, msg.step)
+        values = rows[:, : msg.width * np.dtype(dtype).itemsize].copy().view(dtype)
+        view.depth(camera, values.astype(np.float32) * scale, time_s)
+    else:
+        contents.skipped[topic] = contents.skipped.get(topic, 0) + 1
+        return
+    contents.images += 1
 
 
 def _messages(bag: Path) -> Iterator[tuple[str, str, Any]]:
