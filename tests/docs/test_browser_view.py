@@ -63,3 +63,35 @@ def test_a_taken_port_is_one_line_and_exit_1() -> None:
     assert len(lines) == 1 and "--view: the view cannot listen on 127.0.0.1:" in lines[0], (
         done.stderr
     )
+
+
+def test_a_policy_episode_is_viewed_and_served_until_ctrl_c() -> None:
+    port = free_port_pair()
+    run = [sys.executable, "-m", "openral_cli.main", "sim", "run", "--config", SCENE]
+    command = [
+        *run,
+        "--policy",
+        "scripted_lift",
+        "--steps",
+        "12",
+        "--view",
+        "--view-port",
+        str(port),
+    ]
+    env = {**os.environ, "COLUMNS": "200", "MUJOCO_GL": "egl"}
+    process = subprocess.Popen(
+        command, cwd=REPO, env=env, text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE
+    )
+    assert process.stdout is not None
+    printed = []
+    for line in process.stdout:
+        printed.append(line)
+        if line.startswith("serving the view"):
+            break
+    try:
+        text = "".join(printed)
+        assert f"view: http://127.0.0.1:{port}/" in text and "scripted_lift" in text, text
+        assert listening(port + 1) == ["127.0.0.1"]
+    finally:
+        code, err = stop(process)
+    assert code == 0 and "Traceback" not in err, err

@@ -45,7 +45,8 @@ class ViewBridge:
 
     def _send(self) -> None:
         with self.lock:
-            self.feed(self.hal.hold_action())
+            hold = np.asarray(self.hal.hold_action(), dtype=np.float64).tolist()
+            self.feed(dict(zip(self.hal.action_names, hold, strict=True)))
 
     def stop(self) -> None:
         """Stop sending and close the view (idempotent)."""

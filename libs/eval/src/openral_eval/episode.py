@@ -28,13 +28,12 @@ import atexit
 import hashlib
 import time
 import traceback
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
 import numpy as np
-import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_sim.observation import Observation as SceneObservation
@@ -130,8 +129,9 @@ def close_scenes() -> None:
         hal.disconnect()
 
 
-StepWatch = Callable[[npt.NDArray[np.float64] | None], None]
-"""Called after the reset (None) and after each step (its action): a browser view's feed."""
+StepWatch = Callable[[Mapping[str, float] | None], None]
+"""Called after the reset (None) and after each step (its action, by the env's slot
+names): a browser view's feed."""
 
 
 def run_episode(spec: EpisodeSpec, watch: StepWatch | None = None) -> EpisodeResult:
@@ -199,7 +199,7 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None) ->
             seen = hal.read_images() if keep is not None else {}
             _, _, terminated, truncated, info = env.step(action)
             if watch is not None:
-                watch(action)
+                watch(dict(zip(env.action_names, action.tolist(), strict=True)))
             run.steps += 1
             run.frames += len(hal.last_observation().images)
             run.success = bool(info["success"])

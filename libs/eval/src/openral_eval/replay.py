@@ -118,7 +118,12 @@ class _Watchers:
     def __call__(self, env: SceneEnv, action: np.ndarray | None) -> None:
         self.video.add(env.hal.last_observation())
         if self.watch is not None:
-            self.watch(action)
+            named = (
+                None
+                if action is None
+                else dict(zip(env.action_names, action.tolist(), strict=True))
+            )
+            self.watch(named)
 
 
 def _digest(env: SceneEnv, seed: int, actions: np.ndarray, watchers: _Watchers) -> str:

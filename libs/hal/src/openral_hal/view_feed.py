@@ -9,6 +9,7 @@ hands it the frames it renders for ROS, :meth:`frame`).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -31,8 +32,9 @@ class ViewFeed:
         self.view, self.hal = view, hal
         self._sent: dict[str, npt.NDArray[np.generic]] = {}
 
-    def __call__(self, action: npt.ArrayLike | None = None) -> None:
-        """Send the HAL's state now, and ``action`` (the one just applied) when given."""
+    def __call__(self, action: Mapping[str, float] | None = None) -> None:
+        """Send the HAL's state now, and ``action`` (the one just applied, by slot name:
+        joint slots, or an env's end-effector slots) when given."""
         handles = self.hal.mujoco_handles() if isinstance(self.hal, MujocoBacked) else None
         state = self.hal.read_state()
         time_s = float(state.sim_time_s or 0.0)
@@ -42,10 +44,7 @@ class ViewFeed:
                 "joints", dict(zip(state.names, state.positions.tolist(), strict=True)), time_s
             )
             if action is not None:
-                values = np.asarray(action, dtype=np.float64).tolist()
-                self.view.plot(
-                    "action", dict(zip(self.hal.action_names, values, strict=True)), time_s
-                )
+                self.view.plot("action", action, time_s)
         if isinstance(self.hal, ObservingHal):
             obs = self.hal.last_observation()
             for name, image in obs.images.items():

@@ -187,7 +187,7 @@ def _drive(
         action = hold + (SWAY_RAD * phase if motion == "sway" else 0.0)
         hal.send_action(action)
         if feed is not None:
-            feed(action)
+            feed(dict(zip(hal.action_names, action.tolist(), strict=True)))
         state = hal.read_state()
         positions = zip(state.names, state.positions.tolist(), strict=True)
         seen.records.append({"step": step, "time": state.sim_time_s, "positions": dict(positions)})
