@@ -1,5 +1,5 @@
 """``openral deploy sim --record`` and ``openral ros record`` against a live franka tabletop,
-checked from outside: the bag holds every topic an outside subscriber saw, with the same
+checked from outside: a 30 s recording holds every topic an outside subscriber saw, with the same
 counts over the same time, its images decode, and a SIGKILLed recorder leaves messages that
 ``--repair`` recovers up to about a second before the kill."""
 
@@ -109,7 +109,7 @@ def test_the_bag_holds_what_an_outside_subscriber_counted(
     domain, counter = counted
     bag = tmp_path / "run"
     command = [str(OPENRAL), "deploy", "sim", "--no-viewer", "--config", str(FRANKA_SCENE)]
-    command += ["--duration", "12", "--record", str(bag), "--domain-id", str(domain)]
+    command += ["--duration", "30", "--record", str(bag), "--domain-id", str(domain)]
     done = subprocess.run(command, capture_output=True, text=True, env=ENV, timeout=180)
     assert done.returncode == 0, done.stderr
     assert "Traceback" not in done.stderr
@@ -120,7 +120,7 @@ def test_the_bag_holds_what_an_outside_subscriber_counted(
     assert set(seen) <= set(found), set(seen) - set(found)
     first = max(min(s) for s in seen.values() if len(s) > 1) + EDGE_S * 1e9
     last = min(max(s) for s in seen.values() if len(s) > 1) - EDGE_S * 1e9
-    assert last - first > 5e9, "less than 5 s in common"
+    assert last - first > 20e9, "less than 20 s in common"
     for topic, stamps in seen.items():
         if len(stamps) <= 1:  # latched: one message each
             assert len(found[topic]) == 1, topic
