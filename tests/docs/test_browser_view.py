@@ -15,20 +15,16 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pytest
-
-from tests.docs.headless_chromium import chromium, listening
+from tests.docs.headless_chromium import listening
 from tests.docs.view_screenshot import (
     REPO,
     SCENE,
     free_port_pair,
     photograph,
+    serve,
     start_view,
     stop,
-)
-
-pytestmark = pytest.mark.skipif(
-    chromium() is None, reason="chromium missing: ./bootstrap installs it"
+    view_url,
 )
 
 
@@ -37,8 +33,7 @@ def test_the_view_shows_the_arm_and_a_camera_in_headless_chromium(tmp_path: Path
     process = start_view(port)
     try:
         assert listening(port + 1) == ["127.0.0.1"], "the data stream listens on loopback only"
-        url = f"http://127.0.0.1:{port}/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A{port + 1}%2Fproxy"
-        seen = photograph(url, tmp_path / "view.png")
+        seen = photograph(view_url(port), tmp_path / "view.png")
         print(f"screenshot: {seen}")
         assert seen.drawn(), seen
     finally:
@@ -67,30 +62,10 @@ def test_a_taken_port_is_one_line_and_exit_1() -> None:
 
 def test_a_policy_episode_is_viewed_and_served_until_ctrl_c() -> None:
     port = free_port_pair()
-    run = [sys.executable, "-m", "openral_cli.main", "sim", "run", "--config", SCENE]
-    command = [
-        *run,
-        "--policy",
-        "scripted_lift",
-        "--steps",
-        "12",
-        "--view",
-        "--view-port",
-        str(port),
-    ]
-    env = {**os.environ, "COLUMNS": "200", "MUJOCO_GL": "egl"}
-    process = subprocess.Popen(
-        command, cwd=REPO, env=env, text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE
-    )
-    assert process.stdout is not None
-    printed = []
-    for line in process.stdout:
-        printed.append(line)
-        if line.startswith("serving the view"):
-            break
+    args = ("--policy", "scripted_lift", "--steps", "12", "--view", "--view-port", str(port))
+    process, text = serve("sim", "run", "--config", SCENE, *args)
     try:
-        text = "".join(printed)
-        assert f"view: http://127.0.0.1:{port}/" in text and "scripted_lift" in text, text
+        assert f"view: {view_url(port)}" in text and "scripted_lift" in text, text
         assert listening(port + 1) == ["127.0.0.1"]
     finally:
         code, err = stop(process)

@@ -24,7 +24,7 @@ from tests.docs.headless_chromium import free_port, open_page
 
 REPO = Path(__file__).resolve().parents[2]
 SCENE = "robots/franka_panda/scenes/tabletop.yaml"
-DRAW_WAIT_S = 90.0
+DRAW_WAIT_S = 150.0
 """How long the page may take to load Rerun's Wasm viewer and draw (software GL)."""
 
 
@@ -67,19 +67,33 @@ def _brown(region: np.ndarray) -> float:
     return float(((r > g + 15) & (g > b + 15) & (r > 120)).mean())
 
 
-def start_view(port: int) -> subprocess.Popen[str]:
-    """``openral sim run --view`` on :data:`SCENE`, once it says the view is served."""
-    command = [sys.executable, "-m", "openral_cli.main", "sim", "run", "--config", SCENE,
-               "--steps", "40", "--view", "--view-port", str(port)]  # fmt: skip
+def serve(*args: str) -> tuple[subprocess.Popen[str], str]:
+    """``openral ARGS`` (a command that serves a view) and what it printed up to the line
+    saying it serves the view."""
+    command = [sys.executable, "-m", "openral_cli.main", *args]
     env = {**os.environ, "COLUMNS": "200", "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl")}
     process = subprocess.Popen(
         command, cwd=REPO, env=env, text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE
     )
     assert process.stdout is not None
+    printed = []
     for line in process.stdout:
+        printed.append(line)
         if line.startswith("serving the view"):
-            return process
-    raise AssertionError(f"sim run --view ended early: {process.communicate()[1]}")
+            return process, "".join(printed)
+    raise AssertionError(f"openral {' '.join(args)} ended early: {process.communicate()[1]}")
+
+
+def start_view(port: int) -> subprocess.Popen[str]:
+    """``openral sim run --view`` on :data:`SCENE`, once it says the view is served."""
+    return serve(
+        "sim", "run", "--config", SCENE, "--steps", "40", "--view", "--view-port", str(port)
+    )[0]
+
+
+def view_url(port: int) -> str:
+    """The page of a view on ``port`` (its data stream on the next port)."""
+    return f"http://127.0.0.1:{port}/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A{port + 1}%2Fproxy"
 
 
 def free_port_pair() -> int:
@@ -128,8 +142,7 @@ def main(out: Path) -> None:
     port = free_port_pair()
     process = start_view(port)
     try:
-        url = f"http://127.0.0.1:{port}/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A{port + 1}%2Fproxy"
-        seen = photograph(url, out)
+        seen = photograph(view_url(port), out)
     finally:
         stop(process)
     print(f"{out}: {seen}")

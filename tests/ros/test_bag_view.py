@@ -10,7 +10,6 @@ exit 0. A folder that is not a bag is one line and exit 1.
 
 from __future__ import annotations
 
-import os
 import signal
 import subprocess
 import sys
@@ -24,8 +23,7 @@ from openral_nodes.bag_writer import typestore
 from PIL import Image
 from rosbags.rosbag2 import StoragePlugin, Writer
 
-from tests.docs.headless_chromium import chromium
-from tests.docs.view_screenshot import REPO, free_port_pair, photograph
+from tests.docs.view_screenshot import REPO, free_port_pair, photograph, serve, view_url
 
 TYPES = typestore()
 T = TYPES.types
@@ -169,36 +167,13 @@ def _red_camera(png: Path) -> bool:
     return bool(red.mean() > 0.02)
 
 
-@pytest.mark.skipif(chromium() is None, reason="chromium missing: ./bootstrap installs it")
 def test_ros_view_serves_the_bag_to_a_browser(bag: Path, tmp_path: Path) -> None:
     port = free_port_pair()
-    command = [
-        sys.executable,
-        "-m",
-        "openral_cli.main",
-        "ros",
-        "view",
-        str(bag),
-        "--view-port",
-        str(port),
-    ]
-    env = {**os.environ, "COLUMNS": "200"}
-    process = subprocess.Popen(
-        command, cwd=REPO, env=env, text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE
-    )
-    assert process.stdout is not None
-    lines = []
-    for line in process.stdout:
-        lines.append(line)
-        if line.startswith("serving the view"):
-            break
-    assert (
-        "drew 11 transforms, 10 joint states and 21 images; left out /chatter (10), /odd/image (1)"
-        in "".join(lines)
-    )
+    process, text = serve("ros", "view", str(bag), "--view-port", str(port))
+    left = "left out /chatter (10), /odd/image (1)"
+    assert f"drew 11 transforms, 10 joint states and 21 images; {left}" in text
     try:
-        url = f"http://127.0.0.1:{port}/?url=rerun%2Bhttp%3A%2F%2F127.0.0.1%3A{port + 1}%2Fproxy"
-        photograph(url, tmp_path / "bag.png", done=_red_camera)
+        photograph(view_url(port), tmp_path / "bag.png", done=_red_camera)
         assert _red_camera(tmp_path / "bag.png")
     finally:
         process.send_signal(signal.SIGINT)

@@ -13,17 +13,12 @@ import re
 import time
 from pathlib import Path
 
-import pytest
 from openral_nodes.runtime import claim_domain_id
 
-from tests.docs.headless_chromium import chromium, listening
+from tests.docs.headless_chromium import listening
 from tests.docs.view_screenshot import free_port_pair, photograph
 from tests.ros.lifecycle_client import deploy_output, deploy_sim
 from tests.ros.ros_helpers import FRANKA_SCENE
-
-pytestmark = pytest.mark.skipif(
-    chromium() is None, reason="chromium missing: ./bootstrap installs it"
-)
 
 
 def test_the_running_graph_is_drawn_in_the_browser(tmp_path: Path) -> None:
