@@ -255,3 +255,32 @@ def test_an_export_that_does_not_rerun_as_recorded_writes_nothing(
     (results / "episodes.jsonl").write_text('{"seed": 1}\n')
     broken = _export(results, tmp_path / "ds")
     assert broken.returncode == 1 and "episodes.jsonl:1: not a sweep's result line" in broken.stderr
+
+
+def test_a_sweeps_results_replay_without_a_dataset(
+    swept: tuple[Path, Path], tmp_path: Path
+) -> None:
+    out, _ = swept
+    results = [json.loads(line) for line in (out / "episodes.jsonl").read_text().splitlines()]
+    video = tmp_path / "ep1.mp4"
+    done = subprocess.run(
+        [str(OPENRAL), "sim", "replay", str(out), "--episode", "1", "--video", str(video)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "MUJOCO_GL": "egl", "COLUMNS": "200"},
+    )
+    assert done.returncode == 0, done.stderr
+    steps, digest = results[1]["steps"], results[1]["trajectory_sha256"]
+    assert f"seed 1): {steps} steps replayed; the trajectory matches the sweep's" in done.stdout
+    assert digest[:12] in done.stdout and f"video: {video}" in done.stdout
+    with av.open(str(video)) as container:
+        assert sum(1 for _ in container.decode(video=0)) > 0
+    nowhere = subprocess.run(
+        [str(OPENRAL), "sim", "replay", str(tmp_path), "--episode", "0"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert nowhere.returncode == 1
+    assert "(or a sweep's folder with its episodes.jsonl)" in nowhere.stderr

@@ -5,9 +5,11 @@ A sweep with ``--dataset`` stores, beside the LeRobot files, where each episode 
 :func:`replay` resets that scene with that seed and steps the env with the dataset's own
 ``action`` column, as a trainer reads it (the sweep applied those float32 values, so they
 are exact), hashing every joint position as the sweep's episode does. A matching digest
-means the dataset's actions reproduce the run joint for joint. ``video`` renders the
-replay's first camera to an MP4 and ``view`` (given the replay's HAL, it returns a browser
-view's feed) sees every step; both render the scene's cameras, which changes no joint.
+means the dataset's actions reproduce the run joint for joint. A sweep's results without a
+dataset replay too (:func:`replay_sweep`): the policy runs again from the line's seed.
+``video`` renders the replay's first camera to an MP4 and ``view`` (given the replay's HAL,
+it returns a browser view's feed) sees every step; both render the scene's cameras, which
+changes no joint.
 """
 
 from __future__ import annotations
@@ -24,8 +26,9 @@ from openral_core.errors import OpenralError
 from openral_hal.sim_attached import SimAttachedHAL
 
 from openral_eval.env_actions import ActionMode
-from openral_eval.episode import StepWatch, camera_rate_hz
+from openral_eval.episode import StepWatch, camera_rate_hz, close_scenes, run_episode, scene_for
 from openral_eval.lerobot_dataset import DATA_PATH
+from openral_eval.results import read_results, spec_of
 from openral_eval.scene_env import EnvConfig, SceneEnv
 from openral_eval.video import VideoWriter
 
@@ -64,7 +67,7 @@ def provenance(dataset: Path) -> list[dict[str, object]]:
     except (OSError, ValueError, KeyError, TypeError):
         raise OpenralError(
             f"{path}: missing or unreadable; expected a dataset written by "
-            "`openral sim sweep --dataset`"
+            "`openral sim sweep --dataset` (or a sweep's folder with its episodes.jsonl)"
         ) from None
     return episodes
 
@@ -107,6 +110,38 @@ def replay(
         env.close()
     expected = str(origin["trajectory_sha256"])
     return Replayed(scene, seed, len(actions), digest, expected, writer.frames)
+
+
+def replay_sweep(
+    results: Path,
+    index: int,
+    *,
+    video: Path | None = None,
+    view: Callable[[SimAttachedHAL], StepWatch] | None = None,
+) -> Replayed:
+    """Replay line ``index`` of a sweep's ``results/episodes.jsonl``: its policy again from
+    its seed, limited to the steps it took (a sweep keeps no actions; episodes are pure
+    functions of their line), compared with the line's digest.
+
+    Raises:
+        OpenralError: No such line, or its episode ended with an error.
+    """
+    lines = read_results(results / "episodes.jsonl")
+    if not 0 <= index < len(lines):
+        raise OpenralError(f"--episode {index}: {results} holds episodes 0 to {len(lines) - 1}")
+    line = lines[index]
+    if line.get("error") is not None:
+        raise OpenralError(f"--episode {index} ended with an error in the sweep: {line['error']}")
+    spec = spec_of(line, video=None if video is None else str(video))
+    try:
+        watch = view(scene_for(spec.scene)[0]) if view is not None else None
+        result = run_episode(spec, watch)
+    finally:
+        close_scenes()
+    if result.error is not None:
+        raise OpenralError(f"--episode {index}: the replay ended with an error: {result.error}")
+    expected = str(line["trajectory_sha256"])
+    return Replayed(spec.scene, spec.seed, result.steps, result.trajectory_sha256, expected)
 
 
 class _Watchers:

@@ -18,6 +18,8 @@ from collections.abc import Iterable
 from dataclasses import asdict
 from pathlib import Path
 
+from openral_core.errors import OpenralError
+
 from openral_eval.episode import EpisodeResult, EpisodeSpec
 
 Key = tuple[str, int, str, tuple[tuple[str, str], ...]]
@@ -38,6 +40,36 @@ def result_key(line: dict[str, object]) -> Key:
         str(line.get("policy")),
         pairs,
     )
+
+
+def read_results(path: Path) -> list[dict[str, object]]:
+    """Every line of a finished sweep's ``episodes.jsonl``, checked to be a result.
+
+    Raises:
+        OpenralError: No such file, or a line (named ``path:line``) that is not a result.
+    """
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as error:
+        raise OpenralError(f"{path}: {error.strerror}; expected a sweep's results") from None
+    lines = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        try:
+            line = json.loads(raw)
+            int(line["seed"]), str(line["scene"]), str(line["policy"]), int(line["steps"])
+            str(line["trajectory_sha256"])
+        except (ValueError, KeyError, TypeError):
+            raise OpenralError(f"{path}:{number}: not a sweep's result line") from None
+        lines.append(line)
+    return lines
+
+
+def spec_of(line: dict[str, object], **files: str | None) -> EpisodeSpec:
+    """The episode a result line records, limited to the steps it took (so it ends where
+    it ended: a success, the horizon or the limit); ``files`` sets ``video`` or
+    ``dataset``."""
+    scene, seed, policy, pairs = result_key(line)
+    return EpisodeSpec(scene, seed, policy, pairs, int(str(line["steps"])), **files)
 
 
 class EpisodeLog:

@@ -11,11 +11,10 @@ export before anything is written.
 
 from __future__ import annotations
 
-import json
 import os
 import shutil
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import Annotated
 
 import typer
 from openral_core.errors import OpenralError
@@ -28,9 +27,6 @@ from openral_cli.commands.sweep import (
 )
 from openral_cli.commands.sweep_dataset import dataset_staging, export
 from openral_cli.console import out
-
-if TYPE_CHECKING:
-    from openral_eval.episode import EpisodeSpec
 
 WORK = ".export"
 """The folder under RESULTS where the export's reruns write, removed when it is done."""
@@ -55,8 +51,12 @@ def sim_export(
     work = results / WORK
     shutil.rmtree(work, ignore_errors=True)
     staging = dataset_staging(scenes, dataset, (work, False, None))
-    plan = [_spec(line, staging) for line in lines]
-    from openral_eval.results import EpisodeLog
+    from openral_eval.results import EpisodeLog, spec_of
+
+    plan = [
+        spec_of(line, dataset=kept_steps(staging, str(line["scene"]), int(str(line["seed"]))))
+        for line in lines
+    ]
 
     try:
         log = EpisodeLog(work / "episodes.jsonl")
@@ -71,45 +71,20 @@ def sim_export(
 
 
 def _finished(path: Path) -> list[dict[str, object]]:
-    """The lines of ``path`` whose episode ended without an error.
+    """The lines of ``path`` whose episode ended without an error, all of one policy.
 
     Raises:
-        OpenralError: No such file, a line that is not a sweep's result, or no finished
-            episode.
+        OpenralError: An unreadable file or line, no finished episode, several policies.
     """
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as error:
-        raise OpenralError(f"{path}: {error.strerror}; expected a sweep's results") from None
-    lines = []
-    for number, raw in enumerate(text.splitlines(), start=1):
-        try:
-            line = json.loads(raw)
-            int(line["seed"]), str(line["scene"]), str(line["policy"]), int(line["steps"])
-        except (ValueError, KeyError, TypeError):
-            raise OpenralError(f"{path}:{number}: not a sweep's result line") from None
-        if line.get("error") is None:
-            lines.append(line)
+    from openral_eval.results import read_results
+
+    lines = [line for line in read_results(path) if line.get("error") is None]
     policies = sorted({str(line["policy"]) for line in lines})
     if not lines:
         raise OpenralError(f"{path}: no episode ended without an error; nothing to export")
     if len(policies) > 1:
         raise OpenralError(f"{path}: episodes of several policies ({', '.join(policies)})")
     return lines
-
-
-def _spec(line: dict[str, object], staging: Path) -> EpisodeSpec:
-    """The episode of one result line, limited to the steps it took, keeping its steps."""
-    from openral_eval.episode import EpisodeSpec
-
-    params = line.get("params") or {}
-    assert isinstance(params, dict)
-    pairs = tuple(sorted((str(k), str(v)) for k, v in params.items()))
-    scene, seed = str(line["scene"]), int(str(line["seed"]))
-    steps = int(str(line["steps"]))
-    return EpisodeSpec(
-        scene, seed, str(line["policy"]), pairs, steps, None, kept_steps(staging, scene, seed)
-    )
 
 
 def _check_digests(lines: list[dict[str, object]], rerun: list[dict[str, object]]) -> None:

@@ -25,7 +25,8 @@ if TYPE_CHECKING:
 
 def replay(
     dataset: Annotated[
-        Path, typer.Argument(help="Dataset folder written by `sim sweep --dataset`.")
+        Path,
+        typer.Argument(help="A dataset (`sim sweep --dataset`) or a sweep's --out folder."),
     ],
     episode: Annotated[int, typer.Option("--episode", min=0, help="Episode index to replay.")],
     video: Annotated[
@@ -35,14 +36,15 @@ def replay(
     view: View = False,
     view_port: ViewPort = DEFAULT_VIEW_PORT,
 ) -> None:
-    """Replay EPISODE of DATASET: reset its scene with its seed, step the dataset's actions,
-    and compare the joint trajectory's digest with the one the sweep recorded. Exits 1 when
-    they differ.
+    """Replay EPISODE of DATASET: reset its scene with its seed, step the dataset's actions
+    (for a sweep's results folder: run its policy again), and compare the joint
+    trajectory's digest with the one the sweep recorded. Exits 1 when they differ.
 
     Example:
 
         openral sim replay o/ds --episode 3 --video o/ep3.mp4
     """
+    from openral_eval.replay import PROVENANCE, replay_sweep
     from openral_eval.replay import replay as replay_episode
 
     feeds: list[ViewFeed] = []
@@ -51,9 +53,13 @@ def replay(
         feeds.append(open_view(hal, f"{dataset} · episode {episode}", view_port))
         return feeds[-1]
 
-    done = replay_episode(dataset, episode, video=video, view=open_feed if view else None)
+    if (dataset / PROVENANCE).is_file() or not (dataset / "episodes.jsonl").is_file():
+        done = replay_episode(dataset, episode, video=video, view=open_feed if view else None)
+    else:
+        done = replay_sweep(dataset, episode, video=video, view=open_feed if view else None)
     if video is not None:
-        out.print(f"video: {video} ({done.frames} frames)", markup=False)
+        frames = f" ({done.frames} frames)" if done.frames else ""
+        out.print(f"video: {video}{frames}", markup=False)
     where = f"episode {episode} ({done.scene}, seed {done.seed}): {done.steps} steps replayed"
     if not done.matches:
         raise OpenralError(
