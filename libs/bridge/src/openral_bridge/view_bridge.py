@@ -32,6 +32,7 @@ class ViewBridge:
         self.hal, self.feed, self.lock, self.rate_hz = hal, feed, lock, rate_hz
         self._job: PacedJob | None = None
         self._pacer: Pacer | None = None
+        self._closed = False
 
     def start(self, pacer: Pacer) -> None:
         """Send the scene now, then every ``1 / rate_hz`` seconds."""
@@ -49,8 +50,10 @@ class ViewBridge:
             self.feed(dict(zip(self.hal.action_names, hold, strict=True)))
 
     def stop(self) -> None:
-        """Stop sending and close the view (idempotent)."""
+        """Stop sending and close the view's data stream (idempotent)."""
         if self._job is not None and self._pacer is not None:
             self._pacer.cancel(self._job)
-            self._job = None
+        self._job = None
+        if not self._closed:
+            self._closed = True
             self.feed.view.close()

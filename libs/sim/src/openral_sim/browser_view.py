@@ -29,6 +29,9 @@ import rerun.blueprint as rrb
 from openral_sim.view_geometry import WORLD, BodyTree, Geom, GeomShape, body_tree, relative_poses
 from openral_sim.view_geometry import visible_geoms as _visible_geoms
 
+_PAGES_SERVED: set[int] = set()
+"""Ports this process serves the viewer's page on (a view opened again, after a lifecycle
+deactivate and activate, reuses its page and opens a new data stream)."""
 AXIS_LENGTH_M = 0.1
 """Length of the axes drawn at a frame of :meth:`BrowserView.transform` [m]."""
 
@@ -88,14 +91,19 @@ class BrowserView:
         self._period_s = 1.0 / max_rate_hz
         self._last_s = -np.inf
         self._posed_static = False
-        for port in (self.ports.web, self.ports.data):
+        page_served = self.ports.web in _PAGES_SERVED
+        for port in (self.ports.data,) if page_served else (self.ports.web, self.ports.data):
             _check_free(self.ports.host, port)
         self.stream = rr.RecordingStream("openral", recording_id=title)
         self.stream.send_recording_name(title)
         try:
             sink = rr.GrpcServerSink(bind_ip=self.ports.host, port=self.ports.data)
             self.stream.set_sinks(sink)
-            rr.serve_web_viewer(web_port=self.ports.web, open_browser=False, connect_to=sink.uri)
+            if not page_served:  # Rerun serves the page until the process ends
+                rr.serve_web_viewer(
+                    web_port=self.ports.web, open_browser=False, connect_to=sink.uri
+                )
+                _PAGES_SERVED.add(self.ports.web)
         except Exception as error:  # Rerun raises plain errors for a port in use
             raise ViewUnavailable(f"the view cannot listen: {error}") from None
         self.stream.send_blueprint(_layout(cameras, _eye(model) if model is not None else None))
