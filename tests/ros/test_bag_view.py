@@ -187,3 +187,12 @@ def test_a_folder_that_is_not_a_bag_is_one_line(tmp_path: Path) -> None:
     assert done.returncode == 1
     assert done.stderr.strip().endswith("no metadata.yaml; expected a rosbag2 bag folder")
     assert len(done.stderr.strip().splitlines()) == 1
+
+
+def test_a_broken_bag_is_one_line(tmp_path: Path) -> None:
+    (tmp_path / "metadata.yaml").write_text("garbage: [\n")
+    command = [sys.executable, "-m", "openral_cli.main", "ros", "view", str(tmp_path)]
+    done = subprocess.run(command, cwd=REPO, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 1
+    assert len(done.stderr.strip().splitlines()) == 1, done.stderr
+    assert f"{tmp_path}: not a readable bag (Could not load YAML" in done.stderr

@@ -120,7 +120,8 @@ def serve_bag_view(bag: Path, port: int) -> None:
     except ViewUnavailable as error:
         raise OpenralError(f"--view-port: {error}") from None
     except ReaderError as error:
-        raise OpenralError(f"{bag}: not a readable bag ({error})") from None
+        reason = " ".join(str(error).split())  # rosbags quotes multi-line YAML errors
+        raise OpenralError(f"{bag}: not a readable bag ({reason})") from None
     left = ", ".join(f"{topic} ({count})" for topic, count in sorted(contents.skipped.items()))
     out.print(
         f"drew {contents.frames} transforms, {contents.joint_states} joint states and "
