@@ -73,6 +73,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
 from openral_nodes.command_interfaces import CommandInterfaces
+from openral_nodes.heap_freeze import HeapFreeze
 from openral_nodes.lifecycle_guard import guard_change_state
 from openral_nodes.node_parameters import BOUNDS, PARAMETERS, check_rates, robot_and_scene
 from openral_nodes.robot_state_streams import RobotStateStreams
@@ -127,6 +128,7 @@ class ManifestLifecycleNode(LifecycleNode):
             for k, v in (parameter_overrides or {}).items()
         ]
         super().__init__(node_name, parameter_overrides=overrides, **kwargs)
+        self.heap = HeapFreeze()  # the owner enables it (deploy sim)
         for name, default in PARAMETERS.items():
             self.declare_parameter(name, default)
         self.description: RobotDescription | None = None
@@ -210,6 +212,7 @@ class ManifestLifecycleNode(LifecycleNode):
         if self.loop is not None:  # the pace is judged from here on, not over the start-up
             self.loop.watch.restart()
         pacer.start()
+        self.heap.freeze()
         super().on_activate(state)
         return Result.SUCCESS
 
@@ -362,6 +365,7 @@ class ManifestLifecycleNode(LifecycleNode):
 
     def _stop(self) -> None:
         """Stop the periodic work (its thread joined first), then remove every entity."""
+        self.heap.thaw()
         if self.pacer is not None:
             pacer, self.pacer = self.pacer, None
             if not pacer.stop():

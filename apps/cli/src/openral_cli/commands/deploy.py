@@ -15,7 +15,6 @@ exits 0; a ``shutdown`` transition requested over ROS ends it with exit 0 too.
 
 from __future__ import annotations
 
-import gc
 import signal
 import threading
 import time
@@ -132,7 +131,6 @@ def _run_graph(
         _transition(node, "configure")
         _transition(node, "activate")
         _print_interfaces(node, config)
-        _freeze_the_heap()
         spin_until(executor, stop, timeout_s=duration)
     finally:
         reason = _shut_down(node, stop)
@@ -141,16 +139,6 @@ def _run_graph(
         for sig, handler in previous.items():
             signal.signal(sig, handler)
     return reason, time.monotonic() - started
-
-
-def _freeze_the_heap() -> None:
-    """Move every object of the bring-up (models, modules, the node) out of the garbage
-    collector's reach: a full collection of that heap takes 100-130 ms here (2-3 times
-    that on a loaded machine) with the GIL held, which stalled the E-stop's thread and
-    ``/joint_states`` by 0.27 s during a goal flood. Collections then scan only what the
-    running graph allocates."""
-    gc.collect()
-    gc.freeze()
 
 
 def _node_parameters(
@@ -190,9 +178,11 @@ def _make_node(
     set by a shutdown transition (also one requested over ROS)."""
     from openral_nodes.manifest_node import ManifestLifecycleNode
 
-    return ManifestLifecycleNode(
+    node = ManifestLifecycleNode(
         context=context, parameter_overrides=parameters, log_boot_errors=False, shutdown_event=stop
     )
+    node.heap.enabled = True  # short garbage collections while active (heap_freeze)
+    return node
 
 
 def _transition(node: ManifestLifecycleNode, name: str) -> None:
