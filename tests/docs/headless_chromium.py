@@ -11,14 +11,16 @@ from __future__ import annotations
 
 import base64
 import json
+import os
 import shutil
+import signal
 import socket
 import subprocess
 import tempfile
 import time
 import urllib.request
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import Any
 
@@ -87,11 +89,15 @@ def open_page(url: str, width: int = 1400, height: int = 800) -> Iterator[Page]:
     executable = chromium()
     assert executable, "chromium is missing: ./bootstrap installs it"
     port = free_port()
-    with tempfile.TemporaryDirectory() as profile:
+    # Chromium's helpers (renderer, GPU, crash handler) outlive its main process for a while and
+    # keep writing to the profile: they share its session, which is killed as a whole.
+    with tempfile.TemporaryDirectory(ignore_cleanup_errors=True) as profile:
         size = f"--window-size={width},{height}"
         debug = f"--remote-debugging-port={port}"
         command = [executable, *FLAGS, debug, f"--user-data-dir={profile}", size, url]
-        process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        process = subprocess.Popen(
+            command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
+        )
         try:
             page = Page(_page_socket(port))
             try:
@@ -99,8 +105,18 @@ def open_page(url: str, width: int = 1400, height: int = 800) -> Iterator[Page]:
             finally:
                 page.close()
         finally:
-            process.terminate()
-            process.wait(timeout=20)
+            _end_session(process)
+
+
+def _end_session(process: subprocess.Popen[bytes]) -> None:
+    """Stop Chromium and every helper it started (they share its session)."""
+    with suppress(ProcessLookupError):
+        os.killpg(process.pid, signal.SIGTERM)
+    try:
+        process.wait(timeout=20)
+    finally:
+        with suppress(ProcessLookupError):
+            os.killpg(process.pid, signal.SIGKILL)
 
 
 def _page_socket(port: int, timeout_s: float = 30.0) -> str:
