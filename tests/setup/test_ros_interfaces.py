@@ -110,11 +110,15 @@ def _wait(future: Future, what: str) -> Any:
 
 
 def _publisher(node: Node, topic: str) -> TopicEndpointInfo:
-    """The one publisher of ``topic`` in ``node``'s graph, once discovered."""
+    """The one publisher of ``topic`` in ``node``'s graph, once discovered with its node's name
+    (the endpoint can be seen before the ros_discovery_info naming its node, for a moment
+    ``_NODE_NAME_UNKNOWN_``)."""
     deadline = time.monotonic() + WAIT_S
-    while not (publishers := node.get_publishers_info_by_topic(topic)):
+    while not (publishers := node.get_publishers_info_by_topic(topic)) or any(
+        p.node_name == "_NODE_NAME_UNKNOWN_" for p in publishers
+    ):
         if time.monotonic() > deadline:
-            pytest.fail(f"no publisher of {topic} discovered within {WAIT_S} s")
+            pytest.fail(f"no named publisher of {topic} discovered within {WAIT_S} s")
         time.sleep(0.01)
     [publisher] = publishers
     return publisher
