@@ -16,17 +16,20 @@ default:
 
 # The main job's command; `./bootstrap demo` execs it directly, so a signal to that PID reaches it.
 demo_command := "openral deploy sim --config robots/franka_panda/scenes/tabletop.yaml --no-viewer"
+test_workers := `python3 -c "import os; print(len(os.sched_getaffinity(0)) + 1)"`
 
 # The main job: the Panda's default scene as a live ROS 2 graph, headless, until Ctrl-C.
 demo:
     {{demo_command}}
 
 # The whole test suite: first every test file but the real-time measurements, spread over
-# every core (pytest-xdist; each worker claims its own ROS domain), then the measurements
-# (marked `exclusive`) in one process, alone. Extra arguments go to both runs; the second
-# may find none of its tests among them (pytest's exit status 5).
+# one worker more than there are cores (pytest-xdist; each worker claims its own ROS domain:
+# a third of a worker's time is spent waiting on live graphs, so a spare worker keeps the
+# cores busy), then the measurements (marked `exclusive`) in one process, alone. Extra
+# arguments go to both runs; the second may find none of its tests among them (pytest's
+# exit status 5).
 test *ARGS:
-    pytest -n auto --dist loadfile -m "not exclusive" {{ARGS}}
+    pytest -n {{test_workers}} --dist loadfile -m "not exclusive" {{ARGS}}
     pytest -m exclusive {{ARGS}} || [ $? -eq 5 ]
 
 # ruff lint and format check.

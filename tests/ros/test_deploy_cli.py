@@ -16,8 +16,6 @@ from sensor_msgs.msg import Image, JointState
 from benchmarks.real_time import manifest_with_rates
 from tests.ros.ros_helpers import CAMERAS, FRANKA_SCENE, Probe, image_topic
 
-pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
-
 OPENRAL = Path(sys.executable).parent / "openral"
 EXIT_WAIT_S = 60.0
 ENV = {**os.environ, "MUJOCO_GL": "egl", "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}

@@ -29,8 +29,6 @@ from tf2_msgs.msg import TFMessage
 
 from tests.ros.ros_helpers import FRANKA_SCENE
 
-pytestmark = pytest.mark.exclusive  # a live graph at real-time rates: run alone
-
 OPENRAL = Path(sys.executable).parent / "openral"
 ENV = {**os.environ, "MUJOCO_GL": "egl", "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
 CAMERA = "/openral/cameras/agentview"
@@ -103,6 +101,7 @@ def _bag(folder: Path) -> dict[str, list[tuple[int, bytes, str]]]:
     return found
 
 
+@pytest.mark.exclusive  # counts from a live graph at real-time rates: run alone
 def test_the_bag_holds_what_an_outside_subscriber_counted(
     counted: tuple[int, Counter], tmp_path: Path
 ) -> None:

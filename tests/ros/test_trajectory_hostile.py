@@ -40,8 +40,6 @@ from tests.ros.goal_flood import READY as FLOOD_READY
 from tests.ros.lifecycle_client import DEPLOY_NODE, outside_client
 from tests.ros.trajectory_client import JOINTS, Client, franka_graph
 
-pytestmark = pytest.mark.exclusive  # real-time rates and latencies: run alone
-
 Result = FollowJointTrajectory.Result
 
 OPENRAL = Path(sys.executable).parent / "openral"
@@ -222,6 +220,7 @@ def _goal_flood(client: Client) -> Iterator[list[int]]:
     sent.append(int(out.split()[-1]))
 
 
+@pytest.mark.exclusive  # E-stop latencies under a flood: run alone
 def test_a_flood_of_goals_never_delays_the_estop_or_joint_states(client: Client) -> None:
     with outside_client(client.domain, DEPLOY_NODE, "estop_during_flood") as peer:
         # a first call of each service, not measured: it may still wait on the discovery of
