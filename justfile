@@ -27,8 +27,13 @@ demo:
 # a third of a worker's time is spent waiting on live graphs, so a spare worker keeps the
 # cores busy), then the measurements (marked `exclusive`) in one process, alone. Extra
 # arguments go to both runs; the second may find none of its tests among them (pytest's
-# exit status 5).
+# exit status 5). Both runs share one folder of compiled models (tests/conftest.py).
 test *ARGS:
+    #!/usr/bin/env bash
+    set -euo pipefail
+    OPENRAL_TEST_MODEL_CACHE="$(mktemp -d -t openral-test-models-XXXXXX)"
+    export OPENRAL_TEST_MODEL_CACHE
+    trap 'rm -rf "$OPENRAL_TEST_MODEL_CACHE"' EXIT
     pytest -n {{test_workers}} --dist loadfile -m "not exclusive" {{ARGS}}
     pytest -m exclusive {{ARGS}} || [ $? -eq 5 ]
 

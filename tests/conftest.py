@@ -17,7 +17,8 @@ from openral_core.paths import repo_root
 # The suite (and every process it starts) keeps compiled models in a folder of its own,
 # never reading or filling the user's cache (openral_mujoco.model_cache). pytest-xdist's
 # workers inherit the folder the controlling process made (the cache is safe to share
-# between processes), so a model is compiled once per run, not once per worker.
+# between processes), so a model is compiled once per run, not once per worker; `just test`
+# makes one folder for both of its runs.
 _MODEL_CACHE = os.environ.get("OPENRAL_TEST_MODEL_CACHE", "")
 if not _MODEL_CACHE:
     _MODEL_CACHE = tempfile.mkdtemp(prefix="openral-test-models-")
