@@ -363,6 +363,10 @@ class SimDescription(OpenralModel):
     """
     True: MuJoCo (>= 3.0) cancels gravity on the robot at every physics step, as a torque-controlled arm's controller does: the robot's model is compiled with gravcomp 1 on every body of its tree (the trees that carry its manifest joints; a body at or below a free joint is left alone) and actuatorgravcomp on its joints, so the compensating torque is added to the joints' actuator forces and the PD law of `control` only corrects what is left (without it a torque_pd arm sags by gravity torque / kp). Reported efforts stay the servo's own force. Not with floating_base (the whole robot would float). Default false: gravity pulls the arm.
     """
+    visual_mesh_faces: Annotated[StrictInt | None, Field(ge=100, le=10000000)] = None
+    """
+    Most faces a visual-only mesh (a mesh geom that collides with nothing) keeps in the robot's composed scene; a heavier one is simplified to this many (quadric edge collapse, fast-simplification) when the scene is compiled, once per cached model. Offscreen cameras render on the CPU at a cost set by the faces drawn, not the pixels: the Panda's 135k visual faces take 14 ms a frame at any size, 4 ms at 1500 per mesh. Collision geoms, masses and inertias are untouched, so physics is bit for bit the same; meshes with texture coordinates are kept as they are. Unset: every mesh as the model has it.
+    """
     settle_steps_default: Annotated[StrictInt, Field(ge=0, le=1000)] = 1
     """
     Number of mj_step calls after each commanded action by default, 0 to 1000 (the HAL's settle_steps argument overrides it).

@@ -9,7 +9,8 @@ passive buoyancy). The compensation is exact in every pose, and no Python runs p
 ``gravcomp`` gates a pass of MuJoCo's forward dynamics that is compiled in or out (the
 model's ``ngravcomp``), so it must be set in the spec, before compiling: the robot's own
 model (:func:`openral_mujoco.model_check.compile_robot_model`) and a scene composed around
-it both apply :func:`apply_gravity_compensation` to the robot's spec.
+it both apply :func:`apply_gravity_compensation` to the robot's spec
+(:func:`openral_mujoco.robot_edits.edit_robot_spec`).
 """
 
 from __future__ import annotations

@@ -18,7 +18,6 @@ from openral_core.models import (
 )
 from openral_core.tables import HalWiring, hal_wiring, mobile_base_wiring
 
-from openral_mujoco.gravity import apply_gravity_compensation
 from openral_mujoco.mjcf_model import actuator_joints, is_velocity_servo, root_is_free
 from openral_mujoco.mobile_base import (
     base_model_file,
@@ -27,11 +26,8 @@ from openral_mujoco.mobile_base import (
     mount_problem,
 )
 from openral_mujoco.model_cache import cached_mjcf
+from openral_mujoco.robot_edits import UNEDITED, edit_robot_spec, robot_cache_kind
 from openral_mujoco.state_sensor_check import state_sensor_rows
-
-GRAVITY_COMPENSATED = "robot+gravcomp-1"
-"""Model-cache kind of a robot model compiled with its gravity compensated (the number
-changes whenever :func:`~openral_mujoco.gravity.apply_gravity_compensation` does)."""
 
 
 @dataclass(frozen=True)
@@ -120,20 +116,17 @@ def compile_robot_model(description: RobotDescription, path: Path) -> mujoco.MjM
 def cached_robot_model(
     description: RobotDescription, path: Path
 ) -> tuple[mujoco.MjModel, str | None]:
-    """:func:`compile_robot_model` and the fingerprint of the files it read (None: none);
-    its gravity compensated when the manifest asks for it (:mod:`~openral_mujoco.gravity`)."""
+    """:func:`compile_robot_model` and the fingerprint of the files it read (None: none),
+    with the edits its manifest asks for (:mod:`~openral_mujoco.robot_edits`)."""
 
     def refused(error: ValueError) -> ManifestError:
         return unloadable_model(description, path, error)
 
-    sim = description.sim
-    if sim is not None and sim.gravity_compensation:
+    def edit(spec: mujoco.MjSpec) -> None:
+        edit_robot_spec(spec, description)
 
-        def compensate(spec: mujoco.MjSpec) -> None:
-            apply_gravity_compensation(spec, description)
-
-        return cached_mjcf(path, GRAVITY_COMPENSATED, refused, compensate)
-    return cached_mjcf(path, "robot", refused)
+    kind = robot_cache_kind(description)
+    return cached_mjcf(path, kind, refused, None if kind == UNEDITED else edit)
 
 
 def unloadable_model(description: RobotDescription, path: Path, error: Exception) -> ManifestError:

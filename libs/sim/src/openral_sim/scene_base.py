@@ -25,6 +25,7 @@ from openral_mujoco.mobile_base import base_model_file, base_spec, cached_base_m
 from openral_mujoco.model_cache import cached_model
 from openral_mujoco.model_check import cached_robot_model, require_agreement
 from openral_mujoco.robot_addresses import RobotAddresses, locate_robot
+from openral_mujoco.robot_edits import edit_robot_spec, robot_cache_kind
 
 
 @dataclass(frozen=True)
@@ -120,7 +121,8 @@ def robot_alone(robot: LoadedRobot) -> RobotAlone:
     if models.base_path is not None:
         parts = None
         if models.fingerprints is not None:
-            parts = ("robot-alone", *models.fingerprints, description.model_dump_json())
+            kind = robot_cache_kind(description)
+            parts = ("robot-alone", kind, *models.fingerprints, description.model_dump_json())
         model = cached_model(parts, lambda: _alone(description, models))
     try:
         addresses = locate_robot(wiring, models.model, model)
@@ -131,6 +133,6 @@ def robot_alone(robot: LoadedRobot) -> RobotAlone:
 
 def _alone(robot: RobotDescription, models: RobotModels) -> mujoco.MjModel:
     spec = mujoco.MjSpec()
-    child = mujoco.MjSpec.from_file(str(models.path))
+    child = edit_robot_spec(mujoco.MjSpec.from_file(str(models.path)), robot)
     attach_robot(spec, child, robot, models, spec.worldbody.add_frame())
     return spec.compile()

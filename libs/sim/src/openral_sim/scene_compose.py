@@ -4,7 +4,8 @@ physics options, floor, lights and sky, an optional table and pedestal, the scen
 (welded if asked; on its mobile base, see :mod:`openral_sim.scene_base`), the cameras and
 the sensor sites (lidars, IMUs, force-torque and pose sensors) the manifest mounts on the
 robot's bodies, and the MuJoCo sensors a state sensor asks for
-(:mod:`openral_sim.state_sensors`).
+(:mod:`openral_sim.state_sensors`). The robot's own file is edited as its manifest asks
+(:mod:`openral_mujoco.robot_edits`: gravity compensation, lighter visual meshes).
 
 Every fault is reported at its field of the scene file or the manifest.
 """
@@ -27,10 +28,10 @@ from openral_core.models import (
     RobotDescription,
     SceneObject,
 )
-from openral_mujoco.gravity import apply_gravity_compensation
 from openral_mujoco.model_cache import cached_model, code_digest
 from openral_mujoco.model_check import require_agreement, unloadable_model
 from openral_mujoco.robot_bodies import root_body
+from openral_mujoco.robot_edits import edit_robot_spec
 
 from openral_sim.camera_framing import place_fixed_cameras
 from openral_sim.scene_base import (
@@ -53,15 +54,17 @@ PHYSICS_OPTIONS = tuple(key for key in dir(mujoco.MjSpec().option) if not key.st
 
 
 def robot_spec(robot: RobotDescription, path: Path) -> mujoco.MjSpec:
-    """The robot's own model at ``path`` as a spec to attach.
+    """The robot's own model at ``path`` as a spec to attach, edited as its manifest asks.
 
     Raises:
-        ManifestError: At ``sim.mjcf_uri`` when MuJoCo cannot read the file.
+        ManifestError: At ``sim.mjcf_uri`` when MuJoCo cannot read the file, or at
+            ``sim.visual_mesh_faces`` (:func:`~openral_mujoco.robot_edits.edit_robot_spec`).
     """
     try:
-        return apply_gravity_compensation(mujoco.MjSpec.from_file(str(path)), robot)
+        spec = mujoco.MjSpec.from_file(str(path))
     except ValueError as error:
         raise unloadable_model(robot, path, error) from None
+    return edit_robot_spec(spec, robot)
 
 
 @dataclass(frozen=True)
