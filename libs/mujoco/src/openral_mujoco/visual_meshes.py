@@ -29,7 +29,7 @@ FloatArray = npt.NDArray[np.float64]
 
 @dataclass(frozen=True)
 class Simplified:
-    """What :func:`simplify_visual_meshes` did."""
+    """What :func:`lighten_visual_meshes` did."""
 
     meshes: int
     """Meshes simplified."""
