@@ -17,26 +17,12 @@ where the old one was.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import fast_simplification
 import mujoco
 import numpy as np
 import numpy.typing as npt
 
 FloatArray = npt.NDArray[np.float64]
-
-
-@dataclass(frozen=True)
-class Simplified:
-    """What :func:`lighten_visual_meshes` did."""
-
-    meshes: int
-    """Meshes simplified."""
-    faces_before: int
-    """Faces of the visual meshes before, all of them."""
-    faces_after: int
-    """And after."""
 
 
 class InertiaChanged(Exception):
@@ -47,17 +33,17 @@ INERTIAL = ("body_mass", "body_inertia", "body_ipos", "body_iquat")
 """What the compiled bodies must keep exactly."""
 
 
-def lighten_visual_meshes(spec: mujoco.MjSpec, max_faces: int) -> Simplified:
+def lighten_visual_meshes(spec: mujoco.MjSpec, max_faces: int) -> int:
     """Simplify, in ``spec``, every visual-only mesh with more than ``max_faces`` faces to
-    about that many.
+    about that many; the number of meshes simplified.
 
     Raises:
         InertiaChanged: A body's inertia depends on a mesh that was simplified (``spec`` is
             then left half edited: compile nothing from it).
     """
     model = spec.copy().compile()
-    report = _simplify(spec, model, max_faces)
-    if report.meshes:
+    simplified = _simplify(spec, model, max_faces)
+    if simplified:
         changed = spec.copy().compile()
         moved = [k for k in INERTIAL if not np.array_equal(getattr(model, k), getattr(changed, k))]
         if moved:
@@ -65,20 +51,16 @@ def lighten_visual_meshes(spec: mujoco.MjSpec, max_faces: int) -> Simplified:
                 f"simplifying the visual meshes changes {', '.join(moved)}: a body takes its "
                 "inertia from a visual mesh; remove visual_mesh_faces or give the body an inertial"
             )
-    return report
+    return simplified
 
 
-def _simplify(spec: mujoco.MjSpec, model: mujoco.MjModel, max_faces: int) -> Simplified:
-    """Simplify the heavy visual meshes of ``spec`` (``model`` is it compiled)."""
+def _simplify(spec: mujoco.MjSpec, model: mujoco.MjModel, max_faces: int) -> int:
+    """Simplify the heavy visual meshes of ``spec`` (``model`` is it compiled); how many."""
     visual = _visual_only(model)
-    before = after = changed = 0
+    changed = 0
     for index, mesh in enumerate(spec.meshes):
-        faces = int(model.mesh_facenum[index])
-        if index not in visual:
-            continue
-        before += faces
-        if faces <= max_faces or model.mesh_texcoordadr[index] >= 0:
-            after += faces
+        heavy = model.mesh_facenum[index] > max_faces
+        if index not in visual or not heavy or model.mesh_texcoordadr[index] >= 0:
             continue
         vertices, triangles = _simplified(model, index, max_faces)
         mesh.name = model.mesh(index).name  # a mesh without a file needs its own name
@@ -88,9 +70,8 @@ def _simplify(spec: mujoco.MjSpec, model: mujoco.MjModel, max_faces: int) -> Sim
         mesh.userface = triangles.ravel().tolist()
         mesh.usernormal, mesh.userfacenormal = [], []
         mesh.usertexcoord, mesh.userfacetexcoord = [], []
-        after += len(triangles)
         changed += 1
-    return Simplified(changed, before, after)
+    return changed
 
 
 def _visual_only(model: mujoco.MjModel) -> set[int]:
