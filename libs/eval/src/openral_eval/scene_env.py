@@ -47,6 +47,9 @@ from openral_sim.state_sensors import state_sensors_of
 from openral_eval.env_actions import BASE_SLOTS, ActionContract, ActionMode
 from openral_eval.env_observation import EnvObservation, ObservationLayout
 
+EnvInfo = dict[str, bool | int]
+"""gymnasium's ``info``: ``success`` every step, and the scene's ``seed`` at reset."""
+
 ENV_ID = "openral/Scene-v0"
 """The id :func:`gymnasium.make` knows the scene env by once this module is imported."""
 
@@ -155,7 +158,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[EnvObservation, dict[str, Any]]:
+    ) -> tuple[EnvObservation, EnvInfo]:
         """A new episode: the scene's randomisation drawn from ``seed`` (see the module
         doc); returns the first observation and ``info``."""
         super().reset(seed=seed)
@@ -172,7 +175,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
 
     def step(
         self, action: npt.NDArray[np.float64]
-    ) -> tuple[EnvObservation, SupportsFloat, bool, bool, dict[str, Any]]:
+    ) -> tuple[EnvObservation, SupportsFloat, bool, bool, EnvInfo]:
         """One control period with ``action`` (see the module doc).
 
         Raises:
@@ -244,7 +247,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         return None if handles is None else self._ee.tcp_vector(handles[1])
 
     @staticmethod
-    def _info(*, success: bool) -> dict[str, Any]:
+    def _info(*, success: bool) -> EnvInfo:
         """Only what a trainer needs each step (a vector env merges every key of every env
         on every step: each costs its share of the step)."""
         return {"success": success}
