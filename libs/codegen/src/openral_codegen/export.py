@@ -43,6 +43,12 @@ regeneration would change a byte, add a file or remove one.
 ExportFiles = dict[str, bytes]
 
 
+_PASSES = 2
+"""Derived files are computed twice when the first pass wrote any: the reference's rule
+examples run the validator against the tables on disk, which the first pass may have just
+made current (a changed robot.yaml read as stale otherwise)."""
+
+
 def model_files(root: Path) -> ExportFiles:
     """The generated models package, keyed by repo-relative path."""
     files: ExportFiles = {
@@ -119,8 +125,12 @@ def export(root: Path = REPO_ROOT) -> list[str]:
     """Write the generated tree; returns the repo-relative paths written or deleted."""
     models = model_files(root)
     changed = _write(root, models)
-    planned = {**models, **derived_files(root)}
-    changed += _write(root, planned)
+    for _ in range(_PASSES):
+        planned = {**models, **derived_files(root)}
+        written = _write(root, planned)
+        changed += written
+        if not written:
+            break
     for rel in _existing(root):
         if rel not in planned:
             (root / rel).unlink()
