@@ -26,6 +26,9 @@ from tests.docs.tutorial_runner import (
 )
 
 TUTORIALS = sorted((REPO / "docs" / "tutorials").glob("*.md"))
+REAL_TIME = {"mobile-sensing"}
+"""Tutorials whose printed output is real-time behaviour (the base drives 0.75 m on two
+seconds of wall-clock commands): they run alone, after the others (``exclusive``)."""
 VENV_BIN = REPO / ".venv" / "bin"
 
 
@@ -152,7 +155,13 @@ def test_every_tutorial_has_commands() -> None:
         assert any(isinstance(s, Command) for s in steps), f"{tutorial.name} runs nothing"
 
 
-@pytest.mark.parametrize("tutorial", TUTORIALS, ids=lambda p: p.stem)
+@pytest.mark.parametrize(
+    "tutorial",
+    [
+        pytest.param(t, id=t.stem, marks=[pytest.mark.exclusive] if t.stem in REAL_TIME else [])
+        for t in TUTORIALS
+    ],
+)
 def test_tutorial_commands_run(tutorial: Path, tmp_path: Path, ros_domain: str) -> None:
     sandbox = copy_repository(REPO, tmp_path / "repo")
     logs = tmp_path / "logs"
