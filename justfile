@@ -70,6 +70,10 @@ docs-images *IDS:
 docs-view-image:
     python -m tests.docs.view_screenshot docs/images/browser-view.png
 
+# Redraw the evaluation guide's sweep pictures from the videos of a scripted_lift sweep.
+docs-sweep-images:
+    python -m tests.docs.sweep_pictures
+
 # Fuzz manifests and scenes through load, robot check and the HAL: N cases, counts by outcome, reproducers in fuzz-findings/.
 fuzz N *ARGS:
     python -m tests.fuzz.campaign {{N}} {{ARGS}}

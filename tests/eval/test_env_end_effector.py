@@ -44,7 +44,7 @@ def test_deltas_move_the_tcp_a_centimetre_a_step_holding_its_orientation(panda: 
     for axis, sign in ((0, 1.0), (2, -1.0)):
         action = np.zeros(7)
         action[axis], action[6] = 0.2 * sign, -1.0  # 0.2 x 0.05 m = 1 cm a step; open
-        for _ in range(10):
+        for _ in range(20):  # the issue's line: 20 of +x 0.2, then 20 of -z 0.2
             obs, *_ = panda.step(action)
             tcp = obs["tcp_pose"]
             moves.append((tcp[:3] - previous) @ np.eye(3)[axis] * sign)
@@ -53,32 +53,46 @@ def test_deltas_move_the_tcp_a_centimetre_a_step_holding_its_orientation(panda: 
             q, v = obs["joint_positions"][:7], obs["joint_velocities"][:7]
             assert np.all(q >= low) and np.all(q <= high)
             assert np.all(np.abs(v) <= speed)
-    assert np.all(np.abs(np.array(moves[1:]) - 0.01) <= 0.002), np.round(moves, 4)
-    assert max(turns) <= 0.02, max(turns)
+    assert np.all(np.abs(np.array(moves) - 0.01) <= 0.002), np.round(moves, 4)
+    assert max(turns) <= 0.01, max(turns)
 
 
-def test_a_pose_out_of_reach_stops_at_the_edge_and_does_not_wind_up() -> None:
+@pytest.fixture(scope="module")
+def panda_pose() -> Iterator[SceneEnv]:
     env = make_env(TABLETOP, action_mode="ee_pose", sensors=False)
-    try:
-        obs, _ = env.reset(seed=0)
-        start = obs["tcp_pose"].copy()
-        low, high, speed = _limits(env)
-        far = np.concatenate([[1.5, 0.0, start[2]], start[3:], [1.0]])  # 1.5 m ahead
-        path = []
-        for _ in range(100):  # 5 s
-            obs, *_ = env.step(far)
-            q, v = obs["joint_positions"][:7], obs["joint_velocities"][:7]
-            assert np.all(q >= low) and np.all(q <= high)
-            assert np.all(np.abs(v) <= speed)
-            path.append(obs["tcp_pose"][:3].copy())
-        assert np.linalg.norm(path[-1] - path[-5]) < 0.002  # stopped
-        assert path[-1][0] > start[0] + 0.1  # having gone as far as it could
-        back = np.concatenate([start, [1.0]])
-        for _ in range(40):
-            obs, *_ = env.step(back)
-        assert np.linalg.norm(obs["tcp_pose"][:3] - start[:3]) < 0.01
-    finally:
-        env.close()
+    yield env
+    env.close()
+
+
+@pytest.mark.parametrize(
+    ("x", "z"),
+    [(1.5, None), (1.0, 0.1), (0.0, 1.2), (0.9, 0.9)],
+    ids=["ahead", "ahead-low", "above", "ahead-high"],
+)
+def test_a_pose_out_of_reach_stops_at_the_edge_and_does_not_wind_up(
+    panda_pose: SceneEnv, x: float, z: float | None
+) -> None:
+    """Out and back again: without the IK's pull towards the start pose, two of these
+    left the Panda straightened against joint 4's limit, 0.27 m from its start."""
+    env = panda_pose
+    obs, _ = env.reset(seed=0)
+    start = obs["tcp_pose"].copy()
+    low, high, speed = _limits(env)
+    far = np.concatenate([[x, 0.0, start[2] if z is None else z], start[3:], [1.0]])
+    path = []
+    for _ in range(100):  # 5 s
+        obs, *_ = env.step(far)
+        q, v = obs["joint_positions"][:7], obs["joint_velocities"][:7]
+        assert np.all(q >= low) and np.all(q <= high)
+        assert np.all(np.abs(v) <= speed)
+        path.append(obs["tcp_pose"][:3].copy())
+    assert np.linalg.norm(path[-1] - path[-5]) < 0.002  # stopped
+    gone = np.linalg.norm(start[:3] - far[:3]) - np.linalg.norm(path[-1] - far[:3])
+    assert gone > 0.1  # having gone towards it as far as it could
+    back = np.concatenate([start, [1.0]])
+    for _ in range(60):  # 3 s
+        obs, *_ = env.step(back)
+    assert np.linalg.norm(obs["tcp_pose"][:3] - start[:3]) < 0.01
 
 
 def test_modes_the_scene_or_robot_cannot_take_are_one_clear_error() -> None:

@@ -39,11 +39,18 @@ def test_the_ur10e_connects_and_resets_into_its_start_pose() -> None:
     np.testing.assert_allclose(hal.read_state().positions, expected, atol=SETTLED)
 
 
+FRANKA_START = (
+    "  start_pose: {panda_joint1: 0.0, panda_joint2: -0.785398, panda_joint3: 0.0, "
+    "panda_joint4: -2.356194, panda_joint5: 0.0, panda_joint6: 1.570796, panda_joint7: 0.785398}\n"
+)
+"""franka_panda's own start pose line (Franka's ready pose), replaced by one of one joint."""
+
+
 def test_joints_left_out_of_the_start_pose_keep_the_keyframe(
     write_manifest: ManifestWriter,
 ) -> None:
     path = write_manifest(
-        ("  keyframe_index: 0\n", "  keyframe_index: 0\n  start_pose: {panda_joint1: 0.5}\n"),
+        (FRANKA_START, "  start_pose: {panda_joint1: 0.5}\n"),
         base=FRANKA,
         folder="franka_panda",
     )

@@ -57,6 +57,7 @@ def test_a_manifest_path_runs_as_given_not_the_repository_manifest(
     manifest = franka_copy(
         tmp_path,
         (JOINT7, "name: copied_joint7, sim_joint_name: joint7"),
+        ("panda_joint7: 0.785398}", "copied_joint7: 0.785398}"),  # its start pose
         ("display_name: Franka Emika Panda", "display_name: Copied Panda"),
     )
     probe = Probe(ros_context, {ACTION_SPEC: JointState, JOINT_STATES: JointState}, "load_probe")

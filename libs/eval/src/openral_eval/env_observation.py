@@ -119,11 +119,16 @@ class ObservationLayout:
         }
         if tcp_pose is not None:
             out["tcp_pose"] = tcp_pose
-        self._keep("cameras", dict(obs.images))
-        self._keep("depth", {n: _depth_image(f.depth_m) for n, f in obs.depth.items()})
-        self._keep("lidar", {n: scan.ranges for n, scan in obs.scans.items()})
-        self._keep("state_sensors", {n: _reading(r) for n, r in obs.readings.items()})
-        out.update((kind, _copied(frames)) for kind, frames in self._latest.items() if frames)
+        if obs.images:  # (each kind only when it has news: this runs every step)
+            self._keep("cameras", obs.images)
+        if obs.depth:
+            self._keep("depth", {n: _depth_image(f.depth_m) for n, f in obs.depth.items()})
+        if obs.scans:
+            self._keep("lidar", {n: scan.ranges for n, scan in obs.scans.items()})
+        if obs.readings:
+            self._keep("state_sensors", {n: _reading(r) for n, r in obs.readings.items()})
+        for kind, frames in self._latest.items():
+            out[kind] = _copied(frames)
         cameras = out.get("cameras")
         if isinstance(cameras, dict) and self.slots:
             out["camera_slots"] = {self.slots[n]: cameras[n] for n in self.slots if n in cameras}

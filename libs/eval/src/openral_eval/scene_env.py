@@ -150,6 +150,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         self.box = spaces.Box(low, high, dtype=np.float64)
         """The action space, typed as what it is."""
         self.action_space = self.box
+        self._bounded = bool(np.isfinite(low).all() and np.isfinite(high).all())
         self.steps = 0
         self._limit = self.config.max_steps or scene_horizon(self.hal)
         if self.config.seed is not None:
@@ -194,12 +195,13 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
 
     def checked(self, action: object) -> npt.NDArray[np.float64]:
         """``action`` as float64 values inside the action space, or :class:`ActionRejected`
-        naming the first bad slot."""
-        values = validated_action(action, self.action_names)
+        naming the first bad slot (a NaN is inside no bounds; an infinite value is outside
+        finite ones, so with finite bounds this one comparison is the finite check too)."""
+        values = validated_action(action, self.action_names, finite_checked_by_caller=self._bounded)
         space = self.box
-        outside = (values < space.low) | (values > space.high)
-        if outside.any():
-            i = int(np.argmax(outside))
+        inside = (values >= space.low) & (values <= space.high)
+        if not inside.all():
+            i = int(np.argmin(inside))
             raise ActionRejected(
                 f"action[{i}] ({self.action_names[i]}) is {values[i]:g}; expected within "
                 f"[{space.low[i]:g}, {space.high[i]:g}] ({self.actions.mode.value} mode)"

@@ -104,7 +104,9 @@ class FrameTree:
             FrameTreeError: Two frames share a name.
         """
         self.model, self.tree, self.names, self.base = model, tree, names, base
-        self._origin = _root_origin(tree)
+        self.root_in_base = _root_origin(tree)
+        """The root body's pose in the base frame (position [m], quaternion w, x, y, z)."""
+        self._base_in_root = _inverse_pose(self.root_in_base)
         frames: list[Frame] = [Frame(names.world, "", True), *self._base_frames()]
         link_of = {link.body: link.name for link in tree.links if link.body >= 0}
         body_rows, bodies = [], []
@@ -164,12 +166,10 @@ class FrameTree:
     def base_pose(self, data: mujoco.MjData) -> tuple[FloatArray, FloatArray]:
         """The base frame's world pose (position [m], quaternion w, x, y, z): the root
         body's, less its origin in the base frame."""
-        position, inverse = self._origin
-        root = self.tree.root
-        world, offset = np.empty(4), np.empty(3)
-        mujoco.mju_mulQuat(world, data.xquat[root], inverse)
-        mujoco.mju_rotVecQuat(offset, position, world)
-        return data.xpos[root] - offset, world
+        root, (position, quat) = self.tree.root, self._base_in_root
+        world, world_quat = np.empty(3), np.empty(4)
+        mujoco.mju_mulPose(world, world_quat, data.xpos[root], data.xquat[root], position, quat)
+        return world, world_quat
 
     def _sensor_frame(self, sensor: SensorFrame, link_of: dict[int, str]) -> Frame:
         model = self.model
@@ -228,12 +228,17 @@ def scene_frame_tree(
 
 
 def _root_origin(tree: RobotTree) -> tuple[FloatArray, FloatArray]:
-    """The root body's position in the base frame and the inverse of its orientation there
-    (identity when the root is the base)."""
+    """The root body's pose in the base frame (identity when the root is the base)."""
     for link in tree.links:
         if link.body == tree.root:
-            return np.array(link.position, dtype=np.float64), _conjugate(np.array(link.quat))
+            return np.array(link.position, dtype=np.float64), np.array(link.quat, dtype=np.float64)
     raise FrameTreeError("the robot's tree has no root body")
+
+
+def _inverse_pose(pose: tuple[FloatArray, FloatArray]) -> tuple[FloatArray, FloatArray]:
+    position, quat = np.empty(3), np.empty(4)
+    mujoco.mju_negPose(position, quat, pose[0], pose[1])
+    return position, quat
 
 
 def _sensor_pose(data: mujoco.MjData, sensor: SensorFrame) -> tuple[FloatArray, FloatArray]:
