@@ -3,12 +3,13 @@ of 2 against one env.
 
 On franka_panda's tabletop (20 Hz control): the scene's own ``step(hold)`` on the rollout
 the env wraps, against ``SceneEnv.step(hold)`` (the action check, the HAL, the Dict
-observation), both with cameras off and with both cameras on, interleaved, best of
-``--repeats``. Then ``gymnasium.vector.AsyncVectorEnv`` of 2 (cameras off, one process per
-env) against one env in this process: env steps per second summed over the envs, beside
-the ratio gymnasium's own inter-process steps allow for an env that only burns the same
-time per step (the ceiling: pipes, pickling and the merging of ``info``). Run with
-``just bench-env``.
+observation), both with cameras off and with both cameras on: ``--pairs`` back-to-back
+blocks of each, the overhead from the median of the pairs' ratios. Then
+``gymnasium.vector.AsyncVectorEnv`` of 2 (cameras off, one process per env) against one
+env in this process: env steps per second summed over the envs, beside the ratio
+gymnasium's own inter-process steps allow for an env that only burns the same time per
+step (the ceiling: pipes, pickling and the merging of ``info``). Run with ``just
+bench-env``.
 """
 
 from __future__ import annotations
@@ -45,18 +46,32 @@ def rate(step: Callable[[], object], steps: int) -> float:
     return steps / (time.perf_counter() - start)
 
 
-def step_rates(env: SceneEnv, steps: int, repeats: int) -> tuple[float, float]:
-    """(scene steps/s, env steps/s), best of ``repeats`` interleaved runs."""
+def step_rates(env: SceneEnv, steps: int, pairs: int) -> tuple[float, float]:
+    """(scene steps/s, env steps/s): the medians over ``pairs`` back-to-back blocks of
+    ``steps`` of each, their order swapped every pair (what the machine does meanwhile
+    slows both of a pair alike; a median of pairs, not the best of each, so one quiet
+    moment on one side does not decide the ratio)."""
     scene = env.hal.env
     if not isinstance(scene, SceneRollout):
         raise TypeError("the tabletop is a native scene")
     hold = env.hal.hold_action()
     env.reset(seed=0)
-    best_scene = best_env = 0.0
-    for _ in range(repeats):
-        best_scene = max(best_scene, rate(lambda: scene.step(hold), steps))
-        best_env = max(best_env, rate(lambda: env.step(hold), steps))
-    return best_scene, best_env
+    scene_rates, env_rates = [], []
+    for pair in range(pairs):
+        scene_first = pair % 2 == 0
+        timed = {}
+        for side in ("scene", "env") if scene_first else ("env", "scene"):
+            timed[side] = _block(scene if side == "scene" else env, hold, steps)
+        scene_rates.append(timed["scene"])
+        env_rates.append(timed["env"])
+    ratios = np.array(scene_rates) / np.array(env_rates)
+    median_scene = float(np.median(scene_rates))
+    return median_scene, median_scene / float(np.median(ratios))
+
+
+def _block(stepper: SceneRollout | SceneEnv, hold: np.ndarray, steps: int) -> float:
+    """Steps/s of ``steps`` of ``stepper.step(hold)``."""
+    return rate(lambda: stepper.step(hold), steps)
 
 
 class BusyEnv(gymnasium.Env[dict[str, np.ndarray], np.ndarray]):
@@ -122,20 +137,24 @@ def vector_speedup(steps: int, repeats: int) -> tuple[float, float]:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--steps", type=int, default=400, help="timed steps per run")
-    parser.add_argument("--repeats", type=int, default=5, help="interleaved runs")
+    parser.add_argument("--repeats", type=int, default=5, help="interleaved vector-env runs")
+    parser.add_argument("--pairs", type=int, default=30, help="scene/env block pairs")
     args = parser.parse_args()
     console = Console()
     rates: dict[str, tuple[float, float]] = {}
     with console.status("measuring the env step"):
         for label, sensors in (("cameras off", False), ("2 cameras on", True)):
             env = make_env(SCENE, sensors=sensors)
-            steps = args.steps if sensors is False else args.steps // 4
-            rates[label] = step_rates(env, steps, args.repeats)
+            steps = args.steps // 4 if sensors is False else args.steps // 40
+            rates[label] = step_rates(env, steps, args.pairs)
             env.close()
     with console.status("measuring a vector env of 2"):
         one, two = vector_speedup(args.steps, args.repeats)
         bound = ceiling(1.0 / one, args.steps, args.repeats)
-    table = Table(title=f"franka_panda tabletop, 20 Hz control (best of {args.repeats})")
+    table = Table(
+        title=f"franka_panda tabletop, 20 Hz control (env: median of {args.pairs} pairs; "
+        f"vector: best of {args.repeats})"
+    )
     for column in ("case", "scene steps/s", "env steps/s", "env overhead"):
         table.add_column(column, justify="left" if column == "case" else "right")
     overheads = {}
@@ -158,6 +177,7 @@ def main() -> int:
         {
             "steps": args.steps,
             "repeats": args.repeats,
+            "pairs": args.pairs,
             "rates": {k: {"scene": s, "env": e} for k, (s, e) in rates.items()},
             "overhead": overheads,
             "one_env_steps_per_s": one,
