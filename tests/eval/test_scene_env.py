@@ -17,7 +17,7 @@ from openral_eval.episode import EpisodeSpec, close_scenes, run_episode
 from openral_eval.episode_frames import as_stored
 from openral_eval.policies import POLICIES, PolicyEntry
 from openral_eval.policy import Observation
-from openral_eval.scene_env import ENV_ID, SceneEnv, make_env
+from openral_eval.scene_env import ENV_ID, SceneEnv, make_env, make_vector_env
 from openral_eval.wave import WaveConfig
 from openral_mujoco.errors import ActionRejected
 
@@ -159,6 +159,22 @@ def test_a_vector_env_matches_single_envs_step_for_step() -> None:
     finally:
         vector.close()
     assert [d.hexdigest() for d in digests] == expected
+
+
+def test_a_vector_env_with_cameras_runs_in_fresh_processes() -> None:
+    """Cameras on, the workers must not be forked from a process that has rendered (the
+    env's spaces come from a first env built here): make_vector_env starts them afresh."""
+    vector = make_vector_env(TABLETOP, 2, sensors=["agentview"])
+    try:
+        obs, _ = vector.reset(seed=[1, 2])
+        assert obs["cameras"]["agentview"].shape == (2, 128, 128, 3)
+        assert obs["camera_slots"]["camera1"].shape == (2, 128, 128, 3)
+        first = obs["cameras"]["agentview"].copy()
+        obs, *_ = vector.step(np.stack([vector.single_action_space.sample()] * 2))
+        assert obs["cameras"]["agentview"].std() > 5  # a picture, not a blank buffer
+        assert not np.array_equal(first[0], first[1])  # two seeds, two cube placements
+    finally:
+        vector.close()
 
 
 class _Recorder:

@@ -4,6 +4,7 @@ a process), and both keep rendering."""
 
 from __future__ import annotations
 
+import multiprocessing
 import threading
 import time
 from collections.abc import Callable
@@ -12,6 +13,7 @@ import mujoco
 import pytest
 from openral_core import open_robot_by_id
 from openral_core.loader import load_scene
+from openral_sim.gl_guard import InheritedGlError, close_renderer, open_renderer
 from openral_sim.native_scene import NativeScene
 from openral_sim.sensor_sources import FrameCapture
 
@@ -79,3 +81,41 @@ def test_camera_and_depth_threads_never_render_at_once(monkeypatch: pytest.Monke
         scene.close()
     assert len(rgb_frames) >= 2 and len(depth_frames) >= 2
     assert overlap.most == 1
+
+
+_SMALL = '<mujoco><worldbody><geom type="box" size=".1 .1 .1"/></worldbody></mujoco>'
+
+
+def _render_in_child(queue: multiprocessing.Queue[str]) -> None:
+    model = mujoco.MjModel.from_xml_string(_SMALL)
+    try:
+        close_renderer(open_renderer(model, 32, 32))
+        queue.put("rendered")
+    except InheritedGlError as error:
+        queue.put(str(error))
+
+
+def test_a_process_forked_after_opening_gl_refuses_to_render_instead_of_hanging() -> None:
+    """Measured without the guard: the child's first renderer waits forever (both with
+    the parent's renderer still open and closed)."""
+    close_renderer(open_renderer(mujoco.MjModel.from_xml_string(_SMALL), 32, 32))
+    fork = multiprocessing.get_context("fork")
+    queue: multiprocessing.Queue[str] = fork.Queue()
+    child = fork.Process(target=_render_in_child, args=(queue,))
+    child.start()
+    try:
+        said = queue.get(timeout=30)
+    finally:
+        child.join(5)
+        if child.is_alive():
+            child.kill()
+    assert "was forked from process" in said and "'forkserver'" in said, said
+    assert said.count("\n") == 0
+    fresh = multiprocessing.get_context("forkserver")
+    queue = fresh.Queue()
+    child = fresh.Process(target=_render_in_child, args=(queue,))
+    child.start()
+    try:
+        assert queue.get(timeout=60) == "rendered"
+    finally:
+        child.join(5)

@@ -3,8 +3,8 @@ gymnasium env of a scene file.
 
 Between the HAL and the apps: an episode drives a scene through the same HAL contract as
 ``deploy sim`` (:class:`~openral_hal.sim_attached.SimAttachedHAL`), without ROS.
-``make_env`` and ``SceneEnv`` are imported on first use (gymnasium is not loaded by the CLI's
-other commands).
+``make_env``, ``make_vector_env`` and ``SceneEnv`` are imported on first use (gymnasium is
+not loaded by the CLI's other commands).
 """
 
 from __future__ import annotations
@@ -12,13 +12,14 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from openral_eval.scene_env import EnvConfig, SceneEnv, make_env
+    from openral_eval.scene_env import EnvConfig, SceneEnv, make_env, make_vector_env
 
-__all__ = ["EnvConfig", "SceneEnv", "make_env"]
+__all__ = ["EnvConfig", "SceneEnv", "make_env", "make_vector_env"]
 
 
 def __getattr__(name: str) -> object:
-    """``make_env``, ``SceneEnv`` and ``EnvConfig`` from :mod:`openral_eval.scene_env`."""
+    """``make_env``, ``make_vector_env``, ``SceneEnv`` and ``EnvConfig`` from
+    :mod:`openral_eval.scene_env`."""
     if name in __all__:
         from openral_eval import scene_env
 

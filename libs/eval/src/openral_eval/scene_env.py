@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, fields, replace
+from functools import partial
 from pathlib import Path
 from typing import Any, SupportsFloat, cast
 
@@ -302,6 +303,28 @@ def scene_horizon(hal: SimAttachedHAL) -> int | None:
 def make_env(scene: str | Path, **config: object) -> SceneEnv:
     """The env of ``scene``; ``config``: the other :class:`EnvConfig` fields."""
     return SceneEnv({"scene": str(scene), **config})
+
+
+def make_vector_env(
+    scene: str | Path, num_envs: int, **config: object
+) -> gymnasium.vector.AsyncVectorEnv:
+    """``num_envs`` envs of ``scene`` (``config``: as :func:`make_env`), each in a process
+    of its own: forked from this one when nothing is rendered, else started afresh
+    (``forkserver``: a process forked after this one has rendered cannot render; see
+    :mod:`openral_sim.gl_guard`). Call it under ``if __name__ == "__main__":`` when
+    rendering (a fresh process imports the main module again).
+
+    Raises:
+        ValueError: ``num_envs`` below 1 (a bad config fails in the first env, built
+            here to learn the spaces).
+    """
+    if num_envs < 1:
+        raise ValueError(f"num_envs is {num_envs}; expected at least 1")
+    renders = config.get("sensors", True) is not False or config.get("render_mode") is not None
+    build = partial(make_env, str(scene), **config)
+    return gymnasium.vector.AsyncVectorEnv(
+        [build] * num_envs, context="forkserver" if renders else "fork"
+    )
 
 
 gymnasium.register(id=ENV_ID, entry_point=f"{__name__}:SceneEnv")

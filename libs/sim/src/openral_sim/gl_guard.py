@@ -9,6 +9,12 @@ renderers made and freed on a fourth, so the race is rare and sits below our cod
 software rasterizer, llvmpipe, is the suspect). Every MuJoCo render, renderer creation and
 free in :mod:`openral_sim` therefore holds :data:`GL_LOCK`.
 
+A process forked from one that has opened a context cannot render: the driver's threads
+(llvmpipe's) do not survive the fork, and its first context waits for them forever (seen:
+gymnasium's ``AsyncVectorEnv`` with cameras on, whose default start method forks after its
+first env was built in the parent). :func:`open_renderer` refuses that in one line naming
+the way out, a process started afresh (``forkserver`` or ``spawn``).
+
 Cost: llvmpipe already spreads one render over every core, so two renders at once only
 share the cores two ways; serialized, a frame waits at most for one other frame, which the
 frame renderers' retry (:mod:`openral_bridge.frame_renderer`) absorbs. Checked by the
@@ -18,22 +24,46 @@ fresh clone); the camera benchmarks were not re-run with it.
 
 from __future__ import annotations
 
+import os
 import threading
 
 import mujoco
+from openral_mujoco.errors import HalError
 
-__all__ = ["GL_LOCK", "close_renderer", "open_renderer"]
+__all__ = ["GL_LOCK", "InheritedGlError", "close_renderer", "open_renderer"]
 
 GL_LOCK = threading.Lock()
 """Held around every OpenGL call this package makes (never while waiting on anything
 else, so it cannot deadlock with the HAL's lock)."""
 
 
+_opened_in: int | None = None
+"""The process that opened this module's first GL context (a forked child inherits it)."""
+
+
+class InheritedGlError(HalError):
+    """This process was forked from one that had opened OpenGL contexts; it cannot render."""
+
+
 def open_renderer(model: mujoco.MjModel, height: int, width: int) -> mujoco.Renderer:
     """A ``mujoco.Renderer`` of ``model`` at ``height`` x ``width`` [px], made holding
-    :data:`GL_LOCK` (its context belongs to the calling thread)."""
+    :data:`GL_LOCK` (its context belongs to the calling thread).
+
+    Raises:
+        InheritedGlError: This process was forked after its parent had opened a context.
+    """
+    global _opened_in
+    if _opened_in is not None and _opened_in != os.getpid():
+        raise InheritedGlError(
+            f"process {os.getpid()} was forked from process {_opened_in} after it had "
+            "opened OpenGL contexts, and cannot render (the renderer would wait forever); "
+            "start it afresh instead: multiprocessing's 'forkserver' or 'spawn' (gymnasium: "
+            "AsyncVectorEnv(..., context='forkserver')), or render nothing (sensors=False)"
+        )
     with GL_LOCK:
-        return mujoco.Renderer(model, height, width)
+        renderer = mujoco.Renderer(model, height, width)
+    _opened_in = os.getpid()
+    return renderer
 
 
 def close_renderer(renderer: mujoco.Renderer) -> None:
