@@ -177,6 +177,21 @@ def test_a_vector_env_with_cameras_runs_in_fresh_processes() -> None:
         vector.close()
 
 
+def test_a_robosuite_vector_env_without_cameras_observes_none_and_does_not_hang() -> None:
+    """robosuite renders its scene's cameras whatever the env asks: the observation leaves
+    them out when ``sensors=False``, and its workers start afresh (forked after robosuite
+    opened its renderer, they waited forever)."""
+    robosuite = TABLETOP.parent / "lift_robosuite.yaml"
+    vector = make_vector_env(robosuite, 2, sensors=False)
+    try:
+        obs, _ = vector.reset(seed=[1, 2])
+        assert sorted(obs) == ["joint_positions", "joint_velocities"]
+        obs, *_ = vector.step(np.stack([vector.single_action_space.sample()] * 2))
+        assert obs["joint_positions"].shape[0] == 2
+    finally:
+        vector.close()
+
+
 class _Recorder:
     """Hold plus seeded noise on every slot (clamped by the episode), remembering each action."""
 

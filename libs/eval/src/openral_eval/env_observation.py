@@ -80,11 +80,18 @@ class ObservationLayout:
         *,
         privileged: bool,
         tcp_pose: npt.NDArray[np.float64] | None = None,
+        only: frozenset[str] | None = None,
     ) -> None:
         """Lay out the space from ``first``, an observation with every sensor's frame, and
-        the HAL's joint sample of the same instant."""
+        the HAL's joint sample of the same instant; ``only``: keep just these sensors (for
+        a backend that renders every camera whatever the env asks; None: all it gives)."""
+        self.only = only
         slots = {slot.sensor: slot.slot for slot in robot.tables.vla_slots}
-        self.slots = {sensor: slot for sensor, slot in slots.items() if sensor in first.images}
+        self.slots = {
+            sensor: slot
+            for sensor, slot in slots.items()
+            if sensor in first.images and (only is None or sensor in only)
+        }
         self.privileged = privileged
         self._latest: dict[str, dict[str, object]] = {}
         """Sensor kind → sensor → its newest frame."""
@@ -143,7 +150,11 @@ class ObservationLayout:
         return out
 
     def _keep(self, kind: str, frames: Mapping[str, object]) -> None:
-        """Remember the newest frame of each sensor of ``kind``."""
+        """Remember the newest frame of each sensor of ``kind`` (of ``only``'s)."""
+        if self.only is not None:
+            frames = {name: frame for name, frame in frames.items() if name in self.only}
+            if not frames:
+                return
         self._latest.setdefault(kind, {}).update(frames)
 
 

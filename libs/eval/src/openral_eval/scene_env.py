@@ -36,6 +36,7 @@ import numpy.typing as npt
 from gymnasium import spaces
 from openral_core.loaded import LoadedRobot
 from openral_core.loader import load_scene
+from openral_core.models import Backend
 from openral_hal.factory import HalMode, build_hal
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_hal.tool_centre import ee_command
@@ -140,6 +141,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
             self.hal.read_state(),
             privileged=self.config.privileged,
             tcp_pose=self.tcp_pose(),
+            only=None if isinstance(self.hal.env, SceneRollout) else self._observed,
         )
         self.observation_space = cast(spaces.Space[EnvObservation], self.layout.space)
         self.actions = ActionContract(
@@ -309,7 +311,8 @@ def make_vector_env(
     scene: str | Path, num_envs: int, **config: object
 ) -> gymnasium.vector.AsyncVectorEnv:
     """``num_envs`` envs of ``scene`` (``config``: as :func:`make_env`), each in a process
-    of its own: forked from this one when nothing is rendered, else started afresh
+    of its own: forked from this one when nothing is rendered (a robosuite scene always
+    renders), else started afresh
     (``forkserver``: a process forked after this one has rendered cannot render; see
     :mod:`openral_sim.gl_guard`). Call it under ``if __name__ == "__main__":`` when
     rendering (a fresh process imports the main module again).
@@ -320,7 +323,11 @@ def make_vector_env(
     """
     if num_envs < 1:
         raise ValueError(f"num_envs is {num_envs}; expected at least 1")
-    renders = config.get("sensors", True) is not False or config.get("render_mode") is not None
+    renders = (
+        config.get("sensors", True) is not False
+        or config.get("render_mode") is not None
+        or load_scene(Path(scene)).scene.backend is Backend.robosuite  # renders regardless
+    )
     build = partial(make_env, str(scene), **config)
     return gymnasium.vector.AsyncVectorEnv(
         [build] * num_envs, context="forkserver" if renders else "fork"

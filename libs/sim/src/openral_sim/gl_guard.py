@@ -12,8 +12,9 @@ free in :mod:`openral_sim` therefore holds :data:`GL_LOCK`.
 A process forked from one that has opened a context cannot render: the driver's threads
 (llvmpipe's) do not survive the fork, and its first context waits for them forever (seen:
 gymnasium's ``AsyncVectorEnv`` with cameras on, whose default start method forks after its
-first env was built in the parent). :func:`open_renderer` refuses that in one line naming
-the way out, a process started afresh (``forkserver`` or ``spawn``).
+first env was built in the parent). :func:`open_renderer` (and :func:`claim_gl`, which a
+library's own renderer is announced with) refuses that in one line naming the way out, a
+process started afresh (``forkserver`` or ``spawn``).
 
 Cost: llvmpipe already spreads one render over every core, so two renders at once only
 share the cores two ways; serialized, a frame waits at most for one other frame, which the
@@ -30,7 +31,7 @@ import threading
 import mujoco
 from openral_mujoco.errors import HalError
 
-__all__ = ["GL_LOCK", "InheritedGlError", "close_renderer", "open_renderer"]
+__all__ = ["GL_LOCK", "InheritedGlError", "claim_gl", "close_renderer", "open_renderer"]
 
 GL_LOCK = threading.Lock()
 """Held around every OpenGL call this package makes (never while waiting on anything
@@ -45,9 +46,9 @@ class InheritedGlError(HalError):
     """This process was forked from one that had opened OpenGL contexts; it cannot render."""
 
 
-def open_renderer(model: mujoco.MjModel, height: int, width: int) -> mujoco.Renderer:
-    """A ``mujoco.Renderer`` of ``model`` at ``height`` x ``width`` [px], made holding
-    :data:`GL_LOCK` (its context belongs to the calling thread).
+def claim_gl() -> None:
+    """Record that this process opens OpenGL contexts now (a renderer of ours, or one a
+    library such as robosuite makes itself).
 
     Raises:
         InheritedGlError: This process was forked after its parent had opened a context.
@@ -60,10 +61,19 @@ def open_renderer(model: mujoco.MjModel, height: int, width: int) -> mujoco.Rend
             "start it afresh instead: multiprocessing's 'forkserver' or 'spawn' (gymnasium: "
             "AsyncVectorEnv(..., context='forkserver')), or render nothing (sensors=False)"
         )
-    with GL_LOCK:
-        renderer = mujoco.Renderer(model, height, width)
     _opened_in = os.getpid()
-    return renderer
+
+
+def open_renderer(model: mujoco.MjModel, height: int, width: int) -> mujoco.Renderer:
+    """A ``mujoco.Renderer`` of ``model`` at ``height`` x ``width`` [px], made holding
+    :data:`GL_LOCK` (its context belongs to the calling thread).
+
+    Raises:
+        InheritedGlError: This process was forked after its parent had opened a context.
+    """
+    claim_gl()
+    with GL_LOCK:
+        return mujoco.Renderer(model, height, width)
 
 
 def close_renderer(renderer: mujoco.Renderer) -> None:

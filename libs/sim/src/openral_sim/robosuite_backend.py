@@ -47,6 +47,7 @@ from openral_core.located import error_at, source_of
 from openral_core.models import DeployScene, RgbSensor, RobotDescription
 from openral_core.registry import load_robot_by_id
 
+from openral_sim.gl_guard import claim_gl
 from openral_sim.observation import Observation, Outcome, StepResult
 from openral_sim.sensor_schedule import SensorSchedule, sensor_rates
 
@@ -309,6 +310,8 @@ def _make_env(
 ) -> Any:
     """``robosuite.make`` with offscreen cameras; ``options`` are passed on as they are."""
     width, height = size
+    if cameras:
+        claim_gl()  # robosuite's offscreen renderer
     try:
         return robosuite.make(
             env_name,
