@@ -311,11 +311,10 @@ def make_vector_env(
     scene: str | Path, num_envs: int, **config: object
 ) -> gymnasium.vector.AsyncVectorEnv:
     """``num_envs`` envs of ``scene`` (``config``: as :func:`make_env`), each in a process
-    of its own: forked from this one when nothing is rendered (a robosuite scene always
-    renders), else started afresh
-    (``forkserver``: a process forked after this one has rendered cannot render; see
-    :mod:`openral_sim.gl_guard`). Call it under ``if __name__ == "__main__":`` when
-    rendering (a fresh process imports the main module again).
+    of its own: forked from this one when nothing is rendered, else started afresh with
+    ``forkserver`` (a process forked after this one has rendered cannot render, see
+    :mod:`openral_sim.gl_guard`; a robosuite scene always renders). Call it under ``if
+    __name__ == "__main__":`` when rendering (a fresh process imports the main module).
 
     Raises:
         ValueError: ``num_envs`` below 1 (a bad config fails in the first env, built

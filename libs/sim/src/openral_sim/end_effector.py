@@ -67,7 +67,7 @@ _POSTURE_GAIN = 0.2
 """Share of the way to the start pose that pull asks for in one step. Where the task has
 no say (the arm's redundant swivel) the arm moves about half of this a step: 0.1 is too
 little to leave the straightened elbow, 0.3 swivels a Panda holding a cube fast enough
-to lose it (scripted_lift 18 → 13 in 20)."""
+to lose it (scripted_lift on 20 seeds: 18 lifted at 0.2, 13 at 0.3)."""
 _INACTIVE = -1e30
 """daqp's "no lower bound" on a constraint row."""
 _SPEED_SHARE = 0.8
