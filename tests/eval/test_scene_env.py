@@ -192,6 +192,11 @@ def test_a_robosuite_vector_env_without_cameras_observes_none_and_does_not_hang(
         vector.close()
 
 
+def test_a_vector_env_of_no_envs_is_one_clear_error() -> None:
+    with pytest.raises(ValueError, match="num_envs is 0; expected at least 1"):
+        make_vector_env(TABLETOP, 0, sensors=False)
+
+
 class _Recorder:
     """Hold plus seeded noise on every slot (clamped by the episode), remembering each action."""
 
