@@ -23,7 +23,7 @@ from openral_mujoco.errors import HalError
 from openral_mujoco.mjcf_uri import robot_model_file
 from openral_mujoco.mobile_base import base_model_file, base_spec, cached_base_model
 from openral_mujoco.model_cache import cached_model
-from openral_mujoco.model_check import cached_robot_model, require_agreement
+from openral_mujoco.model_check import cached_robot_model, require_agreement, unloadable_model
 from openral_mujoco.robot_addresses import RobotAddresses, locate_robot
 from openral_mujoco.robot_edits import edit_robot_spec, robot_cache_kind
 
@@ -133,6 +133,20 @@ def robot_alone(robot: LoadedRobot) -> RobotAlone:
 
 def _alone(robot: RobotDescription, models: RobotModels) -> mujoco.MjModel:
     spec = mujoco.MjSpec()
-    child = edit_robot_spec(mujoco.MjSpec.from_file(str(models.path)), robot)
+    child = robot_spec(robot, models.path)
     attach_robot(spec, child, robot, models, spec.worldbody.add_frame())
     return spec.compile()
+
+
+def robot_spec(robot: RobotDescription, path: Path) -> mujoco.MjSpec:
+    """The robot's own model at ``path`` as a spec to attach, edited as its manifest asks.
+
+    Raises:
+        ManifestError: At ``sim.mjcf_uri`` when MuJoCo cannot read the file, or at
+            ``sim.visual_mesh_faces`` (:func:`~openral_mujoco.robot_edits.edit_robot_spec`).
+    """
+    try:
+        spec = mujoco.MjSpec.from_file(str(path))
+    except ValueError as error:
+        raise unloadable_model(robot, path, error) from None
+    return edit_robot_spec(spec, robot)

@@ -5,7 +5,7 @@ physics options, floor, lights and sky, an optional table and pedestal, the scen
 the sensor sites (lidars, IMUs, force-torque and pose sensors) the manifest mounts on the
 robot's bodies, and the MuJoCo sensors a state sensor asks for
 (:mod:`openral_sim.state_sensors`). The robot's own file is edited as its manifest asks
-(:mod:`openral_mujoco.robot_edits`: gravity compensation, lighter visual meshes).
+(:func:`openral_sim.scene_base.robot_spec`: gravity compensation, lighter visual meshes).
 
 Every fault is reported at its field of the scene file or the manifest.
 """
@@ -29,9 +29,8 @@ from openral_core.models import (
     SceneObject,
 )
 from openral_mujoco.model_cache import cached_model, code_digest
-from openral_mujoco.model_check import require_agreement, unloadable_model
+from openral_mujoco.model_check import require_agreement
 from openral_mujoco.robot_bodies import root_body
-from openral_mujoco.robot_edits import edit_robot_spec
 
 from openral_sim.camera_framing import place_fixed_cameras
 from openral_sim.scene_base import (
@@ -39,6 +38,7 @@ from openral_sim.scene_base import (
     add_sensor_sites,
     attach_robot,
     robot_models,
+    robot_spec,
 )
 from openral_sim.scene_cameras import add_fixed_cameras, add_mounted_cameras, rotate_about_z
 from openral_sim.scene_checks import check_object_names, check_weld
@@ -51,20 +51,6 @@ BASE_WELD = "scene_base_weld"
 """Name of the equality constraint that holds a welded floating base."""
 PHYSICS_OPTIONS = tuple(key for key in dir(mujoco.MjSpec().option) if not key.startswith("_"))
 """Every ``<option>`` of MjSpec (timestep, integrator, solver, tolerances, gravity, flags…)."""
-
-
-def robot_spec(robot: RobotDescription, path: Path) -> mujoco.MjSpec:
-    """The robot's own model at ``path`` as a spec to attach, edited as its manifest asks.
-
-    Raises:
-        ManifestError: At ``sim.mjcf_uri`` when MuJoCo cannot read the file, or at
-            ``sim.visual_mesh_faces`` (:func:`~openral_mujoco.robot_edits.edit_robot_spec`).
-    """
-    try:
-        spec = mujoco.MjSpec.from_file(str(path))
-    except ValueError as error:
-        raise unloadable_model(robot, path, error) from None
-    return edit_robot_spec(spec, robot)
 
 
 @dataclass(frozen=True)
