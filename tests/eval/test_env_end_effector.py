@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
+import mujoco
 import numpy as np
 import pytest
 from openral_core.models import LimitedJoint
@@ -153,5 +154,34 @@ def test_an_ee_pose_without_an_orientation_is_refused_and_nothing_moves() -> Non
         np.testing.assert_array_equal(after.positions, before.positions)
         obs, *_ = env.step(np.concatenate([obs["tcp_pose"], [1.0]]))  # a good one still works
         assert np.linalg.norm(obs["tcp_pose"][:3] - zero[:3]) < 0.01
+    finally:
+        env.close()
+
+
+@pytest.mark.parametrize("scene", [TABLETOP, ROBOTS / "panda_mobile" / "scenes" / "room.yaml"])
+def test_the_observed_tcp_pose_is_the_iks_own_tcp_in_the_base_frame(scene: object) -> None:
+    """``tcp_vector`` (MuJoCo's pose routines on rows of the data, in every observation)
+    against mink's composition the IK itself uses (base frame inverse times the TCP frame
+    and flange), on random arm poses; panda_mobile's arm root is offset from its base."""
+    env = make_env(scene, action_mode="ee_pose", sensors=False)
+    try:
+        env.reset(seed=0)
+        command = env.actions.ee
+        assert command is not None
+        model, data = env.hal.mujoco_handles()
+        arm = command.ee._arm_qpos
+        rng = np.random.default_rng(3)
+        for _ in range(20):
+            data.qpos[arm] = model.qpos0[arm] + rng.uniform(-0.5, 0.5, len(arm))
+            mujoco.mj_kinematics(model, data)
+            mine = command.tcp_vector(data)
+            theirs = (
+                command.base(data)
+                .inverse()
+                .multiply(command.ee.commanded_pose(data, data.qpos[arm]))
+            )
+            np.testing.assert_allclose(mine[:3], theirs.translation(), atol=1e-12)
+            quat = theirs.rotation().wxyz  # a rotation has two quaternions: q and -q
+            assert min(np.abs(mine[3:] - quat).max(), np.abs(mine[3:] + quat).max()) < 1e-12
     finally:
         env.close()

@@ -144,13 +144,6 @@ class EndEffector:
             return data.site_xpos[self.frame], quat
         return data.xpos[self.frame], data.xquat[self.frame]
 
-    def world_pose(self, data: mujoco.MjData) -> tuple[FloatArray, FloatArray]:
-        """The TCP's world position [m] and orientation (w, x, y, z) as ``data`` holds them
-        (MuJoCo's own pose routines: it is in every observation)."""
-        position, quat = np.empty(3), np.empty(4)
-        mujoco.mju_mulPose(position, quat, *self.frame_pose(data), self.offset, self.flange_quat)
-        return position, quat
-
     def commanded_pose(self, data: mujoco.MjData, commanded: FloatArray) -> mink.SE3:
         """The TCP's world pose with the arm at its ``commanded`` targets (the rest of the
         state from ``data``)."""
