@@ -89,8 +89,8 @@ def test_variant_errors_explain_the_discriminator(write_manifest: ManifestWriter
     messages = {m["field"]: m["msg"] for m in _issues(path)}
     assert messages["sensors[3]"] == "missing required field 'site' (because kind is 'lidar')"
     assert messages["sensors[0].site"] == (
-        "unknown field 'site'; expected one of: camera, fovy_deg, frame_id, height, kind, "
-        "mount_axis, mount_body, mount_position_m, name, rate_hz, robosuite_camera, "
+        "unknown field 'site'; expected one of: camera, device, fovy_deg, frame_id, height, "
+        "kind, mount_axis, mount_body, mount_position_m, name, rate_hz, robosuite_camera, "
         "vla_feature_key, width (because kind is 'rgb')"
     )
 

@@ -7,7 +7,7 @@ from pydantic import ConfigDict, Field, StrictFloat, StrictInt, StrictStr
 from typing import Annotated, Literal
 from openral_base import OpenralModel
 from typing_extensions import TypeAliasType
-from . import sim_schema
+from . import real_schema, sim_schema
 
 
 class Base(StrEnum):
@@ -220,6 +220,16 @@ class RgbSensor(OpenralModel):
     ] = None
     """
     LeRobot-style observation key a vision-language-action policy expects this camera under, `observation.images.<slot>`. Only for rgb sensors. The slot (the part after the last dot) is what policies look frames up by.
+    """
+    device: Annotated[
+        StrictStr | None,
+        Field(
+            examples=["0", "/dev/video2", "file:tests/fixtures/video/front.mp4"],
+            pattern="^([0-9]{1,3}|/dev/[A-Za-z0-9_./-]{1,120}|file:[^\\u0000]{1,500})$",
+        ),
+    ] = None
+    """
+    Where a real robot's frames come from (`deploy real`; a simulation ignores it): a camera index (`0`), a V4L2 device path (`/dev/video0`) or a video file (`file:clips/front.mp4`, looped; relative to the working directory), read with OpenCV at `rate_hz` and scaled to width x height. Absent: the sensor is not published on the real robot unless `--camera NAME=DEVICE` names one. A device that cannot be opened stops the bring-up with one line.
     """
 
 
@@ -841,4 +851,8 @@ class RobotDescription(OpenralModel):
     sim: sim_schema.SimDescription | None = None
     """
     MuJoCo wiring: where the model comes from and how joints map to qpos, qvel and actuators. Absent for robots that have no simulation model.
+    """
+    real: real_schema.RealDescription | None = None
+    """
+    How the physical robot is driven (driver, control rate, E-stop and shutdown behaviour, the servo bus); see RealDescription. Absent: the robot has no real driver and `build_hal(mode="real")` refuses it.
     """

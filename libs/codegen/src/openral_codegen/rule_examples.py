@@ -26,6 +26,30 @@ MOBILE_FILE = "robots/panda_mobile/robot.yaml"
 UR10E_FILE = "robots/ur10e/robot.yaml"
 H1_FILE = "robots/h1/robot.yaml"
 SCENE_FILE = "robots/franka_panda/scenes/tabletop.yaml"
+SO101_FILE = "robots/so101/robot.yaml"
+SO101_FEETECH_SECTION = """\
+  feetech:
+    servo_model: sts3215
+    baud_rate: 1000000
+    protocol: 0
+    motors:
+      - {joint: shoulder_pan, id: 1}
+      - {joint: shoulder_lift, id: 2}
+      - {joint: elbow_flex, id: 3}
+      - {joint: wrist_flex, id: 4}
+      - {joint: wrist_roll, id: 5}
+      - {joint: gripper, id: 6}
+    calibration: {lerobot_robot_type: so101_follower}
+    settings:  # as LeRobot's follower configures its servos
+      Return_Delay_Time: 0
+      Acceleration: 254
+      P_Coefficient: 16
+      I_Coefficient: 0
+      D_Coefficient: 32
+    joint_settings:
+      gripper: {Max_Torque_Limit: 500, Protection_Current: 250, Overload_Torque: 25}  # LeRobot's
+"""
+"""The so101's whole Feetech bus section (rule 20's example leaves it out)."""
 
 
 @dataclass(frozen=True)
@@ -153,6 +177,38 @@ RULE_BREAKS = (
         "tcp: {body: hand,",
         "tcp: {body: hand, site: hand_site,",
     ),
+    RuleBreak(
+        SchemaName.ROBOT,
+        20,
+        SO101_FILE,
+        SO101_FEETECH_SECTION,
+        "",
+    ),
+    RuleBreak(
+        SchemaName.ROBOT,
+        21,
+        SO101_FILE,
+        "      - {joint: wrist_roll, id: 5}\n",
+        "",
+    ),
+    RuleBreak(
+        SchemaName.ROBOT, 22, SO101_FILE, "{joint: gripper, id: 6}", "{joint: gripper, id: 5}"
+    ),
+    RuleBreak(
+        SchemaName.ROBOT,
+        23,
+        SO101_FILE,
+        "{name: wrist_roll, type: revolute, position_limits: [-2.743847, 2.841206]",
+        "{name: wrist_roll, type: revolute, position_limits: [-3.5, 3.5]",
+    ),
+    RuleBreak(
+        SchemaName.ROBOT,
+        24,
+        SO101_FILE,
+        "      gripper: {Max_Torque_Limit: 500,",
+        "      jaw: {Max_Torque_Limit: 500,",
+    ),
+    RuleBreak(SchemaName.ROBOT, 25, SO101_FILE, "    protocol: 0\n", "    protocol: 1\n"),
     RuleBreak(
         SchemaName.SCENE,
         1,

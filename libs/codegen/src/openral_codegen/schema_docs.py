@@ -79,6 +79,7 @@ PAGES = (
         title="Grippers",
         intro=GRIPPER_INTRO,
     ),
+    ReferencePage("real", SchemaName.REAL),
     ReferencePage("scene", SchemaName.SCENE),
 )
 """Every reference page, in navigation order."""
@@ -224,7 +225,7 @@ class _Renderer:
             "## Rules checked after the schema\n",
             f"{prose(head)}.\n" if numbered else f"{prose(comment)}\n",
         ]
-        if name is SchemaName.SIM:
+        if name in (SchemaName.SIM, SchemaName.REAL):
             lines.append(
                 "They are listed, each with the error it produces, under "
                 "[RobotDescription: rules](robot.md#rules-checked-after-the-schema).\n"

@@ -6,6 +6,13 @@ here so user code never depends on generated module names.
 
 from __future__ import annotations
 
+from openral_generated.models.real_schema import (
+    FeetechBus,
+    FeetechCalibration,
+    FeetechMotor,
+    FeetechSettings,
+    RealDescription,
+)
 from openral_generated.models.robot_schema import (
     Base,
     ContinuousJoint,
@@ -71,6 +78,10 @@ __all__ = [
     "DepthSensor",
     "DriveAxes",
     "DriveKind",
+    "FeetechBus",
+    "FeetechCalibration",
+    "FeetechMotor",
+    "FeetechSettings",
     "ForceTorqueSensor",
     "Frames",
     "GripperHolds",
@@ -89,6 +100,7 @@ __all__ = [
     "PoseSensor",
     "PositionControl",
     "Randomization",
+    "RealDescription",
     "RgbSensor",
     "RobotDescription",
     "SceneObject",

@@ -22,6 +22,7 @@ from openral_core.models import (
     SimDescription,
     TorquePdControl,
 )
+from openral_core.real_rules import real_findings
 from openral_core.tables import frame_names, vla_slot
 from openral_core.yaml_source import PathKey, format_field
 
@@ -58,6 +59,7 @@ def robot_findings(robot: RobotDescription, folder_name: str | None) -> list[Fin
         *_base_findings(robot),
         *_mount_findings(robot),
         *_frame_findings(robot),
+        *real_findings(robot),
     ]
 
 

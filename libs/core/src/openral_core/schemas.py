@@ -25,6 +25,7 @@ class SchemaName(StrEnum):
 
     ROBOT = "robot"
     SIM = "sim"
+    REAL = "real"
     SCENE = "scene"
 
     @property

@@ -15,6 +15,8 @@ tables computed in memory by :func:`robot_tables`):
   limits and frames (None for a robot without ``mobile_base``).
 * **Frame names** — the world, base and odometry frames the ROS graph adds to the model's
   bodies.
+* **Real wiring** — the real driver, its rate, E-stop and shutdown behaviour and, for a
+  servo bus, one row per motor (:mod:`openral_core.real_wiring`); None without ``real``.
 
 Each file also records its origin: the manifest's path and the SHA-256 of the validated
 manifest's canonical JSON (:func:`manifest_sha256`), so a table made from an earlier
@@ -39,6 +41,7 @@ from openral_core.models import (
     TorquePdControl,
 )
 from openral_core.paths import repo_root
+from openral_core.real_wiring import RealWiring, real_wiring
 from openral_core.tcp_wiring import TcpWiring, tcp_wiring
 
 FREE_JOINT_NQPOS = 7
@@ -186,6 +189,8 @@ class RobotTables:
     joint_name_map: dict[str, str]
     frames: FrameNames
     mobile_base: MobileBaseWiring | None = None
+    real: RealWiring | None = None
+    """The real driver's table (None: the robot has no ``real`` section)."""
 
     def to_json(self) -> str:
         """Deterministic JSON text (sorted keys, 2-space indent, trailing newline)."""
@@ -197,6 +202,7 @@ class RobotTables:
         data = json.loads(text)
         wiring = data["hal_wiring"]
         base = data.get("mobile_base")
+        real = data.get("real")
         return cls(
             robot=data["robot"],
             manifest=data["manifest"],
@@ -206,6 +212,7 @@ class RobotTables:
             joint_name_map=dict(data["joint_name_map"]),
             mobile_base=None if base is None else MobileBaseWiring.from_dict(base),
             frames=FrameNames(**data["frames"]),
+            real=None if real is None else RealWiring.from_dict(real),
         )
 
 
@@ -345,6 +352,7 @@ def robot_tables(robot: RobotDescription, *, root: Path | None = None) -> RobotT
         joint_name_map=joint_name_map(robot),
         mobile_base=mobile_base_wiring(robot),
         frames=frame_names(robot),
+        real=real_wiring(robot),
     )
 
 

@@ -1,0 +1,107 @@
+"""Cross-field rules of a manifest's ``real`` section (rules 20 to 25 of robot.schema.json).
+
+They keep the wiring a real driver reads sound before anything touches a bus: the feetech
+driver has its bus, every joint has exactly one motor, no two motors share an id, a joint a
+position servo drives fits in one turn of it, and per-joint settings name joints.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+
+from openral_core.models import FeetechBus, Joint, LimitedJoint, RobotDescription
+from openral_core.yaml_source import PathKey
+
+Finding = tuple[PathKey, str]
+
+
+def real_findings(robot: RobotDescription) -> Iterator[Finding]:
+    """Every rule violation of ``robot.real`` (nothing without a real section)."""
+    real = robot.real
+    if real is None:
+        return
+    if real.driver.value == "feetech" and real.feetech is None:  # rule 20
+        yield (
+            ("real", "driver"),
+            ("the feetech driver needs its bus: add a `feetech` section (servo_model, motors)"),
+        )
+    if real.feetech is not None:
+        yield from _feetech_findings(robot, real.feetech)
+
+
+def _feetech_findings(robot: RobotDescription, bus: FeetechBus) -> Iterator[Finding]:
+    joints = {joint.name: joint for joint in robot.joints}
+    base: PathKey = ("real", "feetech")
+    seen_joints: dict[str, int] = {}
+    seen_ids: dict[int, int] = {}
+    for index, motor in enumerate(bus.motors):
+        path: PathKey = (*base, "motors", index)
+        if motor.joint not in joints:  # rule 21
+            yield (*path, "joint"), _not_a_joint(motor.joint, robot)
+        elif motor.joint in seen_joints:  # rule 21
+            yield (
+                (*path, "joint"),
+                (
+                    f"joint {motor.joint!r} already has motor {bus.motors[seen_joints[motor.joint]].id}"
+                    f" (motors[{seen_joints[motor.joint]}]); each joint is driven by exactly one motor"
+                ),
+            )
+        else:
+            seen_joints[motor.joint] = index
+            yield from _one_turn(joints[motor.joint], (*path, "joint"))
+        if motor.id in seen_ids:  # rule 22
+            yield (
+                (*path, "id"),
+                (
+                    f"id {motor.id} is already the id of motors[{seen_ids[motor.id]}] "
+                    f"({bus.motors[seen_ids[motor.id]].joint}); every motor needs its own id"
+                ),
+            )
+        else:
+            seen_ids[motor.id] = index
+    missing = [name for name in joints if name not in seen_joints]
+    if missing:  # rule 21
+        yield (
+            (*base, "motors"),
+            (f"no motor for joint(s) {', '.join(missing)}; every joint needs exactly one motor"),
+        )
+    for name in bus.joint_settings or {}:  # rule 24
+        if name not in joints:
+            yield (*base, "joint_settings", name), _not_a_joint(name, robot)
+    if int(bus.protocol) != 0:  # rule 25
+        yield (
+            (*base, "protocol"),
+            (
+                "protocol 1 (SCS servos) has no Sync Read, which the driver reads every joint with; "
+                "STS servos use protocol 0"
+            ),
+        )
+
+
+def _one_turn(joint: Joint, path: PathKey) -> Iterator[Finding]:
+    """Rule 23: a position servo reads one turn; its joint is revolute and fits in it."""
+    if not isinstance(joint, LimitedJoint) or joint.type.value != "revolute":
+        kind = joint.type.value
+        yield (
+            path,
+            (
+                f"a Feetech servo in position mode drives a revolute joint with limits; this joint "
+                f"is {kind}"
+            ),
+        )
+        return
+    low, high = joint.position_limits
+    if high - low > 2 * math.pi:
+        yield (
+            path,
+            (
+                f"its position_limits span {high - low:.4f} rad, more than one turn of the servo "
+                f"({2 * math.pi:.4f} rad), which a position servo cannot tell apart"
+            ),
+        )
+
+
+def _not_a_joint(name: str, robot: RobotDescription) -> str:
+    names = ", ".join(joint.name for joint in robot.joints)
+    return f"{name!r} is not a joint of this robot; expected one of: {names}"
