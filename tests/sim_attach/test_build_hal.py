@@ -20,7 +20,13 @@ from openral_core.errors import ManifestError
 from openral_core.loader import load_scene
 from openral_core.models import DeployScene, RobotDescription
 from openral_hal.errors import ConfigurationError, EStopLatched
-from openral_hal.factory import HalMode, build_hal, can_tick, register_real_driver
+from openral_hal.factory import (
+    HalMode,
+    RealOptions,
+    build_hal,
+    can_tick,
+    register_real_driver,
+)
 from openral_hal.mujoco_arm import MujocoArmHAL
 from openral_hal.protocol import EStopLatch, RobotHal, Tickable
 from openral_hal.sim_attached import SimAttachedHAL
@@ -43,9 +49,9 @@ class RealArm(EStopLatch):
 
     is_real = True
 
-    def __init__(self, description: RobotDescription, transport: str | None) -> None:
-        self._description, self.transport = description, transport
-        self._positions = np.zeros(len(description.joints))
+    def __init__(self, robot: LoadedRobot, transport: str | None, options: RealOptions) -> None:
+        self._description, self.transport, self.options = robot.description, transport, options
+        self._positions = np.zeros(len(robot.description.joints))
         self._connected = False
 
     @property
@@ -113,8 +119,8 @@ class UnreadyArm(RealArm):
 class NotAHal:
     """Breaks the contract: no HAL at all."""
 
-    def __init__(self, description: RobotDescription, transport: str | None) -> None:
-        self.description = description
+    def __init__(self, robot: LoadedRobot, transport: str | None, options: RealOptions) -> None:
+        self.description = robot.description
 
 
 class StillRollout:
@@ -248,7 +254,7 @@ def test_a_driver_breaking_the_contract_is_one_line(
 
 
 def test_is_real_wins_over_tick() -> None:
-    stepping = SteppingRealArm(open_robot_by_id("franka_panda").description, None)
+    stepping = SteppingRealArm(open_robot_by_id("franka_panda"), None, RealOptions())
     assert isinstance(stepping, Tickable) and not can_tick(stepping)
 
 

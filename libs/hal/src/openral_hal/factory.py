@@ -3,8 +3,11 @@
 * ``sim`` with a loaded scene → :class:`SimAttachedHAL` on the scene's backend (the scene
   owns physics and cameras);
 * ``sim`` without one → :class:`MujocoArmHAL`, the robot alone in its own model;
-* ``real`` → the driver registered for the robot in :data:`REAL_DRIVERS`. A real robot is
-  never attached to a simulated scene.
+* ``real`` → the robot's real driver: one registered for the robot by name in
+  :data:`REAL_DRIVERS` (tests, a custom driver), else the driver of its manifest's
+  ``real.driver`` kind, found among the installed ``openral.real_drivers`` entry points
+  (``feetech``: :mod:`openral_real`, which sits above this layer, so it is never imported
+  here). A real robot is never attached to a simulated scene.
 
 The robot and the scene arrive loaded (:class:`~openral_core.LoadedRobot`,
 :class:`~openral_core.models.DeployScene`): nothing here reads a file.
@@ -12,8 +15,11 @@ The robot and the scene arrive loaded (:class:`~openral_core.LoadedRobot`,
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
 from enum import StrEnum
+from importlib.metadata import entry_points
+from pathlib import Path
 from typing import TypeGuard
 
 from openral_core import LoadedRobot
@@ -36,8 +42,22 @@ class HalMode(StrEnum):
 
 MODES = tuple(mode.value for mode in HalMode)
 
-RealDriver = Callable[[RobotDescription, str | None], RobotHal]
-"""Factory of a robot's real-hardware HAL: ``factory(description, transport)``."""
+@dataclass(frozen=True)
+class RealOptions:
+    """What a real driver is told beyond its transport (none of it is a robot fact)."""
+
+    calibration_file: Path | None = None
+    """The arm's calibration file (None: the driver's default place for ``arm_id``)."""
+    arm_id: str | None = None
+    """Which arm of this robot type (LeRobot's ``--robot.id``); None: the robot's name."""
+    cameras: Mapping[str, str] = field(default_factory=dict)
+    """RGB sensor → camera device, over the manifest's ``device`` entries."""
+
+
+RealDriver = Callable[[LoadedRobot, str | None, RealOptions], RobotHal]
+"""Factory of a robot's real-hardware HAL: ``factory(robot, transport, options)``."""
+DRIVER_GROUP = "openral.real_drivers"
+"""The entry-point group real drivers register under, by ``real.driver`` kind."""
 
 EnvBuilder = Callable[[DeployScene, LoadedRobot], SimRollout]
 """Builds a scene backend from the loaded scene and robot (default: ``build_scene``)."""
@@ -63,6 +83,7 @@ def build_hal(
     transport: str | None = None,
     scene: DeployScene | None = None,
     env_builder: EnvBuilder | None = None,
+    real_options: RealOptions | None = None,
 ) -> RobotHal:
     """The HAL for ``robot`` in ``mode``; not yet connected.
 
@@ -72,6 +93,7 @@ def build_hal(
         transport: Passed to a real driver (address, bus or similar); unused in sim.
         scene: A loaded deploy scene to attach to (sim only).
         env_builder: Builds the scene backend; defaults to ``openral_sim.scene.build_scene``.
+        real_options: Passed to a real driver (calibration, arm id, cameras).
 
     Raises:
         ConfigurationError: Unknown mode, a real robot with a scene, no real driver for the
@@ -85,7 +107,7 @@ def build_hal(
                 f"a real robot cannot attach to a simulated scene ({scene.scene.id}); drop the "
                 "scene or use mode 'sim'"
             )
-        return _real_hal(robot.description, transport)
+        return _real_hal(robot, transport, real_options or RealOptions())
     if scene is None:
         return MujocoArmHAL.from_robot(robot)
     check_scene_robot(scene, robot)
@@ -100,16 +122,12 @@ def _mode(mode: HalMode | str) -> HalMode:
         raise ConfigurationError(f"unknown HAL mode {mode!r}; expected one of {MODES}") from None
 
 
-def _real_hal(description: RobotDescription, transport: str | None) -> RobotHal:
-    """The registered driver's HAL, checked against the contract before anyone uses it."""
-    factory = REAL_DRIVERS.get(description.name)
-    if factory is None:
-        registered = ", ".join(sorted(REAL_DRIVERS)) or "<none>"
-        raise ConfigurationError(
-            f"no real driver registered for {description.name}; registered: {registered}"
-        )
-    hal: object = factory(description, transport)
-    driver = f"the real driver of {description.name} ({type(hal).__name__})"
+def _real_hal(robot: LoadedRobot, transport: str | None, options: RealOptions) -> RobotHal:
+    """The robot's real driver's HAL, checked against the contract before anyone uses it."""
+    name = robot.name
+    factory = REAL_DRIVERS.get(name) or _installed_driver(robot.description)
+    hal: object = factory(robot, transport, options)
+    driver = f"the real driver of {name} ({type(hal).__name__})"
     try:
         return _conforming_real_hal(hal, driver)
     except ConfigurationError:
@@ -118,6 +136,35 @@ def _real_hal(description: RobotDescription, transport: str | None) -> RobotHal:
         raise ConfigurationError(
             f"{driver}: a property raised {type(error).__name__} before connect(): {error}"
         ) from None
+
+
+def _installed_driver(description: RobotDescription) -> RealDriver:
+    """The installed driver of the manifest's ``real.driver`` kind.
+
+    Raises:
+        ConfigurationError: No ``real`` section and no registered driver, or no installed
+            driver of that kind (or one that does not import).
+    """
+    if description.real is None:
+        registered = ", ".join(sorted(REAL_DRIVERS)) or "<none>"
+        raise ConfigurationError(
+            f"no real driver registered for {description.name} and its manifest has no "
+            f"`real` section; registered: {registered}"
+        )
+    kind = description.real.driver.value
+    found = [point for point in entry_points(group=DRIVER_GROUP) if point.name == kind]
+    if not found:
+        raise ConfigurationError(
+            f"no installed real driver of kind {kind!r} (entry point group {DRIVER_GROUP}); "
+            "install it: pip install 'openral[real]'"
+        )
+    try:
+        factory: RealDriver = found[0].load()
+    except ImportError as error:
+        raise ConfigurationError(
+            f"the {kind} driver does not import ({error}); install it: pip install 'openral[real]'"
+        ) from None
+    return factory
 
 
 def _conforming_real_hal(hal: object, driver: str) -> RobotHal:

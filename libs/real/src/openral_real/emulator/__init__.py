@@ -1,0 +1,1 @@
+"""A Feetech servo bus emulated byte for byte, its servos moving a simulated arm."""

@@ -1,0 +1,379 @@
+"""FeetechHal: a Feetech servo arm (LeRobot's SO-100, SO-101) as a real RobotHal.
+
+Everything robot-specific comes from the manifest's tables (the bus, the motors, the
+envelope) and the arm's calibration file (:mod:`openral_real.calibration`). The safety
+rules of a real HAL:
+
+- it is never ticked and never attached to a scene (it has no ``tick``; ``build_hal``
+  refuses a scene in ``real`` mode); its own loop (:class:`~openral_real.bus_cycle.BusCycle`)
+  keeps time;
+- connecting reads the arm before it writes anything: the calibration file, every motor's
+  answer and model, the calibration registers, the present positions; then it writes the
+  goals *where the arm is* (to the step) before it turns torque on, so nothing jumps;
+- hold is the last measured position, never zero; an all-zero action is refused (unless
+  the manifest allows it); every command passes the position and velocity envelope, and the
+  first motion after connect or release is slower still
+  (:class:`~openral_real.motion_envelope.MotionEnvelope`);
+- the E-stop latches on request, on a bus fault and on a stale reading (see the loop), and
+  nothing is written after it but its effect (``estop``: hold with torque on, or torque
+  off); release starts again from the measured pose;
+- disconnecting (Ctrl-C, SIGTERM through ``deploy real``) holds the measured pose, then
+  leaves torque as the manifest's ``shutdown`` says.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+import numpy.typing as npt
+from openral_core.loaded import LoadedRobot
+from openral_core.models import LimitedJoint, RgbSensor, RobotDescription
+from openral_core.real_wiring import FeetechWiring, RealWiring
+from openral_core.servo_models import fault_text
+from openral_hal.errors import ActionRejected, ConfigurationError, NotConnected
+from openral_hal.factory import RealOptions
+from openral_hal.protocol import EStopLatch
+from openral_mujoco.action import validated_action
+from openral_mujoco.state import FloatArray, JointStateSample
+from openral_sim.frame_tree import FrameTree
+
+from openral_real.bus_cycle import BusCycle, CycleTimes
+from openral_real.calibration import (
+    MotorCalibration,
+    calibration_path,
+    joint_scales,
+    read_calibration,
+)
+from openral_real.errors import BusError, BusFault
+from openral_real.feetech_bus import FeetechBus, ServoReading
+from openral_real.kinematic_twin import KinematicTwin
+from openral_real.motion_envelope import MotionEnvelope
+from openral_real.opencv_cameras import Cameras, camera_devices
+from openral_real.servo_units import ServoUnits
+
+CALIBRATION_REGISTERS = {
+    "Homing_Offset": "homing_offset",
+    "Min_Position_Limit": "range_min",
+    "Max_Position_Limit": "range_max",
+}
+"""The servo registers a calibration is written to, and its field each holds."""
+
+
+@dataclass(frozen=True)
+class _Session:
+    """What a connected HAL holds."""
+
+    bus: FeetechBus
+    cycle: BusCycle
+    units: ServoUnits
+    envelope: MotionEnvelope
+    twin: KinematicTwin | None
+    cameras: Cameras
+
+
+def feetech_hal(robot: LoadedRobot, transport: str | None, options: RealOptions) -> FeetechHal:
+    """The ``feetech`` real driver (the ``openral.real_drivers`` entry point)."""
+    if not transport:
+        raise ConfigurationError(
+            f"{robot.name}: the feetech driver needs the bus's serial port (--transport "
+            "/dev/ttyACM0, or an emulator's /dev/pts/N from: openral sim bus ROBOT)"
+        )
+    return FeetechHal(robot, transport, options)
+
+
+class FeetechHal(EStopLatch):
+    """A Feetech servo arm, driven through the manifest (see the module doc)."""
+
+    is_real = True
+
+    def __init__(self, robot: LoadedRobot, port: str, options: RealOptions | None = None) -> None:
+        """Wire the HAL; nothing is opened until :meth:`connect`.
+
+        Raises:
+            ConfigurationError: The manifest has no feetech bus.
+        """
+        real, bus = _bus_of(robot)
+        self.robot, self.port, self.real, self.bus_wiring = robot, port, real, bus
+        self.options = options or RealOptions()
+        self.calibration_file = calibration_path(
+            robot.name, bus, self.options.arm_id, self.options.calibration_file
+        )
+        self.estop_reason: str | None = None
+        """Why the E-stop latched (None while released)."""
+        self.on_fault: Callable[[str], None] = _say
+        """Called once, on the bus's thread, with the line that says why a fault latched."""
+        self._rgb = {s.name: s for s in robot.description.sensors if isinstance(s, RgbSensor)}
+        self._devices = camera_devices(self._rgb, self.options.cameras)
+        self._session: _Session | None = None
+
+    # -- what the HAL is ---------------------------------------------------------------------
+
+    @property
+    def description(self) -> RobotDescription:
+        """The manifest this HAL drives."""
+        return self.robot.description
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Canonical joint names in manifest order."""
+        return tuple(joint.name for joint in self.robot.description.joints)
+
+    @property
+    def action_names(self) -> tuple[str, ...]:
+        """One action slot per manifest joint (a gripper in its write mode)."""
+        return self.joint_names
+
+    @property
+    def control_period_s(self) -> float:
+        """One read-and-write cycle of the bus [s]."""
+        return self.real.control_period_s
+
+    @property
+    def connected(self) -> bool:
+        """True between :meth:`connect` and :meth:`disconnect`."""
+        return self._session is not None
+
+    @property
+    def times(self) -> CycleTimes:
+        """When the bus cycles ran (lateness, round trips)."""
+        return self._running().cycle.times
+
+    # -- lifecycle ---------------------------------------------------------------------------
+
+    def connect(self) -> None:
+        """Read the arm, hold it where it is with torque on, and start the bus's loop.
+
+        Raises:
+            CalibrationError: The calibration file is missing or another arm's.
+            BusError: The port cannot be opened, a motor is missing or of another model,
+                the servos hold another calibration, or a motor reports a fault; nothing
+                was written to the bus. CameraError: A camera device does not open.
+        """
+        calibration = read_calibration(self.calibration_file, self.description, self.bus_wiring)
+        units = ServoUnits(self.robot, joint_scales(self.description, self.bus_wiring, calibration))
+        twin = KinematicTwin(self.robot) if self.robot.tables.hal_wiring is not None else None
+        bus = FeetechBus(self.port, self.bus_wiring, self.joint_names)
+        bus.open()
+        try:
+            readings = self._prepare(bus, calibration)
+            cameras = Cameras(self._rgb, self._devices)
+            cameras.open()
+        except BaseException:
+            bus.close()
+            raise
+        envelope = self._envelope()
+        envelope.start(units.angles(readings))
+        cycle = BusCycle(
+            bus, units, envelope, self, self.control_period_s, self.real.estop == "torque_off"
+        )
+        cycle.seed(readings)
+        self._estopped, self.estop_reason = False, None
+        self._session = _Session(bus, cycle, units, envelope, twin, cameras)
+        cycle.start()
+
+    def disconnect(self) -> None:
+        """Stop the loop, hold the measured pose, then leave torque as ``shutdown`` says."""
+        session, self._session = self._session, None
+        if session is None:
+            return
+        session.cycle.stop()
+        bus = session.bus
+        try:
+            present = [r.position for r in bus.read_present()]
+            bus.write_goals(present)
+            if self.real.shutdown == "torque_off":
+                bus.write_all("Torque_Enable", [0] * len(present))
+        except BusFault:
+            pass  # a bus that failed cannot be told anything more
+        bus.close()
+        session.cameras.close()
+
+    # -- state and commands ------------------------------------------------------------------
+
+    def read_state(self) -> JointStateSample:
+        """The newest reading of every joint, in manifest units, stamped with the system clock
+        when it was read; a reading older than two control periods is flagged stale and
+        latches the E-stop."""
+        _, sample, age_s = self._running().cycle.latest()
+        stale = age_s > 2 * self.control_period_s
+        if stale and not self._estopped:
+            self.latch_fault(
+                f"the newest reading of the bus is {age_s * 1000:.0f} ms old (control period "
+                f"{self.control_period_s * 1000:g} ms)"
+            )
+        return sample._replace(stale=stale)
+
+    def measured_angles(self) -> FloatArray:
+        """Every joint's angle [rad] in the newest reading (a gripper's jaw angle)."""
+        session = self._running()
+        readings, _, _ = session.cycle.latest()
+        return session.units.angles(readings)
+
+    def hold_action(self) -> FloatArray:
+        """The action that holds the arm where it was last measured (never zeros)."""
+        return self._running().units.action_of(self.measured_angles())
+
+    def send_action(self, action: object) -> None:
+        """Aim the arm at ``action`` (one value per joint, manifest units); the bus's loop
+        moves the goals there within the envelope.
+
+        Raises:
+            ActionRejected: Wrong width, a non-finite value, or all zeros (see the module
+                doc); nothing changes. EStopLatched: The E-stop is latched.
+        """
+        session = self._running()
+        values = validated_action(np.asarray(action, dtype=np.float64), self.action_names)
+        if self.real.refuse_zero_action and not np.any(values):
+            raise ActionRejected(
+                "an all-zero action commands every joint to 0 and the gripper shut on an "
+                "absolute-position arm; zero is not hold on a real robot: send the hold "
+                "action (/openral/action_spec) or the measured positions"
+            )
+        self._refuse_when_estopped()
+        session.envelope.aim(session.units.action_angles(values))
+
+    @property
+    def clamped(self) -> npt.NDArray[np.int64]:
+        """Commands clamped into the position limits, per joint."""
+        return self._running().envelope.clamped.copy()
+
+    # -- the E-stop --------------------------------------------------------------------------
+
+    def latch_fault(self, reason: str) -> None:
+        """Latch the E-stop because of a fault, and say why in one line (once)."""
+        if self._estopped:
+            return
+        self.estop_reason = reason
+        self._estopped = True
+        self.on_fault(f"E-stop latched: {reason}; nothing moves until it is released")
+
+    def _on_latch(self) -> None:
+        """A requested E-stop: its effect is written by the next cycle, started at once."""
+        self.estop_reason = self.estop_reason or "requested"
+        if self._session is not None:
+            self._session.cycle.effect_pending = True
+            self._session.cycle.wake()
+
+    def _on_release(self) -> None:
+        """Start again from the measured pose, slowly; torque back on if it was cut."""
+        session = self._running()
+        session.envelope.start(self.measured_angles())
+        if self.real.estop == "torque_off":
+            session.cycle.torque_on_pending = True
+        self.estop_reason = None
+
+    # -- frames and cameras ------------------------------------------------------------------
+
+    def frame_tree(self) -> FrameTree | None:
+        """The robot's frames in its own model (None without a sim block)."""
+        twin = self._running().twin
+        return twin.frame_tree() if twin is not None else None
+
+    def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
+        """The kinematic twin's (model, data), posed by :meth:`pose_twin`."""
+        twin = self._session.twin if self._session is not None else None
+        return (twin.model, twin.data) if twin is not None else None
+
+    def pose_twin(self, sample: JointStateSample) -> None:
+        """Put the twin at the joints of the newest reading (``sample``'s time)."""
+        twin = self._running().twin
+        if twin is not None:
+            twin.pose(self.measured_angles(), sample.stamp_ns / 1e9)
+
+    def read_images(self) -> dict[str, npt.NDArray[np.uint8]]:
+        """The newest frame of each camera with a device, by sensor name."""
+        return self._session.cameras.frames() if self._session is not None else {}
+
+    def camera_fovy_deg(self, sensor: str) -> float | None:
+        """The manifest's vertical field of view of ``sensor`` [deg]."""
+        found = self._rgb.get(sensor)
+        return float(found.fovy_deg) if found is not None and found.fovy_deg else None
+
+    @property
+    def on_cycle(self) -> Callable[[], None] | None:
+        """Run by the bus's loop after each read, before its write (the graph's step)."""
+        return self._session.cycle.on_cycle if self._session is not None else None
+
+    @on_cycle.setter
+    def on_cycle(self, hook: Callable[[], None] | None) -> None:
+        self._running().cycle.on_cycle = hook
+
+    # -- internals ---------------------------------------------------------------------------
+
+    def _prepare(
+        self, bus: FeetechBus, calibration: Mapping[str, MotorCalibration]
+    ) -> list[ServoReading]:
+        """Read before writing, then hold where the arm is (see the module doc)."""
+        bus.check_motors()
+        self._check_calibrated(bus, calibration)
+        readings = bus.read_present()
+        faulty = [(i, r) for i, r in zip(bus.ids, readings, strict=True) if r.faults]
+        if faulty:
+            servo_id, reading = faulty[0]
+            raise BusError(
+                f"{bus.names[servo_id]} reports {fault_text(reading.faults)}; "
+                "clear it (power the servo off and on) before driving the arm"
+            )
+        for motor in self.bus_wiring.motors:
+            bus.write("Lock", motor.id, 0)
+            wanted = {"Operating_Mode": 0, **motor.settings}
+            for name, value in wanted.items():
+                if bus.read(name, motor.id) != value:
+                    bus.write(name, motor.id, value)
+        bus.write_goals([r.position for r in readings])  # where the arm is: no jump
+        for motor in self.bus_wiring.motors:
+            bus.write("Torque_Enable", motor.id, 1)
+            bus.write("Lock", motor.id, 1)
+        return readings
+
+    def _check_calibrated(
+        self, bus: FeetechBus, calibration: Mapping[str, MotorCalibration]
+    ) -> None:
+        """The servos hold the file's calibration (else nothing is written, one line)."""
+        for motor in self.bus_wiring.motors:
+            expected = calibration[motor.joint]
+            for register, field in CALIBRATION_REGISTERS.items():
+                held, wanted = bus.read(register, motor.id), getattr(expected, field)
+                if held != wanted:
+                    raise BusError(
+                        f"{bus.names[motor.id]} holds {register} {held} but "
+                        f"{self.calibration_file} says {wanted}: the servos hold another "
+                        f"calibration; write this one to them: openral robot calibrate "
+                        f"{self.robot.name} --transport {self.port} --apply "
+                        f"{self.calibration_file} (nothing was written to the bus)"
+                    )
+
+    def _envelope(self) -> MotionEnvelope:
+        joints = self.description.joints
+        low = [j.position_limits[0] if isinstance(j, LimitedJoint) else -np.inf for j in joints]
+        high = [j.position_limits[1] if isinstance(j, LimitedJoint) else np.inf for j in joints]
+        return MotionEnvelope(
+            np.array(low),
+            np.array(high),
+            np.array([j.velocity_limit for j in joints]),
+            self.control_period_s,
+            self.real.first_motion_speed_scale,
+        )
+
+    def _running(self) -> _Session:
+        if self._session is None:
+            raise NotConnected("the arm is not connected; call connect() first")
+        return self._session
+
+
+def _bus_of(robot: LoadedRobot) -> tuple[RealWiring, FeetechWiring]:
+    real = robot.tables.real
+    if real is None or real.feetech is None:
+        raise ConfigurationError(
+            f"{robot.name} has no feetech bus in its manifest (real.feetech); it cannot be "
+            "driven by the feetech driver"
+        )
+    return real, real.feetech
+
+
+def _say(line: str) -> None:
+    sys.stderr.write(f"openral: {line}\n")
