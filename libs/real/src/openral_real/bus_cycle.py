@@ -148,7 +148,10 @@ class BusCycle:
                 return
             started = time.monotonic()
             self.times.late_s.append(max(0.0, started - due))
-            self.cycle()
+            try:
+                self.cycle()
+            except Exception as error:  # a bug of the driver: stop the arm, keep the thread
+                self._fault(f"the bus loop failed ({type(error).__name__}: {error})")
             due = max(due + self.period_s, started)  # late: no catching up in bursts
 
     def cycle(self) -> None:

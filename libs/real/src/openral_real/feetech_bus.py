@@ -26,6 +26,7 @@ Where the SDK falls short, and what is done here instead (with its own calls):
 from __future__ import annotations
 
 import contextlib
+import termios
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -263,7 +264,7 @@ class FeetechBus:
         """An SDK call; a port that failed (unplugged) becomes a :class:`BusFault`."""
         try:
             return function(*args)
-        except (OSError, serial.SerialException) as error:
+        except (OSError, serial.SerialException, termios.error) as error:
             if self._port is not None:
                 self._port.is_using = False
             raise BusFault(f"the bus on {self.port_name} failed: {error}") from None

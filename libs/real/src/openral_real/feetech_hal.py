@@ -24,6 +24,7 @@ rules of a real HAL:
 from __future__ import annotations
 
 import sys
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
@@ -104,6 +105,8 @@ class FeetechHal(EStopLatch):
         )
         self.estop_reason: str | None = None
         """Why the E-stop latched (None while released)."""
+        self.estop_at: float | None = None
+        """When it latched [s, system clock] (None while released)."""
         self.on_fault: Callable[[str], None] = _say
         """Called once, on the bus's thread, with the line that says why a fault latched."""
         self._rgb = {s.name: s for s in robot.description.sensors if isinstance(s, RgbSensor)}
@@ -162,6 +165,9 @@ class FeetechHal(EStopLatch):
             readings = self._prepare(bus, calibration)
             cameras = Cameras(self._rgb, self._devices)
             cameras.open()
+        except BusFault as error:
+            bus.close()
+            raise BusError(f"{error}; connecting stopped before torque was turned on") from None
         except BaseException:
             bus.close()
             raise
@@ -247,13 +253,14 @@ class FeetechHal(EStopLatch):
         """Latch the E-stop because of a fault, and say why in one line (once)."""
         if self._estopped:
             return
-        self.estop_reason = reason
+        self.estop_reason, self.estop_at = reason, time.time()
         self._estopped = True
         self.on_fault(f"E-stop latched: {reason}; nothing moves until it is released")
 
     def _on_latch(self) -> None:
         """A requested E-stop: its effect is written by the next cycle, started at once."""
         self.estop_reason = self.estop_reason or "requested"
+        self.estop_at = self.estop_at or time.time()
         if self._session is not None:
             self._session.cycle.effect_pending = True
             self._session.cycle.wake()
@@ -264,7 +271,7 @@ class FeetechHal(EStopLatch):
         session.envelope.start(self.measured_angles())
         if self.real.estop == "torque_off":
             session.cycle.torque_on_pending = True
-        self.estop_reason = None
+        self.estop_reason = self.estop_at = None
 
     # -- frames and cameras ------------------------------------------------------------------
 

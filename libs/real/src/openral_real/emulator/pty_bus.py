@@ -29,6 +29,8 @@ READ_CHUNK = 4096
 """Bytes taken from the pseudo-terminal per read."""
 POLL_S = 0.05
 """Longest wait for bytes before the server looks at its stop flag again [s]."""
+SILENCE_S = 0.005
+"""A line quiet this long ends a partial packet: a servo's receiver starts afresh [s]."""
 
 
 class PtyBus:
@@ -43,6 +45,7 @@ class PtyBus:
         """Byte runs dropped (bad checksum, no header): a servo answers none of them."""
         self._fds: tuple[int, int] | None = None
         self._reader = PacketReader()
+        self._last_byte = 0.0
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -115,7 +118,13 @@ class PtyBus:
                 self._stop.wait(POLL_S / 10)
                 continue
             if data:
-                self._obey(data, time.monotonic(), fds[0])
+                now = time.monotonic()
+                if self._reader.pending and now - self._last_byte > SILENCE_S:
+                    self.rejected += 1
+                    self.emulator.log(f"REJECTED {self._reader.pending} bytes cut short")
+                    self._reader.reset()
+                self._last_byte = now
+                self._obey(data, now, fds[0])
 
     def _obey(self, data: bytes, arrived: float, master: int) -> None:
         """Answer every packet ``data`` completes, each reply when it would be done."""

@@ -69,12 +69,23 @@ class PacketReader:
     """Splits a byte stream into instruction packets (a servo's receiver).
 
     Bytes before a header are dropped; a packet with a wrong checksum or an impossible
-    length is dropped whole, as a servo ignores it (the host then times out). Memory is
-    bounded: at most one packet (:data:`MAX_PACKET` bytes) is buffered.
+    length is ignored, as a servo ignores it (the host then times out), and the search for
+    a header goes on from the byte after the bad one's start. Memory is bounded: at most one
+    packet (:data:`MAX_PACKET` bytes) is buffered; :meth:`reset` drops a partial one (after
+    a silence on the line, as a servo's receiver does).
     """
 
     def __init__(self) -> None:
         self._buffer = bytearray()
+
+    @property
+    def pending(self) -> int:
+        """Bytes of a packet not yet complete."""
+        return len(self._buffer)
+
+    def reset(self) -> None:
+        """Forget a partial packet."""
+        self._buffer.clear()
 
     def feed(self, data: bytes) -> list[Packet | Rejected]:
         """Every packet (and every rejection) that ``data`` completes, in order."""
@@ -107,8 +118,9 @@ class PacketReader:
         if len(buffer) < total:
             return None
         raw = bytes(buffer[:total])
-        del buffer[:total]
         body = raw[2:-1]
         if raw[-1] != checksum(body):
+            del buffer[:1]
             return Rejected(raw, f"checksum 0x{raw[-1]:02x}, expected 0x{checksum(body):02x}")
+        del buffer[:total]
         return Packet(servo_id, raw[4], raw[5:-1])
