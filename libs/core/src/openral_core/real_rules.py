@@ -40,11 +40,12 @@ def _feetech_findings(robot: RobotDescription, bus: FeetechBus) -> Iterator[Find
         if motor.joint not in joints:  # rule 21
             yield (*path, "joint"), _not_a_joint(motor.joint, robot)
         elif motor.joint in seen_joints:  # rule 21
+            first = seen_joints[motor.joint]
             yield (
                 (*path, "joint"),
                 (
-                    f"joint {motor.joint!r} already has motor {bus.motors[seen_joints[motor.joint]].id}"
-                    f" (motors[{seen_joints[motor.joint]}]); each joint is driven by exactly one motor"
+                    f"joint {motor.joint!r} already has motor {bus.motors[first].id} "
+                    f"(motors[{first}]); each joint is driven by exactly one motor"
                 ),
             )
         else:
@@ -73,8 +74,8 @@ def _feetech_findings(robot: RobotDescription, bus: FeetechBus) -> Iterator[Find
         yield (
             (*base, "protocol"),
             (
-                "protocol 1 (SCS servos) has no Sync Read, which the driver reads every joint with; "
-                "STS servos use protocol 0"
+                "protocol 1 (SCS servos) has no Sync Read, which the driver reads every joint "
+                "with; STS servos use protocol 0"
             ),
         )
 
@@ -82,7 +83,7 @@ def _feetech_findings(robot: RobotDescription, bus: FeetechBus) -> Iterator[Find
 def _one_turn(joint: Joint, path: PathKey) -> Iterator[Finding]:
     """Rule 23: a position servo reads one turn; its joint is revolute and fits in it."""
     if not isinstance(joint, LimitedJoint) or joint.type.value != "revolute":
-        kind = joint.type.value
+        kind = joint.type.value if isinstance(joint, LimitedJoint) else "continuous"
         yield (
             path,
             (

@@ -42,6 +42,7 @@ class HalMode(StrEnum):
 
 MODES = tuple(mode.value for mode in HalMode)
 
+
 @dataclass(frozen=True)
 class RealOptions:
     """What a real driver is told beyond its transport (none of it is a robot fact)."""

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 from openral_core.errors import ManifestError, OpenralError, one_line
 
+from openral_cli.commands.robot_calibrate import calibrate
 from openral_cli.console import err, highlighted, line, out, styled
 from openral_cli.console import error as print_error
 from openral_cli.help_text import command_group
@@ -31,6 +32,7 @@ if TYPE_CHECKING:
 
 
 app = command_group("Inspect and validate robot manifests.")
+app.command("calibrate")(calibrate)
 
 
 @app.command("list")

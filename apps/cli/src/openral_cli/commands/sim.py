@@ -28,6 +28,7 @@ import typer
 
 from openral_cli.browser_view import DEFAULT_VIEW_PORT, View, ViewPort
 from openral_cli.commands.policies import policies
+from openral_cli.commands.sim_bus import bus
 from openral_cli.commands.sim_export import sim_export
 from openral_cli.commands.sim_policy import run_policy
 from openral_cli.commands.sim_replay import replay
@@ -44,6 +45,7 @@ app.command("sweep")(sweep)
 app.command("policies")(policies)
 app.command("replay")(replay)
 app.command("export")(sim_export)
+app.command("bus")(bus)
 
 SWAY_RAD = 0.15
 """Amplitude of the demo motion around the start pose."""
