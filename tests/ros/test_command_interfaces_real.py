@@ -1,8 +1,10 @@
-"""The command interfaces of a node whose HAL is real hardware, driven over ROS.
+"""The command interfaces of a node whose HAL is real hardware without a loop of its own,
+driven over ROS.
 
-A real HAL has no control loop: an action goes to it at once, a joint trajectory is refused
-with the reason (this node follows none for real hardware), and ``/openral/reset`` answers
-``success: false`` because software cannot put a real robot back.
+Such a HAL has no control loop: an action goes to it at once, a joint trajectory is refused
+with the reason, and ``/openral/reset`` answers ``success: false`` because software cannot
+put a real robot back. (A real HAL with its own loop, the Feetech arms', follows
+trajectories: tests/real/test_deploy_real.py.)
 """
 
 from __future__ import annotations
@@ -14,7 +16,8 @@ from typing import Any
 import numpy as np
 import pytest
 from openral_bridge.topics import JOINT_TRAJECTORY, RESET, SAFE_ACTION
-from openral_core.registry import load_robot_by_id
+from openral_core import open_robot_by_id
+from openral_hal.factory import RealOptions
 from openral_nodes.command_interfaces import CommandInterfaces
 from openral_nodes.runtime import Spinner
 from openral_nodes.service_call import call_trigger
@@ -30,8 +33,7 @@ from tests.sim_attach.test_build_hal import RealArm
 
 @pytest.fixture
 def real(ros_context: Context) -> Iterator[tuple[CommandInterfaces, RealArm, Node]]:
-    robot = load_robot_by_id("franka_panda")
-    hal = RealArm(robot, None)
+    hal = RealArm(open_robot_by_id("franka_panda"), None, RealOptions())
     hal.connect()
     node = Node("real_commands", context=ros_context)
     client = Node("real_client", context=ros_context)
@@ -70,5 +72,5 @@ def test_a_trajectory_is_refused_and_reset_answers_false(
     wait_until(lambda: commands.trajectories_refused == 1, 10.0, "the refusal")
     assert np.array_equal(hal.hold_action(), np.zeros(len(hal.action_names)))
     answer = call_trigger(client, RESET, 10.0)
-    assert (answer.success, answer.message) == (False, "a real robot has no scene to reset")
+    assert not answer.success and answer.message.startswith("a real robot cannot be reset")
     assert not commands.follows_trajectories

@@ -41,7 +41,7 @@ from openral_bridge.topics import (
 from openral_bridge.trajectory_follower import DesiredPoint
 from openral_core.models import TrajectoryRules
 from openral_hal.errors import EStopLatched, HalError
-from openral_hal.protocol import RobotHal
+from openral_hal.protocol import ActionScreen, RobotHal
 from openral_mujoco.action import validated_action
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, String
@@ -159,6 +159,8 @@ class CommandInterfaces:
         hal, loop = self.hal, self.loop
         try:
             values = validated_action(np.asarray(msg.data, dtype=np.float64), hal.action_names)
+            if isinstance(hal, ActionScreen):  # refused now, not at the next tick
+                hal.screen_action(values)
             if loop is None:
                 with self.lock:
                     hal.send_action(values)
@@ -230,9 +232,13 @@ class CommandInterfaces:
         return response
 
     def _on_reset(self, request: Any, response: Any) -> Any:
-        if self.loop is None:
+        if self.loop is None or self.hal.is_real:
             response.success = False
-            response.message = "a real robot has no scene to reset"
+            response.message = (
+                "a real robot cannot be reset: it has no scene to put back; move it with an "
+                "action or a joint trajectory"
+            )
+            self._log().warning(f"{RESET}: refused: {response.message}")
             return response
         try:
             text = self.loop.reset()
@@ -248,7 +254,7 @@ class CommandInterfaces:
 
     def _why_no_trajectories(self) -> str:
         if self.loop is None:
-            return "a real robot's HAL follows no trajectories here; send safe_action"
+            return "this HAL has no control loop to follow trajectories with; send safe_action"
         names = self.hal.action_names
         return (
             f"this scene's action is its controller's ({len(names)} slots: "

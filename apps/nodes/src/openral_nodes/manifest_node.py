@@ -17,7 +17,8 @@ Transitions:
   manifest, scene or mode fails here with one message);
 - activate → connect the HAL; a simulated one gets its control loop
   (:class:`~openral_bridge.control_loop.ControlLoop`), which steps once before anything is
-  published and then once per control period, publishing ``/clock`` after each step; then
+  published and then once per control period, publishing ``/clock`` after each step (a real
+  one's loop rides on its driver's cycle instead: :mod:`openral_nodes.control_loops`); then
   publish the latched ``/openral/action_spec`` and ``/joint_states`` (stamped in simulated
   time), take commands (``/openral/safe_action``, ``/openral/joint_trajectory``, the E-stop
   and ``/openral/reset`` services: :mod:`openral_nodes.command_interfaces`) and start the
@@ -58,24 +59,22 @@ from openral_bridge.joint_state_publisher import sim_stamp
 from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.ros_messages import LATCHED
 from openral_bridge.topics import ACTION_SPEC, CLOCK, TopicInfo
-from openral_bridge.trajectory_follower import follower_for
 from openral_core import LoadedRobot
 from openral_core.errors import OpenralError
-from openral_core.models import DeployScene, RobotDescription
+from openral_core.models import RobotDescription
 from openral_hal.errors import NotConnected
-from openral_hal.factory import build_hal, can_tick
+from openral_hal.factory import can_tick
 from openral_hal.protocol import RobotHal
-from openral_sim.rollout import SimRollout
-from openral_sim.scene import build_scene
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 
 from openral_nodes.command_interfaces import CommandInterfaces
+from openral_nodes.control_loops import start_control_loop
 from openral_nodes.heap_freeze import HeapFreeze
 from openral_nodes.lifecycle_guard import guard_change_state
-from openral_nodes.node_parameters import BOUNDS, PARAMETERS, check_rates, robot_and_scene
+from openral_nodes.node_parameters import BOUNDS, PARAMETERS, check_rates, configured_hal
 from openral_nodes.robot_state_streams import RobotStateStreams
 from openral_nodes.scene_bridges import SceneBridges
 
@@ -86,12 +85,6 @@ lifecycle transitions [s]."""
 
 Result = TransitionCallbackReturn
 """Transition outcome (a pybind enum, typed Any; hence the ``-> Any`` of the callbacks)."""
-
-
-def _on_demand(scene: DeployScene, robot: LoadedRobot) -> SimRollout:
-    """The scene backend without images in its observations: the sensor bridge renders each
-    camera when its frame is due."""
-    return build_scene(scene, robot, render_observations=False)
 
 
 class ManifestLifecycleNode(LifecycleNode):
@@ -159,14 +152,7 @@ class ManifestLifecycleNode(LifecycleNode):
         the reason."""
         try:
             self._check_rates()
-            robot, scene = robot_and_scene(
-                str(self._param("robot_id")),
-                str(self._param("manifest_path")),
-                str(self._param("sim_env_yaml")),
-            )
-            self.hal = build_hal(
-                robot, mode=str(self._param("hal_mode")), scene=scene, env_builder=_on_demand
-            )
+            robot, self.hal = configured_hal({name: self._param(name) for name in PARAMETERS})
             self.description, self._loaded = robot.description, robot
         except (OpenralError, ValueError) as error:
             return self._fail_configure(str(error))
@@ -181,6 +167,8 @@ class ManifestLifecycleNode(LifecycleNode):
         inactive) with :attr:`boot_error` set when the HAL does not connect."""
         try:
             hal = self._hal()
+            if hal.is_real:  # its collection stalls threads: before the driver's starts
+                self.heap.freeze()
             if not hal.connected:
                 hal.connect()
         except Exception as error:  # a HAL or renderer failure; report it, stay inactive
@@ -254,7 +242,7 @@ class ManifestLifecycleNode(LifecycleNode):
             return []
         rows = [TopicInfo(ACTION_SPEC, "sensor_msgs/msg/JointState", None)]
         rows = (self.states.topics() if self.states else []) + rows
-        if self.loop is not None:
+        if self.loop is not None and self.hal is not None and can_tick(self.hal):
             rows.insert(0, TopicInfo(CLOCK, "rosgraph_msgs/msg/Clock", 1.0 / self.loop.period_s))
         rows += self.commands.topics() if self.commands is not None else []
         return rows + (self.bridge.topics() if self.bridge else [])
@@ -300,23 +288,22 @@ class ManifestLifecycleNode(LifecycleNode):
         return Result.FAILURE
 
     def _start_loop(self, hal: RobotHal, pacer: Pacer) -> None:
-        """A simulated HAL's control loop: it steps once now, so every message after this
-        carries a simulated time > 0."""
-        self._clock_pub = self.create_publisher(Clock, CLOCK, 10)
-        self._entities = [("publisher", self._clock_pub)]
+        """The HAL's control loop (:mod:`openral_nodes.control_loops`); a simulated one steps
+        once now, so every message after this carries a simulated time > 0, and has
+        ``/clock``."""
+        self._entities = []
         if can_tick(hal):
-            robot = self._loaded
-            joints = robot is not None and hal.action_names == hal.joint_names
-            follower = follower_for(robot) if robot and joints else None
-            self.loop = ControlLoop(
-                self,
-                hal,
-                on_tick=self._publish_clock,
-                lock=self.hal_lock,
-                follower=follower,
-                on_reset=self._publish_sensors_now,
-            )
-            self.loop.start(pacer)
+            self._clock_pub = self.create_publisher(Clock, CLOCK, 10)
+            self._entities = [("publisher", self._clock_pub)]
+        self.loop = start_control_loop(
+            self,
+            hal,
+            self.hal_lock,
+            self._loaded,
+            pacer,
+            on_tick=self._publish_clock,
+            on_reset=self._publish_sensors_now,
+        )
 
     def _create_entities(self, pacer: Pacer) -> None:
         """The latched action spec, ``/joint_states`` (published once now), the action

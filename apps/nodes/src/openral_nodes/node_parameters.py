@@ -10,7 +10,10 @@ from typing import Any
 from openral_core import LoadedRobot, open_robot, open_robot_by_id
 from openral_core.loader import load_scene
 from openral_core.models import DeployScene
-from openral_sim.scene import scene_robot
+from openral_hal.factory import RealOptions, build_hal
+from openral_hal.protocol import RobotHal
+from openral_sim.rollout import SimRollout
+from openral_sim.scene import build_scene, scene_robot
 
 PARAMETERS: dict[str, Any] = {
     "robot_id": "",
@@ -22,8 +25,14 @@ PARAMETERS: dict[str, Any] = {
     "joint_state_rate_hz": 50.0,
     "publish_tf": True,
     "view_port": 0,
+    "transport": "",
+    "calibration_file": "",
+    "arm_id": "",
+    "cameras": [""],
 }
-"""Every parameter and its default."""
+"""Every parameter and its default. A real robot's: ``transport`` (its bus or address),
+``calibration_file`` and ``arm_id`` (which calibration), ``cameras`` (``NAME=DEVICE``
+strings over the manifest's devices; ``[""]`` for none, as ROS has no empty list type)."""
 
 RATE_RANGE_HZ = (0.1, 1000.0)
 """Accepted ``camera_publish_rate_hz`` (or 0) and ``joint_state_rate_hz``, inclusive [Hz]."""
@@ -82,3 +91,51 @@ def robot_and_scene(
         "no robot: set parameter robot_id or manifest_path, or a sim_env_yaml scene "
         "that names its robot_id"
     )
+
+
+def real_options(calibration_file: str, arm_id: str, cameras: list[str]) -> RealOptions:
+    """The real driver's options from the parameters.
+
+    Raises:
+        ValueError: A ``cameras`` entry that is not ``NAME=DEVICE``.
+    """
+    devices = {}
+    for entry in (item for item in cameras if item):
+        name, equals, device = entry.partition("=")
+        if not equals or not name or not device:
+            raise ValueError(f"parameter cameras: {entry!r} is not NAME=DEVICE (front=/dev/video0)")
+        devices[name] = device
+    return RealOptions(
+        calibration_file=Path(calibration_file) if calibration_file else None,
+        arm_id=arm_id or None,
+        cameras=devices,
+    )
+
+
+def configured_hal(values: dict[str, Any]) -> tuple[LoadedRobot, RobotHal]:
+    """The robot the parameters name and its HAL (not connected): a scene's is built
+    without images in its observations (the sensor bridge renders each camera when due).
+
+    Raises:
+        ValueError, OpenralError: See :func:`robot_and_scene`, :func:`real_options` and
+            ``build_hal``.
+    """
+    robot, scene = robot_and_scene(
+        str(values["robot_id"]), str(values["manifest_path"]), str(values["sim_env_yaml"])
+    )
+    options = real_options(
+        str(values["calibration_file"]), str(values["arm_id"]), list(values["cameras"])
+    )
+    hal = build_hal(
+        robot,
+        mode=str(values["hal_mode"]),
+        scene=scene,
+        env_builder=_on_demand,
+        transport=str(values["transport"]) or None,
+        real_options=options,
+    )
+    return robot, hal
+
+
+def _on_demand(scene: DeployScene, robot: LoadedRobot) -> SimRollout:
+    return build_scene(scene, robot, render_observations=False)

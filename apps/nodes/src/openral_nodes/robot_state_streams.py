@@ -1,11 +1,12 @@
 """RobotStateStreams: what the manifest node publishes about the robot's own state.
 
 - ``/joint_states`` and ``/openral/manifest_joint_states``
-  (:class:`~openral_bridge.joint_state_publisher.JointStatePublisher`);
+  (:class:`~openral_bridge.joint_state_publisher.JointStatePublisher`): at the joint-state
+  rate, or, for a real robot, once per reading of its driver (each a new stamp);
 - ``/tf`` and ``/tf_static`` (:class:`~openral_bridge.tf_publisher.TfPublisher`; off with
   the ``publish_tf`` parameter) and the URDF on ``/robot_description``
-  (:class:`~openral_bridge.description_publisher.DescriptionPublisher`), for a simulated HAL
-  with a frame tree (a native scene).
+  (:class:`~openral_bridge.description_publisher.DescriptionPublisher`), for a HAL with a
+  frame tree (a native scene, or a real robot's model posed at its readings).
 
 A model whose frames cannot be laid out as a tree is said once in the log; the graph then
 runs without ``/tf`` and ``/robot_description`` and ``/joint_states`` carries the manifest's
@@ -70,6 +71,9 @@ class RobotStateStreams:
         source: StateSource = HalStates(hal, lock)
         if loop is not None:
             source = TickStates(loop, tree.tree if tree else None, data, base)
+        self.each_tick = loop is not None and hal.is_real  # a reading per driver cycle
+        if self.each_tick and loop is not None:
+            rate_hz = 1.0 / loop.period_s
         self.states = JointStatePublisher(node, rate_hz, source)
         self.tf = None
         if publish_tf and tree is not None and data is not None:
@@ -84,7 +88,7 @@ class RobotStateStreams:
     def start(self, pacer: Pacer) -> None:
         """Publish the joint states and transforms once now, then on ``pacer``; start
         making the URDF."""
-        self.states.start(pacer)
+        self.states.start(pacer, self.loop if self.each_tick else None)
         if self.tf is not None and self.loop is not None:
             self.tf.start(pacer, self.loop)
         if self.description is not None:

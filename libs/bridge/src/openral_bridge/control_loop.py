@@ -33,6 +33,12 @@ takes (the node's E-stop services, the joint-state and camera jobs), so nothing 
 changes the scene in the middle of a step. :meth:`offer` takes a lock of its own and never
 waits for a tick.
 
+A real robot is driven, not ticked: its driver's own loop calls :meth:`ControlLoop.tick`
+after each reading (:meth:`ControlLoop.start_driven`, through
+:class:`~openral_bridge.real_cadence.RealCadence`). Its state goes on changing while the
+E-stop is latched, so each such tick still reads it (and runs the readers and watchers),
+but applies nothing and aborts a trajectory in flight.
+
 This replaces the design record's idle stepper, which stepped only while nobody commanded
 the scene and at the camera rate (so simulated time ran at the camera rate's pace).
 """
@@ -151,11 +157,12 @@ class ControlLoop:
         self._reset: _ResetRequest | None = None
         self._pending_lock = threading.Lock()
         self._job: tuple[Pacer, PacedJob] | None = None
+        self._driven: Callable[[Callable[[], None] | None], None] | None = None
 
     @property
     def running(self) -> bool:
-        """True between :meth:`start` and :meth:`stop`."""
-        return self._job is not None
+        """True between :meth:`start` (or :meth:`start_driven`) and :meth:`stop`."""
+        return self._job is not None or self._driven is not None
 
     def start(self, pacer: Pacer) -> None:
         """Tick once now (so simulated time has advanced before anything is published),
@@ -165,6 +172,15 @@ class ControlLoop:
         self.tick()
         self._job = (pacer, pacer.every(self.period_s, self.tick, "control"))
 
+    def start_driven(self, drive: Callable[[Callable[[], None] | None], None]) -> None:
+        """Tick once now, then whenever the robot's driver calls back: ``drive(tick)``
+        hands :meth:`tick` to it (``drive(None)`` at :meth:`stop` takes it back)."""
+        self.stop()
+        self.watch.restart()
+        self.tick()
+        self._driven = drive
+        drive(self.tick)
+
     def stop(self) -> None:
         """Unschedule the tick (idempotent; returns once a tick in progress has ended); a
         pending action is dropped and counted."""
@@ -172,6 +188,9 @@ class ControlLoop:
             pacer, job = self._job
             self._job = None
             pacer.cancel(job)
+        if self._driven is not None:
+            drive, self._driven = self._driven, None
+            drive(None)
         with self._pending_lock:
             self._drop_pending()
             reset, self._reset = self._reset, None
@@ -242,7 +261,11 @@ class ControlLoop:
         toward_ee = False
         try:
             with self.lock:
-                if action is None:
+                held = self.hal.estopped  # a real robot still reads on; it takes nothing
+                dropped = action if held else None
+                if held:
+                    action = None
+                elif action is None:
                     action, sample, toward_ee = self._follow_step()
                 stepped = self.hal.tick(action, glide=sample is not None)
                 state = self.hal.read_state() if stepped else self.state
@@ -254,13 +277,15 @@ class ControlLoop:
             self._abort_trajectory(f"the control tick failed ({type(error).__name__})")
             self._failed(error)
             return
-        if not stepped:  # E-stopped: time is frozen on purpose, the action is dropped
+        if not stepped or held:  # E-stopped: nothing applied (a scene's time is frozen too)
             self.watch.restart()
-            self._abort_trajectory("the E-stop is latched: the scene did not step")
-            if action is not None and sample is None:
+            frozen = "" if stepped else ": the scene did not step"
+            self._abort_trajectory(f"the E-stop is latched{frozen}")
+            if (dropped if held else action) is not None and sample is None:
                 with self._pending_lock:
                     self.superseded += 1
-            return
+            if not stepped:
+                return
         self._after_step(state, action is not None and sample is None, sample, toward_ee)
 
     def _follow_step(self) -> tuple[FloatArray | None, DesiredPoint | None, bool]:

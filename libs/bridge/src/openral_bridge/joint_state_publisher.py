@@ -155,9 +155,11 @@ class JointStatePublisher:
         """Readings published since :meth:`start`."""
         self._out = PacedPublishers(node)
         self._messages: tuple[StateReading, Any, Any] | None = None
+        self._ticks: ControlLoop | None = None
 
-    def start(self, pacer: Pacer) -> None:
-        """Create the publishers, publish once, then once per period on ``pacer``."""
+    def start(self, pacer: Pacer, each_tick_of: ControlLoop | None = None) -> None:
+        """Create the publishers, publish once, then once per period on ``pacer`` (or after
+        every tick of ``each_tick_of``: a real robot's every reading, freshly stamped)."""
         self.stop()
         node = self.node
         self._out.open(
@@ -166,12 +168,23 @@ class JointStatePublisher:
         )
         self.published = 0
         self.publish()
-        self._out.schedule(pacer, 1.0 / self.rate_hz, self.publish, "joint_states")
+        if each_tick_of is not None:
+            self._ticks = each_tick_of
+            each_tick_of.watchers.append(self._after_tick)
+        else:
+            self._out.schedule(pacer, 1.0 / self.rate_hz, self.publish, "joint_states")
 
     def stop(self) -> None:
         """Unschedule the job and destroy the publishers (idempotent)."""
+        if self._ticks is not None:
+            ticks, self._ticks = self._ticks, None
+            if self._after_tick in ticks.watchers:
+                ticks.watchers.remove(self._after_tick)
         self._out.close()
         self._messages = None
+
+    def _after_tick(self, state: JointStateSample) -> None:
+        self.publish()
 
     def publish(self) -> None:
         """Publish the newest reading."""

@@ -388,6 +388,9 @@ class SimSensorBridge:
             or (isinstance(s, RgbSensor) and s.name not in self._cameras)
         ]
         if skipped:
-            self._log().info(
-                f"not published (the scene does not render them): {', '.join(skipped)}"
+            why = (
+                "no device names them: a sensor's `device`, or --camera NAME=DEVICE"
+                if self.hal.is_real
+                else "the scene does not render them"
             )
+            self._log().info(f"not published ({why}): {', '.join(skipped)}")

@@ -7,6 +7,10 @@ spec's slots, and latches an E-stop. Capabilities are separate Protocols, checke
 * :class:`CameraHal` renders the manifest's RGB sensors;
 * :class:`Tickable` is advanced by a control loop, one control period per tick (simulated
   HALs only; a real HAL never is);
+* :class:`CycledHal` is a real HAL with a loop of its own (read, a hook, write, once per
+  control period), which a graph's control step rides on instead of ticking it; a
+  :class:`TwinHal` also poses a model of the robot at each reading (its frames), and an
+  :class:`ActionScreen` says at once whether it would refuse an action;
 * :class:`MujocoBacked` exposes the live MuJoCo model and data;
 * :class:`MobileBaseHal` drives a mobile base with velocity commands and reports its
   odometry (when its ``base`` is not None);
@@ -22,6 +26,7 @@ spec's slots, and latches an E-stop. Capabilities are separate Protocols, checke
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Protocol, runtime_checkable
 
 import mujoco
@@ -157,9 +162,11 @@ class MujocoBacked(Protocol):
 
 
 __all__ = [
+    "ActionScreen",
     "BaseOdometrySource",
     "CameraHal",
     "CameraSource",
+    "CycledHal",
     "DepthSource",
     "EStopLatch",
     "FramesHal",
@@ -170,6 +177,7 @@ __all__ = [
     "RobotHal",
     "StateSensorSource",
     "Tickable",
+    "TwinHal",
 ]
 
 
@@ -217,5 +225,43 @@ class FramesHal(MujocoBacked, Protocol):
 
         Raises:
             HalError: The model's layout cannot be stated as a tree.
+        """
+        ...
+
+
+@runtime_checkable
+class CycledHal(RobotHal, Protocol):
+    """A real HAL whose own loop reads the robot, runs :attr:`on_cycle`, then writes the
+    command, once per control period (as ros2_control's read, update, write)."""
+
+    @property
+    def control_period_s(self) -> float:
+        """One cycle of the HAL's loop [s]."""
+        ...
+
+    on_cycle: Callable[[], None] | None
+    """Run on the loop's thread after each read, before the write (None: nothing)."""
+    on_fault: Callable[[str], None]
+    """Called once, with one line, when a fault latches the E-stop."""
+
+
+@runtime_checkable
+class TwinHal(Protocol):
+    """A HAL that keeps a model of its robot posed at the measured joints."""
+
+    def pose_twin(self, sample: JointStateSample) -> None:
+        """Pose the model at the reading ``sample`` came from."""
+        ...
+
+
+@runtime_checkable
+class ActionScreen(Protocol):
+    """A HAL that can say, before an action is queued, that it would refuse it."""
+
+    def screen_action(self, values: FloatArray) -> None:
+        """Nothing when ``values`` (validated: width, finite) would be taken.
+
+        Raises:
+            ActionRejected: The HAL refuses it (the message says why). EStopLatched.
         """
         ...

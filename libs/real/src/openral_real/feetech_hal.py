@@ -56,6 +56,10 @@ from openral_real.motion_envelope import MotionEnvelope
 from openral_real.opencv_cameras import Cameras, camera_devices
 from openral_real.servo_units import ServoUnits
 
+SWITCH_INTERVAL_S = 0.001
+"""Python's thread switch interval while connected [s]: the bus's thread waits at most this
+long for Python's lock after its bytes arrive (the default, 5 ms, is half a control
+period). Restored at disconnect."""
 CALIBRATION_REGISTERS = {
     "Homing_Offset": "homing_offset",
     "Min_Position_Limit": "range_min",
@@ -112,6 +116,7 @@ class FeetechHal(EStopLatch):
         self._rgb = {s.name: s for s in robot.description.sensors if isinstance(s, RgbSensor)}
         self._devices = camera_devices(self._rgb, self.options.cameras)
         self._session: _Session | None = None
+        self._switch_interval = sys.getswitchinterval()
 
     # -- what the HAL is ---------------------------------------------------------------------
 
@@ -179,6 +184,8 @@ class FeetechHal(EStopLatch):
         cycle.seed(readings)
         self._estopped, self.estop_reason = False, None
         self._session = _Session(bus, cycle, units, envelope, twin, cameras)
+        self._switch_interval = sys.getswitchinterval()
+        sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL_S))
         cycle.start()
 
     def disconnect(self) -> None:
@@ -197,6 +204,7 @@ class FeetechHal(EStopLatch):
             pass  # a bus that failed cannot be told anything more
         bus.close()
         session.cameras.close()
+        sys.setswitchinterval(self._switch_interval)
 
     # -- state and commands ------------------------------------------------------------------
 
@@ -233,6 +241,16 @@ class FeetechHal(EStopLatch):
         """
         session = self._running()
         values = validated_action(np.asarray(action, dtype=np.float64), self.action_names)
+        self.screen_action(values)
+        session.envelope.aim(session.units.action_angles(values))
+
+    def screen_action(self, values: FloatArray) -> None:
+        """Refuse an all-zero action (unless the manifest allows it) and any action while
+        the E-stop is latched; ``values`` already has the right width and is finite.
+
+        Raises:
+            ActionRejected: All zeros. EStopLatched: The E-stop is latched.
+        """
         if self.real.refuse_zero_action and not np.any(values):
             raise ActionRejected(
                 "an all-zero action commands every joint to 0 and the gripper shut on an "
@@ -240,7 +258,6 @@ class FeetechHal(EStopLatch):
                 "action (/openral/action_spec) or the measured positions"
             )
         self._refuse_when_estopped()
-        session.envelope.aim(session.units.action_angles(values))
 
     @property
     def clamped(self) -> npt.NDArray[np.int64]:
@@ -286,10 +303,12 @@ class FeetechHal(EStopLatch):
         return (twin.model, twin.data) if twin is not None else None
 
     def pose_twin(self, sample: JointStateSample) -> None:
-        """Put the twin at the joints of the newest reading (``sample``'s time)."""
-        twin = self._running().twin
-        if twin is not None:
-            twin.pose(self.measured_angles(), sample.stamp_ns / 1e9)
+        """Put the twin at the joints of the newest reading, as of ``sample``'s stamp."""
+        session = self._running()
+        if session.twin is not None:
+            readings, _, _ = session.cycle.latest()
+            angles, rates, efforts = session.units.physical(readings)
+            session.twin.pose(angles, rates, efforts, sample.stamp_ns / 1e9)
 
     def read_images(self) -> dict[str, npt.NDArray[np.uint8]]:
         """The newest frame of each camera with a device, by sensor name."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
 from openral_hal.errors import HalError
 from openral_mujoco.mjcf_uri import robot_model_file
@@ -44,14 +45,26 @@ class KinematicTwin:
         for slot, name in enumerate(wiring.joint_names):
             if name in gripper_qpos:
                 self._qpos[slot] = gripper_qpos[name]
+        self._dof = np.array([int(self.model.jnt_dofadr[j]) for j in self._joints_at(self._qpos)])
         self._addresses = addresses
         self._tree: FrameTree | None = None
 
-    def pose(self, angles: FloatArray, time_s: float) -> None:
-        """Put every joint at ``angles`` [rad, a gripper's jaw angle] as of ``time_s`` [s]."""
-        self.data.qpos[self._qpos] = angles
-        self.data.time = time_s
-        mujoco.mj_kinematics(self.model, self.data)
+    def pose(
+        self, angles: FloatArray, rates: FloatArray, efforts: FloatArray, time_s: float
+    ) -> None:
+        """Put every joint at ``angles`` [rad, a gripper's jaw angle], moving at ``rates``
+        [rad/s] and pushing with ``efforts`` [N m], as of ``time_s`` [s, system clock]."""
+        data = self.data
+        data.qpos[self._qpos] = angles
+        data.qvel[self._dof] = rates
+        data.qfrc_actuator[self._dof] = efforts
+        data.time = time_s
+        mujoco.mj_kinematics(self.model, data)
+
+    def _joints_at(self, qpos: npt.NDArray[np.int64]) -> list[int]:
+        """The model's joint at each qpos address."""
+        starts = {int(address): j for j, address in enumerate(self.model.jnt_qposadr)}
+        return [starts[int(address)] for address in qpos]
 
     def frame_tree(self) -> FrameTree:
         """The robot's frames in its model, laid out once.

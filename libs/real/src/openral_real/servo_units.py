@@ -45,15 +45,23 @@ class ServoUnits:
         """Joint angles [rad] of a present block."""
         return np.array([s.angle(r.position) for s, r in zip(self.scales, readings, strict=True)])
 
-    def sample(self, readings: Sequence[ServoReading], stamp_ns: int) -> JointStateSample:
-        """The manifest's joint state of a present block read at ``stamp_ns`` [ns, system
-        clock] (efforts [N m] from the servos' loads, as shares of their stall torque)."""
-        positions = self.angles(readings)
-        velocities = np.array(
-            [s.rate(r.velocity) for s, r in zip(self.scales, readings, strict=True)]
-        )
+    def physical(
+        self, readings: Sequence[ServoReading]
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Joint angles [rad], rates [rad/s] and efforts [N m] of a present block (a
+        gripper's jaw as a joint; efforts from the servos' loads, as shares of their stall
+        torque)."""
+        pairs = list(zip(self.scales, readings, strict=True))
+        angles = np.array([s.angle(r.position) for s, r in pairs])
+        rates = np.array([s.rate(r.velocity) for s, r in pairs])
         signs = np.array([s.sign for s in self.scales])
         efforts = np.array([r.load for r in readings], float) / 1000.0 * self.effort_limit * signs
+        return angles, rates, efforts
+
+    def sample(self, readings: Sequence[ServoReading], stamp_ns: int) -> JointStateSample:
+        """The manifest's joint state of a present block read at ``stamp_ns`` [ns, system
+        clock]: :meth:`physical`, a gripper in its read mode."""
+        positions, velocities, efforts = self.physical(readings)
         for g in self._grippers:
             positions[g.slot] = g.read_offset + g.read_weight * positions[g.slot]
             velocities[g.slot] *= g.read_weight

@@ -1,15 +1,19 @@
-"""``openral deploy``: run a robot as a live ROS 2 graph.
+"""``openral deploy``: run a robot as a live ROS 2 graph, simulated or real.
 
 Example::
 
     openral deploy sim --config robots/franka_panda/scenes/tabletop.yaml --no-viewer
+    openral deploy real --robot so101 --transport /dev/ttyACM0 --arm-id my_follower
 
 The scene's robot comes up as one :class:`~openral_nodes.manifest_node.ManifestLifecycleNode`
 in this process, driven through configure and activate here (there is no ``ros2 launch``).
 The node reads the scene file and the robot's manifest once, at configure; a problem in
 either ends the command with one line.
 It runs until Ctrl-C or SIGTERM (or ``--duration``), then deactivates, cleans up and
-exits 0; a ``shutdown`` transition requested over ROS ends it with exit 0 too.
+exits 0; a ``shutdown`` transition requested over ROS ends it with exit 0 too. ``deploy
+real`` runs the same node on the robot's real driver (``real`` in its manifest): the arm
+is held where it is at bring-up, and at the end it holds, then takes the manifest's
+``shutdown`` torque state.
 ``openral ros topics`` in a second terminal lists what it publishes.
 """
 
@@ -53,6 +57,27 @@ NoTf = Annotated[
         help="Publish no /tf or /tf_static (another node, e.g. robot_state_publisher, does).",
     ),
 ]
+Duration = Annotated[
+    float | None,
+    typer.Option(
+        "--duration", min=0.0, help="Stop after this many seconds (default: run until Ctrl-C)."
+    ),
+]
+DomainId = Annotated[
+    int | None,
+    typer.Option("--domain-id", min=0, max=232, help="ROS domain id (default: ROS_DOMAIN_ID)."),
+]
+Record = Annotated[
+    Path | None,
+    typer.Option(
+        "--record",
+        help="Record every topic into a rosbag2 bag (MCAP) in this new folder.",
+        show_default=False,
+    ),
+]
+Overwrite = Annotated[
+    bool, typer.Option("--overwrite", help="Replace --record's folder if it holds a bag.")
+]
 
 
 @app.command("sim")
@@ -70,27 +95,10 @@ def sim(
         typer.Option("--joint-state-rate", min=0.1, max=1000.0, help="/joint_states rate [Hz]."),
     ] = 50.0,
     no_tf: NoTf = False,
-    duration: Annotated[
-        float | None,
-        typer.Option(
-            "--duration", min=0.0, help="Stop after this many seconds (default: run until Ctrl-C)."
-        ),
-    ] = None,
-    domain_id: Annotated[
-        int | None,
-        typer.Option("--domain-id", min=0, max=232, help="ROS domain id (default: ROS_DOMAIN_ID)."),
-    ] = None,
-    record: Annotated[
-        Path | None,
-        typer.Option(
-            "--record",
-            help="Record every topic into a rosbag2 bag (MCAP) in this new folder.",
-            show_default=False,
-        ),
-    ] = None,
-    overwrite: Annotated[
-        bool, typer.Option("--overwrite", help="Replace --record's folder if it holds a bag.")
-    ] = False,
+    duration: Duration = None,
+    domain_id: DomainId = None,
+    record: Record = None,
+    overwrite: Overwrite = False,
     view: View = False,
     view_port: ViewPort = DEFAULT_VIEW_PORT,
 ) -> None:
@@ -105,7 +113,8 @@ def sim(
         domain = context.get_domain_id()
         recorder = None if record is None else start_recording(record, overwrite, domain)
         try:
-            reason, elapsed_s = _run_graph(context, parameters, config, duration)
+            title = f"deploy sim: {{robot}} in {config.name}"
+            reason, elapsed_s = _run_graph(context, parameters, title, duration)
         finally:
             if recorder is not None:
                 stop_recording(recorder)
@@ -113,8 +122,63 @@ def sim(
     out.print(stopped, soft_wrap=False, highlight=True)
 
 
+@app.command("real")
+def real(
+    robot: Annotated[str, typer.Option("--robot", help="Robot id with a real section.")],
+    transport: Annotated[
+        str, typer.Option("--transport", help="The robot's bus (/dev/ttyACM0, /dev/pts/N).")
+    ],
+    arm_id: Annotated[
+        str | None,
+        typer.Option("--arm-id", help="Which arm's calibration (LeRobot's --robot.id)."),
+    ] = None,
+    calibration: Annotated[
+        Path | None, typer.Option("--calibration", help="The calibration file to use.")
+    ] = None,
+    camera: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--camera",
+            help="NAME=DEVICE: an RGB sensor's camera (0, /dev/video0, file:clip.mp4).",
+        ),
+    ] = None,
+    no_tf: NoTf = False,
+    duration: Duration = None,
+    domain_id: DomainId = None,
+    record: Record = None,
+    overwrite: Overwrite = False,
+) -> None:
+    """Bring ROBOT's real arm up on TRANSPORT as the same ROS 2 graph as deploy sim."""
+    if calibration is not None:
+        _require_file(calibration, "calibration", "~/.cache/huggingface/lerobot/calibration/...")
+    parameters: dict[str, Any] = {
+        "robot_id": robot,
+        "hal_mode": "real",
+        "transport": transport,
+        "viewer_enabled": False,
+        "calibration_file": str(calibration.resolve()) if calibration else "",
+        "arm_id": arm_id or "",
+        "cameras": list(camera or [""]),
+        "publish_tf": not no_tf,
+    }
+    require_ros()
+    from openral_nodes.runtime import ros_session
+
+    with ros_session(domain_id=domain_id) as context:
+        recorder = None
+        if record is not None:
+            recorder = start_recording(record, overwrite, context.get_domain_id())
+        try:
+            title = f"deploy real: {{robot}} on {transport}"
+            reason, elapsed_s = _run_graph(context, parameters, title, duration)
+        finally:
+            if recorder is not None:
+                stop_recording(recorder)
+    out.print(f"stopped ({reason}) after {elapsed_s:.1f} s; clean shutdown", soft_wrap=False)
+
+
 def _run_graph(
-    context: Context, parameters: dict[str, Any], config: Path, duration: float | None
+    context: Context, parameters: dict[str, Any], title: str, duration: float | None
 ) -> tuple[str, float]:
     """Bring the node up, serve until a signal, ``duration`` or a shutdown transition, then
     take it down; why it stopped and how long it ran [s]."""
@@ -130,7 +194,7 @@ def _run_graph(
     try:
         _transition(node, "configure")
         _transition(node, "activate")
-        _print_interfaces(node, config)
+        _print_interfaces(node, title)
         spin_until(executor, stop, timeout_s=duration)
     finally:
         reason = _shut_down(node, stop)
@@ -212,7 +276,7 @@ def _shut_down(node: ManifestLifecycleNode, stop: threading.Event) -> str:
     return "signal" if stop.is_set() else "--duration"
 
 
-def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
+def _print_interfaces(node: ManifestLifecycleNode, title: str) -> None:
     """What the graph offers: published topics in a table (fits 80 columns), then inputs."""
     from openral_bridge.topics import (
         CMD_VEL,
@@ -230,7 +294,7 @@ def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
     names, _ = node.action_layout()
     robot = node.description.name if node.description is not None else "?"
     table = Table(
-        title=f"deploy sim: {robot} in {config.name}",
+        title=title.format(robot=robot),
         box=box.SIMPLE_HEAD,
         pad_edge=False,
     )
@@ -257,7 +321,7 @@ def _print_interfaces(node: ManifestLifecycleNode, config: Path) -> None:
     if node.bridge is not None and node.bridge.base is not None:
         out.print(f"base:     {CMD_VEL} (geometry_msgs/msg/Twist, base frame)", soft_wrap=False)
     out.print(f"E-stop:   {ESTOP}, {RELEASE_ESTOP} (std_srvs/srv/Trigger)", soft_wrap=False)
-    if node.loop is not None:
+    if node.loop is not None and node.hal is not None and not node.hal.is_real:
         out.print(f"reset:    {RESET} (std_srvs/srv/Trigger)", soft_wrap=False)
     view = node.bridge.view if node.bridge is not None else None
     if view is not None:

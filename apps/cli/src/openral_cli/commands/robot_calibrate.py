@@ -76,6 +76,9 @@ def calibrate(
             _apply(bus, applied, apply)
             return
         found = _record(robot, bus, non_interactive)
+        from openral_real.arm_calibration import apply_calibration
+
+        apply_calibration(bus, found)
     finally:
         bus.close()
     from openral_real.calibration import write_calibration

@@ -25,7 +25,7 @@ from openral_core.real_wiring import FeetechWiring
 from openral_core.servo_models import SERVO_MODELS
 
 from openral_real.emulator.emulated_arm import Drive, EmulatedArm
-from openral_real.emulator.servo_memory import ServoMemory
+from openral_real.emulator.servo_memory import ServoMemory, from_sign_magnitude
 from openral_real.emulator.sts_wire import BROADCAST_ID, Instruction, Packet, status_packet
 
 BITS_PER_BYTE = 10
@@ -259,7 +259,12 @@ class BusEmulator:
         return self._names.get(address, f"@{address}")
 
     def _values(self, address: int, payload: bytes) -> str:
-        return f"{self._name(address)}={_number(payload)}"
+        name = self._name(address)
+        value = _number(payload)
+        model = SERVO_MODELS[self.wiring.servo_model]
+        if name in model.sign_bits and len(payload) == model.registers[name][1]:
+            value = from_sign_magnitude(value, model.sign_bits[name])
+        return f"{name}={value}"
 
 
 def _number(payload: bytes) -> int:

@@ -8,6 +8,7 @@ its serial port. Its log has one line per packet and event, stamped with the sys
 
 from __future__ import annotations
 
+import sys
 import threading
 import time
 from pathlib import Path
@@ -25,6 +26,11 @@ from openral_hal.protocol import Tickable
 from openral_real.emulator.bus_emulator import BusEmulator
 from openral_real.emulator.emulated_arm import EmulatedArm, servo_held
 from openral_real.emulator.pty_bus import PtyBus
+
+
+SWITCH_INTERVAL_S = 0.0005
+"""Longest time a thread holds Python's lock while another waits for it [s] (Python's
+default, 5 ms, is longer than the driver waits for a servo's reply)."""
 
 
 class EmulatedBus:
@@ -87,7 +93,12 @@ class EmulatedBus:
                 self._log.flush()
 
     def start(self) -> str:
-        """Open the pseudo-terminal, start the simulation's clock and serve; the path."""
+        """Open the pseudo-terminal, start the simulation's clock and serve; the path.
+
+        The process's thread switch interval drops to :data:`SWITCH_INTERVAL_S`, so the
+        thread that answers the bus is never kept waiting for Python's lock by the
+        simulation's thread for longer than a servo takes to answer."""
+        sys.setswitchinterval(min(sys.getswitchinterval(), SWITCH_INTERVAL_S))
         path = self.pty.open()
         self.arm.start()
         self.pty.start()
