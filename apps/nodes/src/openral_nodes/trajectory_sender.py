@@ -167,11 +167,11 @@ class TrajectorySender:
     ) -> TrajectoryReport:
         with self._lock:
             desired, states = self._desired[sent_at:], list(self._states)
-        by_time = {round(_stamp(s) * 1e6): s for s in states}
+        nearest = _nearest_in_time(states)
         errors = np.zeros(len(names))
         report = TrajectoryReport(names, start, goal)
         for point in desired:
-            state = by_time.get(round(_stamp(point) * 1e6))
+            state = nearest(_stamp(point))
             if state is None:
                 continue
             wanted = self._positions(point, names)
@@ -210,6 +210,28 @@ class TrajectorySender:
         with self._lock:
             self._desired.append(msg)
             self._lock.notify_all()
+
+
+def _nearest_in_time(states: list[Any]) -> Callable[[float], Any | None]:
+    """The joint state stamped nearest a time, within half the states' usual spacing (a
+    simulated graph stamps both at the same tick: the match is exact; a real robot's
+    readings fall near the desired points' times, never on them)."""
+    stamps = np.array([_stamp(s) for s in states])
+    order = np.argsort(stamps)
+    stamps = stamps[order]
+    spacing = float(np.median(np.diff(stamps))) if len(stamps) > 2 else 0.0
+
+    def nearest(time_s: float) -> Any | None:
+        at = int(np.searchsorted(stamps, time_s))
+        candidates = [i for i in (at - 1, at) if 0 <= i < len(stamps)]
+        if not candidates:
+            return None
+        best = min(candidates, key=lambda i: abs(stamps[i] - time_s))
+        if abs(stamps[best] - time_s) > max(spacing / 2.0, 1e-6):
+            return None
+        return states[int(order[best])]
+
+    return nearest
 
 
 def _stamp(msg: Any) -> float:

@@ -124,10 +124,15 @@ def sim(
 
 @app.command("real")
 def real(
-    robot: Annotated[str, typer.Option("--robot", help="Robot id with a real section.")],
     transport: Annotated[
         str, typer.Option("--transport", help="The robot's bus (/dev/ttyACM0, /dev/pts/N).")
     ],
+    robot: Annotated[
+        str | None, typer.Option("--robot", help="Robot id with a real section (so101).")
+    ] = None,
+    manifest: Annotated[
+        Path | None, typer.Option("--manifest", help="Manifest file instead of --robot.")
+    ] = None,
     arm_id: Annotated[
         str | None,
         typer.Option("--arm-id", help="Which arm's calibration (LeRobot's --robot.id)."),
@@ -149,10 +154,15 @@ def real(
     overwrite: Overwrite = False,
 ) -> None:
     """Bring ROBOT's real arm up on TRANSPORT as the same ROS 2 graph as deploy sim."""
+    if (robot is None) == (manifest is None):
+        raise typer.BadParameter("give the robot: --robot ID or --manifest FILE (one of them)")
     if calibration is not None:
         _require_file(calibration, "calibration", "~/.cache/huggingface/lerobot/calibration/...")
+    if manifest is not None:
+        _require_file(manifest, "manifest", "robots/so101/robot.yaml")
     parameters: dict[str, Any] = {
-        "robot_id": robot,
+        "robot_id": robot or "",
+        "manifest_path": str(manifest.resolve()) if manifest is not None else "",
         "hal_mode": "real",
         "transport": transport,
         "viewer_enabled": False,
@@ -169,7 +179,7 @@ def real(
         if record is not None:
             recorder = start_recording(record, overwrite, context.get_domain_id())
         try:
-            title = f"deploy real: {{robot}} on {transport}"
+            title = f"deploy real: {{robot}} on {transport}"  # {robot}: the node's, once loaded
             reason, elapsed_s = _run_graph(context, parameters, title, duration)
         finally:
             if recorder is not None:

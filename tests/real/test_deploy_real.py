@@ -1,0 +1,174 @@
+"""``openral deploy real`` as a subprocess, driving an emulated SO-101 bus (on the emulator,
+not on hardware): the graph of deploy sim on a real driver, policies and goals moving the
+servos, E-stop, faults, a clean stop, and bad input said in one line."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from openral_nodes.service_call import call_trigger
+from rclpy.node import Node
+
+from tests.real.conftest import Rig
+from tests.real.deploy_helpers import (
+    Remote,
+    camera_clip,
+    deploy_real,
+    joints_now,
+    openral,
+    remote_graph,
+    stop,
+)
+from tests.ros.action_client import TrajectoryActionClient, goal
+
+SUCCEEDED = 4
+ARM = ("shoulder_pan", "elbow_flex", "wrist_flex")
+
+
+def _serving(remote: Remote) -> None:
+    remote.probe.wait_count("/joint_states", 1, timeout_s=40.0)
+
+
+def test_wave_and_a_three_point_goal_move_the_emulated_servos(rig: Rig, tmp_path: Path) -> None:
+    clip = camera_clip(tmp_path / "clip.mp4")
+    cameras = ("--camera", f"front=file:{clip}", "--camera", f"wrist=file:{clip}")
+    with remote_graph() as remote:
+        process = deploy_real(rig.path, rig.calibration, remote.domain, *cameras)
+        try:
+            _serving(remote)
+            remote.probe.wait_count("/openral/cameras/front/image", 2, timeout_s=10.0)
+            frame = remote.probe.latest("/openral/cameras/front/image")
+            assert (frame.width, frame.height, frame.encoding) == (128, 128, "rgb8")
+            seen = time.time()
+            runner = openral(
+                "rskill", "run", "--robot", "so101", "--policy", "wave", "-p", "amplitude=0.3",
+                "--duration", "4", "--domain-id", str(remote.domain),
+            )  # fmt: skip
+            out, err = runner.communicate(timeout=60)
+            assert runner.returncode == 0, err
+            pan = [
+                int(line.split()[3].split("=")[1])
+                for line in rig.bus.written("Goal_Position", seen)
+            ]
+            assert max(pan) - min(pan) > 0.4 * 4096 / (2 * np.pi)  # the wave swung the servo
+            _three_point_goal(remote)
+        finally:
+            out, err = stop(process)
+    assert "clean shutdown" in out, err
+
+
+def _three_point_goal(remote: Remote) -> None:
+    node = Node("real_goal_client", context=remote.context)
+    remote.spinner.add_node(node)
+    client = TrajectoryActionClient(node)
+    try:
+        start = joints_now(remote)
+        points = [
+            (1.0, [start[j] + 0.3 for j in ARM]),
+            (2.0, [start[j] - 0.2 for j in ARM]),
+            (3.0, [start[j] + 0.4 for j in ARM]),
+        ]
+        status, _, _ = client.run(goal(ARM, points, goal_tolerance=0.02, goal_time_s=1.0))
+        assert status == SUCCEEDED
+        reached = joints_now(remote)
+        for joint, wanted in zip(ARM, points[-1][1], strict=True):
+            assert reached[joint] == pytest.approx(wanted, abs=0.02)
+    finally:
+        client.destroy()
+        remote.spinner.remove_node(node)
+        node.destroy_node()  # type: ignore[no-untyped-call]
+
+
+def test_estop_holds_reset_is_refused_and_sigint_holds_then_releases_torque(rig: Rig) -> None:
+    with remote_graph() as remote:
+        process = deploy_real(rig.path, rig.calibration, remote.domain)
+        client = Node("real_estop_client", context=remote.context)
+        remote.spinner.add_node(client)
+        try:
+            _serving(remote)
+            assert call_trigger(client, "/openral/estop", 10.0).success
+            reset = call_trigger(client, "/openral/reset", 10.0)
+            assert not reset.success and "a real robot cannot be reset" in reset.message
+            assert call_trigger(client, "/openral/release_estop", 10.0).success
+            stopped = time.time()
+            out, err = stop(process)
+        finally:
+            remote.spinner.remove_node(client)
+            client.destroy_node()  # type: ignore[no-untyped-call]
+            stop(process)
+    assert process.returncode == 0, err
+    assert "stopped (signal)" in out and "clean shutdown" in out and "Traceback" not in err
+    writes = [line.split()[1:3] for line in rig.bus.lines if float(line.split()[0]) > stopped]
+    writes = [kind for kind in writes if kind[0] == "SYNC_WRITE"]
+    assert writes[-2:] == [["SYNC_WRITE", "Goal_Position"], ["SYNC_WRITE", "Torque_Enable"]]
+    assert [s.get("Torque_Enable") for s in rig.bus.emulator.servos.values()] == [0] * 6
+
+
+def test_a_silent_motor_is_one_line_and_no_goal_follows(rig: Rig) -> None:
+    from openral_real.emulator.bus_emulator import Fault
+
+    with remote_graph() as remote:
+        process = deploy_real(rig.path, rig.calibration, remote.domain)
+        try:
+            _serving(remote)
+            injected = time.time()
+            rig.bus.emulator.inject(3, Fault.SILENT)
+            time.sleep(1.0)
+            goals = rig.bus.written("Goal_Position", injected + 0.025)
+        finally:
+            _, err = stop(process)
+    latched = [line for line in err.splitlines() if "E-stop latched" in line]
+    assert len(latched) == 1, err
+    assert "motor 3 (elbow_flex) stopped answering" in latched[0]
+    assert goals == []
+
+
+@pytest.mark.parametrize(
+    ("case", "expected"),
+    [
+        ("wrong port", "no such serial port"),
+        ("busy port", "the port is busy"),
+        ("missing motor", "motor 5 (wrist_roll) does not answer"),
+        ("another robot's calibration", "this is another robot's calibration"),
+        ("duplicate motor ids", "real.feetech.motors[5].id: id 5 is already the id of"),
+    ],
+)
+def test_bad_input_is_one_line_exit_1_and_nothing_written(
+    rig: Rig, tmp_path: Path, case: str, expected: str
+) -> None:
+    import serial
+
+    args = ["--transport", rig.path, "--calibration", str(rig.calibration), "--robot", "so101"]
+    held = None
+    if case == "wrong port":
+        args[1] = "/dev/pts/no-such-port"
+    elif case == "busy port":
+        held = serial.Serial(rig.path, 1_000_000, exclusive=True)
+    elif case == "missing motor":
+        from openral_real.emulator.bus_emulator import Fault
+
+        rig.bus.emulator.inject(5, Fault.SILENT)
+    elif case == "another robot's calibration":
+        other = tmp_path / "koch.json"
+        other.write_text(rig.calibration.read_text().replace('"wrist_roll"', '"wrist_twist"'))
+        args[3] = str(other)
+    else:
+        manifest = tmp_path / "so101" / "robot.yaml"
+        manifest.parent.mkdir()
+        text = (rig.robot.folder / "robot.yaml").read_text()
+        manifest.write_text(text.replace("{joint: gripper, id: 6}", "{joint: gripper, id: 5}"))
+        args[-2:] = ["--manifest", str(manifest)]
+    before = len([line for line in rig.bus.lines if "WRITE" in line])
+    try:
+        process = openral("deploy", "real", *args, "--duration", "1")
+        _, err = process.communicate(timeout=60)
+    finally:
+        if held is not None:
+            held.close()
+    lines = [line for line in err.strip().splitlines() if not line.startswith("[INFO]")]
+    assert process.returncode == 1 and len(lines) == 1, err
+    assert expected in lines[0], lines[0]
+    assert len([line for line in rig.bus.lines if "WRITE" in line]) == before
