@@ -125,6 +125,10 @@ bench-reload *ARGS:
 bench-trajectory *ARGS:
     python -m benchmarks.trajectory_tracking {{ARGS}}
 
+# The real driver on the emulated so101 bus: a control tick's bus round trip (against the bare SDK and the wire time) and 100 Hz held for 60 s; writes benchmarks/results/real_bus.json.
+bench-real *ARGS:
+    python -m benchmarks.real_bus {{ARGS}}
+
 # CPU that `deploy sim --record` adds to deploy sim alone on the franka tabletop, and messages dropped; writes benchmarks/results/record_cost.json.
 bench-record *ARGS:
     python -m benchmarks.record_cost {{ARGS}}

@@ -82,8 +82,8 @@ def test_a_manifest_that_does_not_load_is_counted_as_not_checked(
     assert result.exit_code == 1
     assert result.stderr.splitlines() == [
         f"✗ {invalid}:7:1: nmae: unknown field 'nmae' (did you mean name?); expected one of: "
-        "base, display_name, frames, joints, mobile_base, name, schema_version, sensors, sim, "
-        "trajectory",
+        "base, display_name, frames, joints, mobile_base, name, real, schema_version, sensors, "
+        "sim, trajectory",
         "1 of 1 robot(s) could not be checked",
     ]
     assert re.search(r"│ invalid +│ - +│ - +│ could not be checked +│", result.stdout)
@@ -126,8 +126,8 @@ def test_list_shows_an_invalid_robot_with_its_located_problem(
     assert [cell.strip() for cell in row.split("│")][1:-1] == ["bad_arm (invalid)", *"-----"]
     assert result.stderr == (
         f"✗ {bad}:8:1: nmae: unknown field 'nmae' (did you mean name?); expected one of: "
-        "base, display_name, frames, joints, mobile_base, name, schema_version, sensors, sim, "
-        "trajectory\n"
+        "base, display_name, frames, joints, mobile_base, name, real, schema_version, sensors, "
+        "sim, trajectory\n"
     )
     assert re.search(r"│ ur5e +│ +6 │", result.stdout)
 

@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
-from openral_core.models import DeployScene, RobotDescription, SimDescription
+from openral_core.models import DeployScene, RealDescription, RobotDescription, SimDescription
 from openral_core.schemas import SchemaName, validator
 from pydantic import BaseModel, ValidationError
 
@@ -24,6 +24,7 @@ from tests.properties.schema_strategy import documents
 MODELS: dict[SchemaName, type[BaseModel]] = {
     SchemaName.ROBOT: RobotDescription,
     SchemaName.SIM: SimDescription,
+    SchemaName.REAL: RealDescription,
     SchemaName.SCENE: DeployScene,
 }
 # Shrinking these large documents can take minutes; a failure is reported unshrunk

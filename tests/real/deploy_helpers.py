@@ -99,3 +99,50 @@ def camera_clip(file: Path, frames: int = 20) -> Path:
         writer.write(frame)
     writer.release()
     return file
+
+
+class RemoteBus:
+    """``openral sim bus so101`` in a process of its own (as a user runs it), calibrated
+    non-interactively into ``folder``; its console and its log at hand."""
+
+    def __init__(self, folder: Path) -> None:
+        self.log = folder / "bus.log"
+        self.calibration = folder / "so101.json"
+        self.process = openral("sim", "bus", "so101", "--log", str(self.log), stdin=subprocess.PIPE)
+        assert self.process.stdout is not None
+        self.path = self.process.stdout.readline().strip()
+        self.process.stdout.readline()  # the summary line
+        calibrate = openral(
+            "robot", "calibrate", "so101", "--transport", self.path, "--non-interactive",
+            "--calibration", str(self.calibration),
+        )  # fmt: skip
+        _, err = calibrate.communicate(timeout=60)
+        assert calibrate.returncode == 0, err
+
+    def command(self, line: str) -> str:
+        """One console command and its one-line answer."""
+        assert self.process.stdin is not None and self.process.stdout is not None
+        self.process.stdin.write(line + "\n")
+        self.process.stdin.flush()
+        return self.process.stdout.readline().strip()
+
+    def lines(self, after: float = 0.0) -> list[str]:
+        """Log lines stamped after ``after`` [s, system clock]."""
+        text = self.log.read_text(encoding="utf-8")
+        return [line for line in text.splitlines() if float(line.split(" ", 1)[0]) > after]
+
+    def written(self, register: str, after: float = 0.0) -> list[str]:
+        """Log lines that wrote ``register`` after ``after``."""
+        return [
+            line
+            for line in self.lines(after)
+            if f"SYNC_WRITE {register} " in line or f" {register}=" in line
+        ]
+
+    def close(self) -> None:
+        """``quit``, then wait for the process (killed if it does not end)."""
+        try:
+            self.command("quit")
+            self.process.communicate(timeout=30)
+        finally:
+            self.process.kill()

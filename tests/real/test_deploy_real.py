@@ -1,10 +1,13 @@
 """``openral deploy real`` as a subprocess, driving an emulated SO-101 bus (on the emulator,
 not on hardware): the graph of deploy sim on a real driver, policies and goals moving the
-servos, E-stop, faults, a clean stop, and bad input said in one line."""
+servos, E-stop, faults, a clean stop, and bad input said in one line. The emulator answers
+in real time beside the driver: these run in the exclusive phase."""
 
 from __future__ import annotations
 
+import re
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -12,9 +15,9 @@ import pytest
 from openral_nodes.service_call import call_trigger
 from rclpy.node import Node
 
-from tests.real.conftest import Rig
 from tests.real.deploy_helpers import (
     Remote,
+    RemoteBus,
     camera_clip,
     deploy_real,
     joints_now,
@@ -24,45 +27,80 @@ from tests.real.deploy_helpers import (
 )
 from tests.ros.action_client import TrajectoryActionClient, goal
 
+pytestmark = pytest.mark.exclusive  # a servo bus emulated in real time, beside its driver
 SUCCEEDED = 4
 ARM = ("shoulder_pan", "elbow_flex", "wrist_flex")
+
+
+@pytest.fixture
+def bus(tmp_path: Path) -> Iterator[RemoteBus]:
+    """An emulated SO-101 bus in a process of its own, calibrated."""
+    remote = RemoteBus(tmp_path)
+    yield remote
+    remote.close()
+
+
+def _torque(bus: RemoteBus) -> list[int]:
+    return [int(x) for x in re.findall(r"torque (\d)", bus.command("status"))]
 
 
 def _serving(remote: Remote) -> None:
     remote.probe.wait_count("/joint_states", 1, timeout_s=40.0)
 
 
-def test_wave_and_a_three_point_goal_move_the_emulated_servos(rig: Rig, tmp_path: Path) -> None:
+def test_one_graph_wave_a_three_point_goal_estop_and_a_clean_stop(
+    bus: RemoteBus, tmp_path: Path
+) -> None:
+    """One deploy real, as a user runs it: cameras from clips, `rskill run --policy wave`,
+    a 3-point FollowJointTrajectory goal, E-stop and release, reset refused, Ctrl-C."""
     clip = camera_clip(tmp_path / "clip.mp4")
     cameras = ("--camera", f"front=file:{clip}", "--camera", f"wrist=file:{clip}")
     with remote_graph() as remote:
-        process = deploy_real(rig.path, rig.calibration, remote.domain, *cameras)
+        process = deploy_real(bus.path, bus.calibration, remote.domain, *cameras)
+        client = Node("real_client", context=remote.context)
+        remote.spinner.add_node(client)
         try:
             _serving(remote)
-            remote.probe.wait_count("/openral/cameras/front/image", 2, timeout_s=10.0)
-            frame = remote.probe.latest("/openral/cameras/front/image")
-            assert (frame.width, frame.height, frame.encoding) == (128, 128, "rgb8")
-            seen = time.time()
-            runner = openral(
-                "rskill", "run", "--robot", "so101", "--policy", "wave", "-p", "amplitude=0.3",
-                "--duration", "4", "--domain-id", str(remote.domain),
-            )  # fmt: skip
-            out, err = runner.communicate(timeout=60)
-            assert runner.returncode == 0, err
-            pan = [
-                int(line.split()[3].split("=")[1])
-                for line in rig.bus.written("Goal_Position", seen)
-            ]
-            assert max(pan) - min(pan) > 0.4 * 4096 / (2 * np.pi)  # the wave swung the servo
-            _three_point_goal(remote)
-        finally:
+            _cameras_publish(remote)
+            _wave_moves_the_servos(bus, remote)
+            _three_point_goal(remote, client)
+            _estop_release_and_reset(client)
+            stopped = time.time()
             out, err = stop(process)
-    assert "clean shutdown" in out, err
+        finally:
+            remote.spinner.remove_node(client)
+            client.destroy_node()  # type: ignore[no-untyped-call]
+            stop(process)
+    assert process.returncode == 0, err
+    assert "stopped (signal)" in out and "clean shutdown" in out and "Traceback" not in err
+    assert "nothing moves until it is released" not in err  # no fault latched on the way
+    writes = [line.split()[1:3] for line in bus.lines(stopped)]
+    writes = [kind for kind in writes if kind[0] == "SYNC_WRITE"]
+    assert writes[-2:] == [["SYNC_WRITE", "Goal_Position"], ["SYNC_WRITE", "Torque_Enable"]]
+    assert _torque(bus) == [0] * 6
 
 
-def _three_point_goal(remote: Remote) -> None:
-    node = Node("real_goal_client", context=remote.context)
-    remote.spinner.add_node(node)
+def _cameras_publish(remote: Remote) -> None:
+    remote.probe.wait_count("/openral/cameras/front/image", 2, timeout_s=10.0)
+    frame = remote.probe.latest("/openral/cameras/front/image")
+    assert (frame.width, frame.height, frame.encoding) == (128, 128, "rgb8")
+
+
+def _wave_moves_the_servos(bus: RemoteBus, remote: Remote) -> None:
+    seen = time.time()
+    runner = openral(
+        "rskill", "run", "--robot", "so101", "--policy", "wave", "-p", "amplitude=0.3",
+        "--duration", "6", "--domain-id", str(remote.domain),
+    )  # fmt: skip
+    _, err = runner.communicate(timeout=60)
+    assert runner.returncode == 0, err
+    written = bus.written("Goal_Position", seen)
+    assert written, (bus.lines(seen - 1)[-5:], err)
+    pan = [int(line.split()[3].split("=")[1]) for line in written]
+    assert max(pan) - min(pan) > 0.25 * 4096 / (2 * np.pi)  # the wave swung the servo
+
+
+def _three_point_goal(remote: Remote, node: Node) -> None:
     client = TrajectoryActionClient(node)
     try:
         start = joints_now(remote)
@@ -78,46 +116,24 @@ def _three_point_goal(remote: Remote) -> None:
             assert reached[joint] == pytest.approx(wanted, abs=0.02)
     finally:
         client.destroy()
-        remote.spinner.remove_node(node)
-        node.destroy_node()  # type: ignore[no-untyped-call]
 
 
-def test_estop_holds_reset_is_refused_and_sigint_holds_then_releases_torque(rig: Rig) -> None:
+def _estop_release_and_reset(client: Node) -> None:
+    assert call_trigger(client, "/openral/estop", 10.0).success
+    reset = call_trigger(client, "/openral/reset", 10.0)
+    assert not reset.success and "a real robot cannot be reset" in reset.message
+    assert call_trigger(client, "/openral/release_estop", 10.0).success
+
+
+def test_a_silent_motor_is_one_line_and_no_goal_follows(bus: RemoteBus) -> None:
     with remote_graph() as remote:
-        process = deploy_real(rig.path, rig.calibration, remote.domain)
-        client = Node("real_estop_client", context=remote.context)
-        remote.spinner.add_node(client)
-        try:
-            _serving(remote)
-            assert call_trigger(client, "/openral/estop", 10.0).success
-            reset = call_trigger(client, "/openral/reset", 10.0)
-            assert not reset.success and "a real robot cannot be reset" in reset.message
-            assert call_trigger(client, "/openral/release_estop", 10.0).success
-            stopped = time.time()
-            out, err = stop(process)
-        finally:
-            remote.spinner.remove_node(client)
-            client.destroy_node()  # type: ignore[no-untyped-call]
-            stop(process)
-    assert process.returncode == 0, err
-    assert "stopped (signal)" in out and "clean shutdown" in out and "Traceback" not in err
-    writes = [line.split()[1:3] for line in rig.bus.lines if float(line.split()[0]) > stopped]
-    writes = [kind for kind in writes if kind[0] == "SYNC_WRITE"]
-    assert writes[-2:] == [["SYNC_WRITE", "Goal_Position"], ["SYNC_WRITE", "Torque_Enable"]]
-    assert [s.get("Torque_Enable") for s in rig.bus.emulator.servos.values()] == [0] * 6
-
-
-def test_a_silent_motor_is_one_line_and_no_goal_follows(rig: Rig) -> None:
-    from openral_real.emulator.bus_emulator import Fault
-
-    with remote_graph() as remote:
-        process = deploy_real(rig.path, rig.calibration, remote.domain)
+        process = deploy_real(bus.path, bus.calibration, remote.domain)
         try:
             _serving(remote)
             injected = time.time()
-            rig.bus.emulator.inject(3, Fault.SILENT)
+            assert bus.command("silent 3").startswith("ok")
             time.sleep(1.0)
-            goals = rig.bus.written("Goal_Position", injected + 0.025)
+            goals = bus.written("Goal_Position", injected + 0.025)
         finally:
             _, err = stop(process)
     latched = [line for line in err.splitlines() if "E-stop latched" in line]
@@ -137,31 +153,30 @@ def test_a_silent_motor_is_one_line_and_no_goal_follows(rig: Rig) -> None:
     ],
 )
 def test_bad_input_is_one_line_exit_1_and_nothing_written(
-    rig: Rig, tmp_path: Path, case: str, expected: str
+    bus: RemoteBus, tmp_path: Path, case: str, expected: str
 ) -> None:
     import serial
+    from openral_core.paths import repo_root
 
-    args = ["--transport", rig.path, "--calibration", str(rig.calibration), "--robot", "so101"]
+    args = ["--transport", bus.path, "--calibration", str(bus.calibration), "--robot", "so101"]
     held = None
     if case == "wrong port":
         args[1] = "/dev/pts/no-such-port"
     elif case == "busy port":
-        held = serial.Serial(rig.path, 1_000_000, exclusive=True)
+        held = serial.Serial(bus.path, 1_000_000, exclusive=True)
     elif case == "missing motor":
-        from openral_real.emulator.bus_emulator import Fault
-
-        rig.bus.emulator.inject(5, Fault.SILENT)
+        assert bus.command("silent 5").startswith("ok")
     elif case == "another robot's calibration":
         other = tmp_path / "koch.json"
-        other.write_text(rig.calibration.read_text().replace('"wrist_roll"', '"wrist_twist"'))
+        other.write_text(bus.calibration.read_text().replace('"wrist_roll"', '"wrist_twist"'))
         args[3] = str(other)
     else:
         manifest = tmp_path / "so101" / "robot.yaml"
         manifest.parent.mkdir()
-        text = (rig.robot.folder / "robot.yaml").read_text()
+        text = (repo_root() / "robots" / "so101" / "robot.yaml").read_text()
         manifest.write_text(text.replace("{joint: gripper, id: 6}", "{joint: gripper, id: 5}"))
         args[-2:] = ["--manifest", str(manifest)]
-    before = len([line for line in rig.bus.lines if "WRITE" in line])
+    started = time.time()
     try:
         process = openral("deploy", "real", *args, "--duration", "1")
         _, err = process.communicate(timeout=60)
@@ -171,4 +186,4 @@ def test_bad_input_is_one_line_exit_1_and_nothing_written(
     lines = [line for line in err.strip().splitlines() if not line.startswith("[INFO]")]
     assert process.returncode == 1 and len(lines) == 1, err
     assert expected in lines[0], lines[0]
-    assert len([line for line in rig.bus.lines if "WRITE" in line]) == before
+    assert [line for line in bus.lines(started) if "WRITE" in line] == []

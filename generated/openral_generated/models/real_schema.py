@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from enum import IntEnum, StrEnum
+from enum import StrEnum
 from pydantic import (
     ConfigDict,
     Field,
@@ -40,30 +40,6 @@ class Shutdown(StrEnum):
 
     hold = "hold"
     torque_off = "torque_off"
-
-
-class BaudRate(IntEnum):
-    """
-    Bus speed [bit/s], one of the rates STS servos offer. LeRobot's arms run at 1,000,000.
-    """
-
-    integer_1000000 = 1000000
-    integer_500000 = 500000
-    integer_250000 = 250000
-    integer_128000 = 128000
-    integer_115200 = 115200
-    integer_57600 = 57600
-    integer_38400 = 38400
-    integer_19200 = 19200
-
-
-class Protocol(IntEnum):
-    """
-    Feetech protocol end: 0 for STS/SMS servos (little-endian words, Sync Read), 1 for SCS servos. The driver reads every joint in one Sync Read, so it needs 0.
-    """
-
-    integer_0 = 0
-    integer_1 = 1
 
 
 class ServoModel(StrEnum):
@@ -159,11 +135,11 @@ class FeetechBus(OpenralModel):
     model_config = ConfigDict(
         extra="forbid",
     )
-    baud_rate: BaudRate = BaudRate.integer_1000000
+    baud_rate: Annotated[StrictInt, Field(ge=19200, le=1000000)] = 1000000
     """
-    Bus speed [bit/s], one of the rates STS servos offer. LeRobot's arms run at 1,000,000.
+    Bus speed [bit/s]: one of the rates STS servos offer (1000000, 500000, 250000, 128000, 115200, 57600, 38400, 19200). LeRobot's arms run at 1,000,000.
     """
-    protocol: Protocol = Protocol.integer_0
+    protocol: Annotated[StrictInt, Field(ge=0, le=1)] = 0
     """
     Feetech protocol end: 0 for STS/SMS servos (little-endian words, Sync Read), 1 for SCS servos. The driver reads every joint in one Sync Read, so it needs 0.
     """

@@ -220,7 +220,8 @@ class CommandInterfaces:
         follower = self.loop.follower if self.loop is not None else None
         aborted = follower is not None and follower.cancel("the E-stop latched")
         note = "; the joint trajectory is aborted" if aborted else ""
-        self._log().warning(f"E-stop latched: actions are refused and the scene is frozen{note}")
+        held = "the arm is held" if self.hal.is_real else "the scene is frozen"
+        self._log().warning(f"E-stop latched: actions are refused and {held}{note}")
         response.success, response.message = True, f"E-stop latched{note}"
         return response
 

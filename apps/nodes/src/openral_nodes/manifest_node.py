@@ -75,7 +75,7 @@ from openral_nodes.control_loops import start_control_loop
 from openral_nodes.heap_freeze import HeapFreeze
 from openral_nodes.lifecycle_guard import guard_change_state
 from openral_nodes.node_parameters import BOUNDS, PARAMETERS, check_rates, configured_hal
-from openral_nodes.robot_state_streams import RobotStateStreams
+from openral_nodes.robot_state_streams import RobotStateStreams, urdf_before_connect
 from openral_nodes.scene_bridges import SceneBridges
 
 NODE_NAME = "openral_manifest_node"
@@ -143,6 +143,7 @@ class ManifestLifecycleNode(LifecycleNode):
         self._loaded: LoadedRobot | None = None
         self._entities: list[tuple[str, Any]] = []
         self._shutdown_event = shutdown_event
+        self._urdf: str | None = None
         guard_change_state(self, WARN_EVERY_S)
 
     # -- transitions -----------------------------------------------------------------------
@@ -167,7 +168,8 @@ class ManifestLifecycleNode(LifecycleNode):
         inactive) with :attr:`boot_error` set when the HAL does not connect."""
         try:
             hal = self._hal()
-            if hal.is_real:  # its collection stalls threads: before the driver's starts
+            if hal.is_real:  # both stall threads for tens of ms: before the driver starts
+                self._urdf = urdf_before_connect(hal, self._loaded)
                 self.heap.freeze()
             if not hal.connected:
                 hal.connect()
@@ -325,6 +327,7 @@ class ManifestLifecycleNode(LifecycleNode):
             rate_hz,
             self._loaded,
             bool(self._param("publish_tf")),
+            self._urdf,
         )
         self.states.start(pacer)
         rules = self.description.trajectory if self.description is not None else None

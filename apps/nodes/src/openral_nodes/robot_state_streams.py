@@ -51,6 +51,7 @@ class RobotStateStreams:
         rate_hz: float,
         robot: LoadedRobot | None,
         publish_tf: bool = True,
+        urdf: str | None = None,
     ) -> None:
         """Lay out the frames (nothing is published until :meth:`start`).
 
@@ -63,6 +64,8 @@ class RobotStateStreams:
             robot: The loaded robot (for its URDF).
             publish_tf: False leaves ``/tf`` and ``/tf_static`` to another node (a
                 robot_state_publisher fed by our ``/joint_states`` and ``/robot_description``).
+            urdf: The URDF made beforehand (:func:`urdf_before_connect`); None: made on a
+                thread after start.
         """
         self.node, self.loop = node, loop
         tree = self._frame_tree(hal) if loop is not None else None
@@ -82,7 +85,7 @@ class RobotStateStreams:
         if tree is not None and robot is not None:
             name = robot.name
             self.description = DescriptionPublisher(
-                node, lambda: scene_robot_description(tree, name)
+                node, (lambda: urdf) if urdf else (lambda: scene_robot_description(tree, name))
             )
 
     def start(self, pacer: Pacer) -> None:
@@ -132,3 +135,17 @@ def _data(hal: RobotHal) -> Any:
     """The HAL's live MuJoCo data (a FramesHal has it)."""
     handles = hal.mujoco_handles() if isinstance(hal, FramesHal) else None
     return handles[1] if handles is not None else None
+
+
+def urdf_before_connect(hal: RobotHal, robot: LoadedRobot | None) -> str | None:
+    """A real robot's URDF, made before its driver starts (making one holds Python's lock for
+    tens of milliseconds, which would stall the driver's loop); None for a simulated robot
+    (made on a thread after start) or one without frames.
+
+    Raises:
+        HalError: The robot's frames cannot be laid out as a tree.
+    """
+    if not hal.is_real or robot is None or not isinstance(hal, FramesHal):
+        return None
+    tree = hal.frame_tree()
+    return scene_robot_description(tree, robot.name) if tree is not None else None

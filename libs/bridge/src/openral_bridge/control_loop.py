@@ -81,6 +81,10 @@ class Following(Protocol):
         ...
 
 
+Drive = Callable[[Callable[[], None] | None], None]
+"""Hands a driver the tick to call after each of its readings (None: takes it back)."""
+
+
 class ResetFailed(RuntimeError):
     """A reset was not carried out (the loop stopped, timed out, or the HAL raised)."""
 
@@ -127,14 +131,9 @@ class ControlLoop:
         self.node, self.hal, self.on_tick = node, hal, on_tick
         self.lock = lock if lock is not None else threading.Lock()
         self.period_s = float(hal.control_period_s)
-        self.ticks = 0
-        """Ticks that advanced the scene."""
-        self.applied = 0
-        """Actions applied by a tick."""
-        self.superseded = 0
-        """Actions replaced by a newer one, or dropped, before any tick applied them."""
-        self.failed = 0
-        """Ticks that raised (a diverged simulation, a refused action)."""
+        self.ticks = self.applied = self.superseded = self.failed = 0
+        """Ticks that advanced the scene; actions applied by a tick; actions replaced by a
+        newer one, or dropped, before any tick applied them; ticks that raised."""
         self.watch = RealTimeWatch()
         self.state: JointStateSample | None = None
         """The HAL's state right after the last tick that stepped (read holding the lock);
@@ -157,7 +156,7 @@ class ControlLoop:
         self._reset: _ResetRequest | None = None
         self._pending_lock = threading.Lock()
         self._job: tuple[Pacer, PacedJob] | None = None
-        self._driven: Callable[[Callable[[], None] | None], None] | None = None
+        self._driven: Drive | None = None
 
     @property
     def running(self) -> bool:
@@ -172,7 +171,7 @@ class ControlLoop:
         self.tick()
         self._job = (pacer, pacer.every(self.period_s, self.tick, "control"))
 
-    def start_driven(self, drive: Callable[[Callable[[], None] | None], None]) -> None:
+    def start_driven(self, drive: Drive) -> None:
         """Tick once now, then whenever the robot's driver calls back: ``drive(tick)``
         hands :meth:`tick` to it (``drive(None)`` at :meth:`stop` takes it back)."""
         self.stop()

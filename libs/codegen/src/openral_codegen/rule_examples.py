@@ -210,6 +210,9 @@ RULE_BREAKS = (
     ),
     RuleBreak(SchemaName.ROBOT, 25, SO101_FILE, "    protocol: 0\n", "    protocol: 1\n"),
     RuleBreak(
+        SchemaName.ROBOT, 26, SO101_FILE, "    baud_rate: 1000000\n", "    baud_rate: 230400\n"
+    ),
+    RuleBreak(
         SchemaName.SCENE,
         1,
         SCENE_FILE,

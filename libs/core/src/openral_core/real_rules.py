@@ -1,4 +1,4 @@
-"""Cross-field rules of a manifest's ``real`` section (rules 20 to 25 of robot.schema.json).
+"""Cross-field rules of a manifest's ``real`` section (rules 20 to 26 of robot.schema.json).
 
 They keep the wiring a real driver reads sound before anything touches a bus: the feetech
 driver has its bus, every joint has exactly one motor, no two motors share an id, a joint a
@@ -14,6 +14,8 @@ from openral_core.models import FeetechBus, Joint, LimitedJoint, RobotDescriptio
 from openral_core.yaml_source import PathKey
 
 Finding = tuple[PathKey, str]
+STS_BAUD_RATES = (1_000_000, 500_000, 250_000, 128_000, 115_200, 57_600, 38_400, 19_200)
+"""The bus speeds an STS servo can be set to [bit/s]."""
 
 
 def real_findings(robot: RobotDescription) -> Iterator[Finding]:
@@ -70,6 +72,12 @@ def _feetech_findings(robot: RobotDescription, bus: FeetechBus) -> Iterator[Find
     for name in bus.joint_settings or {}:  # rule 24
         if name not in joints:
             yield (*base, "joint_settings", name), _not_a_joint(name, robot)
+    if int(bus.baud_rate) not in STS_BAUD_RATES:  # rule 26
+        rates = ", ".join(str(rate) for rate in STS_BAUD_RATES)
+        yield (
+            (*base, "baud_rate"),
+            f"{bus.baud_rate} is no rate of STS servos; expected one of {rates}",
+        )
     if int(bus.protocol) != 0:  # rule 25
         yield (
             (*base, "protocol"),

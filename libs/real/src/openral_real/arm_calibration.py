@@ -23,11 +23,9 @@ from collections.abc import Callable
 from openral_core.models import LimitedJoint, RobotDescription
 from openral_core.real_wiring import FeetechWiring
 
-from openral_real.calibration import MotorCalibration
+from openral_real.calibration import HALF_TURN, MotorCalibration
 from openral_real.feetech_bus import FeetechBus
 
-HALF_TURN = 2047
-"""Where the middle of a joint's range reads after homing [steps] (4095 // 2, LeRobot's)."""
 RANGE_POLL_S = 0.02
 """How often the range recording reads the arm [s]."""
 

@@ -7,10 +7,15 @@ this) and ``range_min``/``range_max`` (the present positions at the ends of the 
 travel, recorded while the arm was moved by hand). So an arm calibrated with LeRobot works
 here as it is, and a file written here works in LeRobot.
 
-How present positions become radians (:class:`JointScale`): the middle of the calibrated
-range is the middle of the joint's ``position_limits``; 4096 steps (the servo's resolution)
-are one turn; ``drive_mode`` 1 turns the sign. For a joint whose limits are symmetric about
-0, this is LeRobot's own degrees reading, in radians.
+How present positions become radians (:class:`JointScale`): the homing pose, where the
+present position reads 2047 (half a turn) after calibration, is the middle of the joint's
+``position_limits`` (where the user held it: "the middle of its range"); 4096 steps (the
+servo's resolution) are one turn; ``drive_mode`` 1 turns the sign. The recorded range
+bounds the goals. Anchoring the angle at the homing pose, not at the middle of the
+recorded range (LeRobot's degrees), keeps the reading true where a joint cannot be swept
+evenly: an SO-101's elbow folds onto its upper arm before its upper limit, so its recorded
+range is lopsided. Two calibrations homed in the same pose, LeRobot's or this driver's,
+read the same radians whatever ranges they recorded.
 """
 
 from __future__ import annotations
@@ -29,6 +34,8 @@ from openral_real.errors import CalibrationError
 FIELDS = ("id", "drive_mode", "homing_offset", "range_min", "range_max")
 HOMING_LIMIT = 2047
 """Largest homing offset the 11-bit sign-magnitude register holds [steps]."""
+HALF_TURN = 2047
+"""What a homed servo reads in the homing pose [steps] (LeRobot's ``int(4095 / 2)``)."""
 
 
 @dataclass(frozen=True)
@@ -48,7 +55,7 @@ class JointScale:
 
     calibration: MotorCalibration
     centre_rad: float
-    """The middle of the joint's position limits [rad]."""
+    """The middle of the joint's position limits [rad]: its angle in the homing pose."""
     steps_per_rad: float
 
     @property
@@ -56,18 +63,13 @@ class JointScale:
         """-1 when the servo counts against the joint."""
         return -1.0 if self.calibration.drive_mode else 1.0
 
-    @property
-    def middle(self) -> float:
-        """The middle of the calibrated range [steps]."""
-        return (self.calibration.range_min + self.calibration.range_max) / 2.0
-
     def angle(self, steps: float) -> float:
         """The joint angle [rad] at present position ``steps``."""
-        return self.centre_rad + self.sign * (steps - self.middle) / self.steps_per_rad
+        return self.centre_rad + self.sign * (steps - HALF_TURN) / self.steps_per_rad
 
     def steps(self, angle_rad: float) -> int:
         """The present position [steps] of ``angle_rad``, inside the calibrated range."""
-        raw = round(self.middle + self.sign * (angle_rad - self.centre_rad) * self.steps_per_rad)
+        raw = round(HALF_TURN + self.sign * (angle_rad - self.centre_rad) * self.steps_per_rad)
         return min(max(raw, self.calibration.range_min), self.calibration.range_max)
 
     def rate(self, steps_per_s: float) -> float:

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import termios
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -42,6 +43,8 @@ PRESENT_FIRST = "Present_Position"
 PRESENT_LAST = "Moving"
 SERIAL_READ_TIMEOUT_S = 0.001
 """How long one read of the port waits for bytes before the SDK looks at its timeout [s]."""
+STALL_MS = 2.0
+"""A reply wait this much longer than its timeout was this thread held up [ms]."""
 CONNECT_TIMEOUT_MS = 50.0
 """Reply timeout of the pings and register reads at connect [ms]."""
 
@@ -225,8 +228,7 @@ class FeetechBus:
         self._check(None, result, 0, "sending the Sync Read")
         readings = []
         for servo_id in ids:
-            self._port.setPacketTimeoutMillis(self._reply_ms(length))
-            data, result, error = self._call(self._packets.readRx, self._port, servo_id, length)
+            data, result, error = self._receive(servo_id, length)
             if result == scs.COMM_RX_CORRUPT:  # once more, on its own
                 self._port.setPacketTimeoutMillis(self._reply_ms(length) + self._byte_ms * 8)
                 data, result, error = self._call(
@@ -237,6 +239,20 @@ class FeetechBus:
         return readings
 
     # -- internals ---------------------------------------------------------------------------
+
+    def _receive(self, servo_id: int, length: int) -> tuple[list[int], int, int]:
+        """One motor's reply to the Sync Read. A timeout that took far longer than the
+        timeout itself means this thread was held up (Python's lock, the scheduler) while
+        the reply came: when bytes are waiting, they are read once more."""
+        reply_ms = self._reply_ms(length)
+        began = time.monotonic()
+        self._port.setPacketTimeoutMillis(reply_ms)
+        data, result, error = self._call(self._packets.readRx, self._port, servo_id, length)
+        held_up = (time.monotonic() - began) * 1000.0 > reply_ms + STALL_MS
+        if result == scs.COMM_RX_TIMEOUT and held_up and self._port.getBytesAvailable():
+            self._port.setPacketTimeoutMillis(reply_ms)
+            data, result, error = self._call(self._packets.readRx, self._port, servo_id, length)
+        return data, result, error
 
     def _reading(self, block: bytes, error: int) -> ServoReading:
         first = self._present[0]

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
@@ -34,7 +34,6 @@ import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
 from openral_core.models import LimitedJoint, RgbSensor, RobotDescription
 from openral_core.real_wiring import FeetechWiring, RealWiring
-from openral_core.servo_models import fault_text
 from openral_hal.errors import ActionRejected, ConfigurationError, NotConnected
 from openral_hal.factory import RealOptions
 from openral_hal.protocol import EStopLatch
@@ -42,15 +41,15 @@ from openral_mujoco.action import validated_action
 from openral_mujoco.state import FloatArray, JointStateSample
 from openral_sim.frame_tree import FrameTree
 
+from openral_real.bus_bringup import bring_up
 from openral_real.bus_cycle import BusCycle, CycleTimes
 from openral_real.calibration import (
-    MotorCalibration,
     calibration_path,
     joint_scales,
     read_calibration,
 )
 from openral_real.errors import BusError, BusFault
-from openral_real.feetech_bus import FeetechBus, ServoReading
+from openral_real.feetech_bus import FeetechBus
 from openral_real.kinematic_twin import KinematicTwin
 from openral_real.motion_envelope import MotionEnvelope
 from openral_real.opencv_cameras import Cameras, camera_devices
@@ -60,12 +59,6 @@ SWITCH_INTERVAL_S = 0.001
 """Python's thread switch interval while connected [s]: the bus's thread waits at most this
 long for Python's lock after its bytes arrive (the default, 5 ms, is half a control
 period). Restored at disconnect."""
-CALIBRATION_REGISTERS = {
-    "Homing_Offset": "homing_offset",
-    "Min_Position_Limit": "range_min",
-    "Max_Position_Limit": "range_max",
-}
-"""The servo registers a calibration is written to, and its field each holds."""
 
 
 @dataclass(frozen=True)
@@ -116,6 +109,8 @@ class FeetechHal(EStopLatch):
         self._rgb = {s.name: s for s in robot.description.sensors if isinstance(s, RgbSensor)}
         self._devices = camera_devices(self._rgb, self.options.cameras)
         self._session: _Session | None = None
+        self._twin = KinematicTwin(robot) if robot.tables.hal_wiring is not None else None
+        """The robot's model, compiled here so its frames are known before connecting."""
         self._switch_interval = sys.getswitchinterval()
 
     # -- what the HAL is ---------------------------------------------------------------------
@@ -163,11 +158,11 @@ class FeetechHal(EStopLatch):
         """
         calibration = read_calibration(self.calibration_file, self.description, self.bus_wiring)
         units = ServoUnits(self.robot, joint_scales(self.description, self.bus_wiring, calibration))
-        twin = KinematicTwin(self.robot) if self.robot.tables.hal_wiring is not None else None
+        twin = self._twin
         bus = FeetechBus(self.port, self.bus_wiring, self.joint_names)
         bus.open()
         try:
-            readings = self._prepare(bus, calibration)
+            readings = bring_up(bus, calibration, self._fix_hint())
             cameras = Cameras(self._rgb, self._devices)
             cameras.open()
         except BusFault as error:
@@ -293,9 +288,9 @@ class FeetechHal(EStopLatch):
     # -- frames and cameras ------------------------------------------------------------------
 
     def frame_tree(self) -> FrameTree | None:
-        """The robot's frames in its own model (None without a sim block)."""
-        twin = self._running().twin
-        return twin.frame_tree() if twin is not None else None
+        """The robot's frames in its own model (None without a sim block); known before
+        connecting."""
+        return self._twin.frame_tree() if self._twin is not None else None
 
     def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
         """The kinematic twin's (model, data), posed by :meth:`pose_twin`."""
@@ -330,48 +325,12 @@ class FeetechHal(EStopLatch):
 
     # -- internals ---------------------------------------------------------------------------
 
-    def _prepare(
-        self, bus: FeetechBus, calibration: Mapping[str, MotorCalibration]
-    ) -> list[ServoReading]:
-        """Read before writing, then hold where the arm is (see the module doc)."""
-        bus.check_motors()
-        self._check_calibrated(bus, calibration)
-        readings = bus.read_present()
-        faulty = [(i, r) for i, r in zip(bus.ids, readings, strict=True) if r.faults]
-        if faulty:
-            servo_id, reading = faulty[0]
-            raise BusError(
-                f"{bus.names[servo_id]} reports {fault_text(reading.faults)}; "
-                "clear it (power the servo off and on) before driving the arm"
-            )
-        for motor in self.bus_wiring.motors:
-            bus.write("Lock", motor.id, 0)
-            wanted = {"Operating_Mode": 0, **motor.settings}
-            for name, value in wanted.items():
-                if bus.read(name, motor.id) != value:
-                    bus.write(name, motor.id, value)
-        bus.write_goals([r.position for r in readings])  # where the arm is: no jump
-        for motor in self.bus_wiring.motors:
-            bus.write("Torque_Enable", motor.id, 1)
-            bus.write("Lock", motor.id, 1)
-        return readings
-
-    def _check_calibrated(
-        self, bus: FeetechBus, calibration: Mapping[str, MotorCalibration]
-    ) -> None:
-        """The servos hold the file's calibration (else nothing is written, one line)."""
-        for motor in self.bus_wiring.motors:
-            expected = calibration[motor.joint]
-            for register, field in CALIBRATION_REGISTERS.items():
-                held, wanted = bus.read(register, motor.id), getattr(expected, field)
-                if held != wanted:
-                    raise BusError(
-                        f"{bus.names[motor.id]} holds {register} {held} but "
-                        f"{self.calibration_file} says {wanted}: the servos hold another "
-                        f"calibration; write this one to them: openral robot calibrate "
-                        f"{self.robot.name} --transport {self.port} --apply "
-                        f"{self.calibration_file} (nothing was written to the bus)"
-                    )
+    def _fix_hint(self) -> str:
+        """How to write this HAL's calibration file to the servos (for a refusal)."""
+        return (
+            f"write {self.calibration_file} to them: openral robot calibrate {self.robot.name} "
+            f"--transport {self.port} --apply {self.calibration_file}"
+        )
 
     def _envelope(self) -> MotionEnvelope:
         joints = self.description.joints

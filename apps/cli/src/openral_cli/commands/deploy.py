@@ -156,21 +156,8 @@ def real(
     """Bring ROBOT's real arm up on TRANSPORT as the same ROS 2 graph as deploy sim."""
     if (robot is None) == (manifest is None):
         raise typer.BadParameter("give the robot: --robot ID or --manifest FILE (one of them)")
-    if calibration is not None:
-        _require_file(calibration, "calibration", "~/.cache/huggingface/lerobot/calibration/...")
-    if manifest is not None:
-        _require_file(manifest, "manifest", "robots/so101/robot.yaml")
-    parameters: dict[str, Any] = {
-        "robot_id": robot or "",
-        "manifest_path": str(manifest.resolve()) if manifest is not None else "",
-        "hal_mode": "real",
-        "transport": transport,
-        "viewer_enabled": False,
-        "calibration_file": str(calibration.resolve()) if calibration else "",
-        "arm_id": arm_id or "",
-        "cameras": list(camera or [""]),
-        "publish_tf": not no_tf,
-    }
+    parameters = _real_parameters(robot, manifest, transport, arm_id, calibration, camera)
+    parameters["publish_tf"] = not no_tf
     require_ros()
     from openral_nodes.runtime import ros_session
 
@@ -185,6 +172,31 @@ def real(
             if recorder is not None:
                 stop_recording(recorder)
     out.print(f"stopped ({reason}) after {elapsed_s:.1f} s; clean shutdown", soft_wrap=False)
+
+
+def _real_parameters(
+    robot: str | None,
+    manifest: Path | None,
+    transport: str,
+    arm_id: str | None,
+    calibration: Path | None,
+    cameras: list[str] | None,
+) -> dict[str, Any]:
+    """The manifest node's parameters for ``deploy real`` (files checked first)."""
+    if calibration is not None:
+        _require_file(calibration, "calibration", "~/.cache/huggingface/lerobot/calibration/...")
+    if manifest is not None:
+        _require_file(manifest, "manifest", "robots/so101/robot.yaml")
+    return {
+        "robot_id": robot or "",
+        "manifest_path": str(manifest.resolve()) if manifest is not None else "",
+        "hal_mode": "real",
+        "transport": transport,
+        "viewer_enabled": False,
+        "calibration_file": str(calibration.resolve()) if calibration else "",
+        "arm_id": arm_id or "",
+        "cameras": list(cameras or [""]),
+    }
 
 
 def _run_graph(

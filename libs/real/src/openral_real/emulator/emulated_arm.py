@@ -36,6 +36,7 @@ from openral_hal.protocol import Tickable
 from openral_mujoco.gripper import gripper_command, reading_map
 from openral_mujoco.state import FloatArray
 
+from openral_real.emulator.realtime import answer_first
 from openral_real.emulator.servo_motion import ServoProfile
 
 SLICE_S = 0.004
@@ -161,6 +162,7 @@ class EmulatedArm:
             self._shafts = self._read_shafts()
 
     def _run(self) -> None:
+        answer_first()  # it holds Python's lock the bus's answering thread waits for
         period = SLICE_S if isinstance(self.hal, MujocoArmHAL) else self._period()
         deadline = time.monotonic()
         while not self._stop.is_set():

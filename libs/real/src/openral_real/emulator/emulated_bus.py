@@ -27,7 +27,6 @@ from openral_real.emulator.bus_emulator import BusEmulator
 from openral_real.emulator.emulated_arm import EmulatedArm, servo_held
 from openral_real.emulator.pty_bus import PtyBus
 
-
 SWITCH_INTERVAL_S = 0.0005
 """Longest time a thread holds Python's lock while another waits for it [s] (Python's
 default, 5 ms, is longer than the driver waits for a servo's reply)."""

@@ -22,13 +22,16 @@ import time
 import tty
 from pathlib import Path
 
-from openral_real.emulator.bus_emulator import BusEmulator
+from openral_real.emulator.bus_emulator import BusEmulator, Reply
+from openral_real.emulator.realtime import answer_first
 from openral_real.emulator.sts_wire import Packet, PacketReader
 
 READ_CHUNK = 4096
 """Bytes taken from the pseudo-terminal per read."""
 POLL_S = 0.05
 """Longest wait for bytes before the server looks at its stop flag again [s]."""
+BATCH_S = 0.0005
+"""Replies due this close to the previous one leave with it [s]."""
 SILENCE_S = 0.005
 """A line quiet this long ends a partial packet: a servo's receiver starts afresh [s]."""
 
@@ -94,6 +97,10 @@ class PtyBus:
         self._thread = threading.Thread(target=self._serve, name="pty-bus", daemon=True)
         self._thread.start()
 
+    def _serve(self) -> None:
+        answer_first()
+        self._serve_until_stopped()
+
     def stop(self) -> None:
         """Stop serving and close the pseudo-terminal (idempotent)."""
         self._stop.set()
@@ -105,7 +112,7 @@ class PtyBus:
         if self.link is not None and self.link.is_symlink():
             self.link.unlink()
 
-    def _serve(self) -> None:
+    def _serve_until_stopped(self) -> None:
         while not self._stop.is_set():
             fds = self._fds
             if fds is None:
@@ -127,20 +134,33 @@ class PtyBus:
                 self._obey(data, now, fds[0])
 
     def _obey(self, data: bytes, arrived: float, master: int) -> None:
-        """Answer every packet ``data`` completes, each reply when it would be done."""
+        """Answer every packet ``data`` completes, each reply when it would have left a real
+        bus; replies due within :data:`BATCH_S` of each other leave together (each extra
+        sleep is one more chance for a busy machine to answer late)."""
         for item in self._reader.feed(data):
             if not isinstance(item, Packet):
                 self.rejected += 1
                 self.emulator.log(f"REJECTED {item.reason}")
                 continue
             replies = self.emulator.handle(item, len(item.encode()))
-            for reply in replies:
-                wait = arrived + reply.at_s - time.monotonic()
+            for due_s, chunk in _batches(replies):
+                wait = arrived + due_s - time.monotonic()
                 if wait > 0:
                     time.sleep(wait)
                 try:
-                    os.write(master, reply.data)
+                    os.write(master, chunk)
                 except OSError:
                     return
             if replies:
                 arrived = time.monotonic()
+
+
+def _batches(replies: list[Reply]) -> list[tuple[float, bytes]]:
+    """(when the batch is due [s], its bytes): runs of replies due within :data:`BATCH_S`."""
+    batches: list[tuple[float, bytes]] = []
+    for reply in replies:
+        if batches and reply.at_s - batches[-1][0] <= BATCH_S:
+            batches[-1] = (reply.at_s, batches[-1][1] + reply.data)
+        else:
+            batches.append((reply.at_s, reply.data))
+    return batches
