@@ -26,9 +26,10 @@ from tests.docs.tutorial_runner import (
 )
 
 TUTORIALS = sorted((REPO / "docs" / "tutorials").glob("*.md"))
-REAL_TIME = {"mobile-sensing"}
+REAL_TIME = {"mobile-sensing", "real-so101"}
 """Tutorials whose printed output is real-time behaviour (the base drives 0.75 m on two
-seconds of wall-clock commands): they run alone, after the others (``exclusive``)."""
+seconds of wall-clock commands; an emulated servo bus answers within milliseconds): they
+run alone, after the others (``exclusive``)."""
 VENV_BIN = REPO / ".venv" / "bin"
 
 

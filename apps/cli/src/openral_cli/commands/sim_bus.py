@@ -57,6 +57,9 @@ def bus(
 
     robot = open_robot_by_id(robot_id)
     loaded_scene = load_scene(scene) if scene is not None else None
+    for path in (log, link):
+        if path is not None:
+            path.parent.mkdir(parents=True, exist_ok=True)
     log_file = log.open("w", encoding="utf-8") if log is not None else None
     try:
         emulated = EmulatedBus(robot, scene=loaded_scene, seed=seed, log=log_file, link=link)

@@ -76,6 +76,7 @@ class EmulatedBus:
                     self.arm.place(joint.name, sum(joint.position_limits) / 2.0)
         self.emulator = BusEmulator(self.arm, self.wiring, log=self.log, seed=seed)
         self.pty = PtyBus(self.emulator, link)
+        self._switch_interval = sys.getswitchinterval()
 
     @property
     def path(self) -> str:
@@ -97,7 +98,8 @@ class EmulatedBus:
         The process's thread switch interval drops to :data:`SWITCH_INTERVAL_S`, so the
         thread that answers the bus is never kept waiting for Python's lock by the
         simulation's thread for longer than a servo takes to answer."""
-        sys.setswitchinterval(min(sys.getswitchinterval(), SWITCH_INTERVAL_S))
+        self._switch_interval = sys.getswitchinterval()
+        sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL_S))
         path = self.pty.open()
         self.arm.start()
         self.pty.start()
@@ -105,10 +107,11 @@ class EmulatedBus:
         return path
 
     def stop(self) -> None:
-        """Stop serving and the simulation (idempotent)."""
+        """Stop serving and the simulation (idempotent); the switch interval as it was."""
         self.pty.stop()
         self.arm.stop()
         self.hal.disconnect()
+        sys.setswitchinterval(self._switch_interval)
 
     def written(self, register: str, after: float = 0.0) -> list[str]:
         """Log lines that wrote ``register`` (WRITE or SYNC_WRITE) after ``after`` [s]."""
