@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from openral_core import LoadedRobot
+from openral_core import LoadedRobot, open_robot_by_id
 from openral_hal.errors import ConfigurationError
 from openral_real.emulator.bus_emulator import Fault
 from openral_real.emulator.emulated_bus import EmulatedBus
@@ -22,6 +22,13 @@ from tests.real.test_feetech_hal import wait_for
 pytestmark = pytest.mark.exclusive
 PERIOD_S = 0.01
 """The so101's control period (real.control_rate_hz 100)."""
+
+
+@pytest.fixture
+def so101() -> LoadedRobot:
+    """The SO-101 as it ships: 100 Hz, 5 ms for a reply."""
+    return open_robot_by_id("so101")
+
 
 FAULTS: dict[str, tuple[Callable[[EmulatedBus], None], str]] = {
     "silent motor": (

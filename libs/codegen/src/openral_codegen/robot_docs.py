@@ -25,6 +25,7 @@ from openral_core.models import (
 from openral_core.tables import RobotTables
 
 from openral_codegen.models import CodegenError
+from openral_codegen.robot_real_docs import real_section
 
 HEADER = "<!-- GENERATED from robots/ by `just schema-export` -- do not edit. -->\n"
 IMAGE_DIR = "docs/images/robots"
@@ -82,6 +83,7 @@ def robot_page(source: RobotSource) -> str:
         _grippers_section(source),
         _sensors_section(source),
         _sim_section(source),
+        real_section(robot.name, source.tables.real),
         _scenes_section(source),
         _readme_section(source.readme, "Known limitations"),
         _manifest_section(source),

@@ -88,15 +88,27 @@ class ServoReading:
 class FeetechBus:
     """One robot's Feetech bus on one serial port (see the module doc)."""
 
-    def __init__(self, port: str, wiring: FeetechWiring, joints: Sequence[str]) -> None:
+    def __init__(
+        self,
+        port: str,
+        wiring: FeetechWiring,
+        joints: Sequence[str],
+        reply_timeout_s: float | None = None,
+    ) -> None:
         """Nothing is opened until :meth:`open`.
 
         Args:
             port: The serial port (``/dev/ttyACM0``, an emulator's ``/dev/pts/N``).
             wiring: The robot's bus table.
             joints: The joint of each motor, in the wiring's order (for messages).
+            reply_timeout_s: How long a present-block reply may take [s] (default: the
+                manifest's ``reply_timeout_ms``, the control loop's; calibration, which has
+                no loop to keep, waits longer).
         """
         self.port_name, self.wiring = port, wiring
+        self.reply_timeout_s = (
+            wiring.reply_timeout_s if reply_timeout_s is None else float(reply_timeout_s)
+        )
         self.ids = wiring.ids
         self.names = {
             motor.id: f"motor {motor.id} ({joint})"
@@ -274,7 +286,7 @@ class FeetechBus:
 
     def _reply_ms(self, length: int) -> float:
         """Wire time of one status packet of ``length`` data bytes plus the reply timeout."""
-        return (6 + length) * self._byte_ms + self.wiring.reply_timeout_s * 1000.0
+        return (6 + length) * self._byte_ms + self.reply_timeout_s * 1000.0
 
     def _call(self, function: Any, *args: Any) -> Any:
         """An SDK call; a port that failed (unplugged) becomes a :class:`BusFault`."""
@@ -290,7 +302,7 @@ class FeetechBus:
         if result == scs.COMM_RX_TIMEOUT:
             raise BusFault(
                 f"{who} stopped answering ({doing}: no reply within "
-                f"{self.wiring.reply_timeout_s * 1000:g} ms)"
+                f"{self.reply_timeout_s * 1000:g} ms)"
             )
         if result == scs.COMM_RX_CORRUPT:
             raise BusFault(f"{who} sent a corrupt reply ({doing}: bad checksum or cut short)")

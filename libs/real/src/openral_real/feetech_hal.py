@@ -159,17 +159,19 @@ class FeetechHal(EStopLatch):
         calibration = read_calibration(self.calibration_file, self.description, self.bus_wiring)
         units = ServoUnits(self.robot, joint_scales(self.description, self.bus_wiring, calibration))
         twin = self._twin
+        cameras = Cameras(self._rgb, self._devices)
+        cameras.open()  # before the bus: a missing camera leaves the arm untouched
         bus = FeetechBus(self.port, self.bus_wiring, self.joint_names)
-        bus.open()
         try:
+            bus.open()
             readings = bring_up(bus, calibration, self._fix_hint())
-            cameras = Cameras(self._rgb, self._devices)
-            cameras.open()
         except BusFault as error:
             bus.close()
+            cameras.close()
             raise BusError(f"{error}; connecting stopped before torque was turned on") from None
         except BaseException:
             bus.close()
+            cameras.close()
             raise
         envelope = self._envelope()
         envelope.start(units.angles(readings))

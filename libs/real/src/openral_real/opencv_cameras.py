@@ -59,6 +59,9 @@ class _Reader:
         source: int | str = int(device) if device.isdigit() else device.removeprefix("file:")
         if self.is_file and not Path(str(source)).is_file():
             raise CameraError(f"camera {sensor.name}: no video file {source}")
+        if isinstance(source, str) and source.startswith("/dev/") and not Path(source).exists():
+            raise CameraError(f"camera {sensor.name}: cannot open {device} (no such device)")
+        cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)  # one line: ours
         self.capture = cv2.VideoCapture(source)
         if not self.capture.isOpened():
             raise CameraError(

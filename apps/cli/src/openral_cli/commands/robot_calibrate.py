@@ -25,6 +25,9 @@ import typer
 
 from openral_cli.console import out
 
+CALIBRATION_REPLY_S = 0.05
+"""How long calibration waits for a servo's reply [s]: it keeps no control loop's pace."""
+
 if TYPE_CHECKING:
     from openral_core import LoadedRobot
     from openral_real.calibration import MotorCalibration
@@ -68,7 +71,8 @@ def calibrate(
         raise ConfigurationError(f"{robot_id} has no feetech bus in its manifest (real.feetech)")
     applied = read_calibration(apply, robot.description, wiring) if apply is not None else None
     target = calibration_path(robot_id, wiring, arm_id, calibration)
-    bus = FeetechBus(transport, wiring, [joint.name for joint in robot.description.joints])
+    joints = [joint.name for joint in robot.description.joints]
+    bus = FeetechBus(transport, wiring, joints, reply_timeout_s=CALIBRATION_REPLY_S)
     bus.open()
     try:
         bus.check_motors()
