@@ -6,9 +6,10 @@ Feetech HAL at 100 Hz for ``--seconds`` while a client aims it at a new sine tar
 cycle. Measured in the same run:
 
 - **bare SDK**: the round trip of the SDK's own ``GroupSyncRead`` of the same present block
-  plus a ``GroupSyncWrite`` of six goals, back to back (what the SDK can do on this bus);
-- **wire**: the bytes of those packets at the baud rate (10 bits a byte), a floor no driver
-  goes under;
+  plus a ``GroupSyncWrite`` of six goals, back to back, on the servos as the driver set
+  them up (return delay 0): what the SDK alone does on this bus;
+- **wire**: the bytes of the Sync Read and its replies at the baud rate (10 bits a byte),
+  a floor no driver goes under (the Sync Write has no reply to wait for);
 - **driver**: each cycle's Sync Read plus Sync Write, and how late each cycle started
   after its due time (the line: no late tick over 5 ms).
 
@@ -87,11 +88,10 @@ def bare_sdk(port: str, cycles: int) -> list[float]:
 
 
 def wire_s(baud: int) -> float:
-    """Bytes of one Sync Read of 11 bytes from 6 servos plus one Sync Write of 6 goals,
-    at ``baud`` (10 bits a byte) [s]."""
-    read = (8 + 6) + 6 * (6 + 11)
-    write = 8 + 6 * 3
-    return (read + write) * 10 / baud
+    """Bytes of one Sync Read of 11 bytes from 6 servos (request and replies) at ``baud``
+    (10 bits a byte) [s]: what a host waits for. The Sync Write has no reply: a host hands
+    its 26 bytes to the adapter and goes on."""
+    return ((8 + 6) + 6 * (6 + 11)) * 10 / baud
 
 
 def drive(port: str, file: Path, seconds: float) -> FeetechHal:
@@ -127,13 +127,19 @@ def main() -> int:
         emulator, port = start_emulator(folder)
         try:
             calibrate(port, folder / "arm.json")
-            bare = summary(bare_sdk(port, 2000))
-            hal = drive(port, folder / "arm.json", args.seconds)
+            try:
+                hal = drive(port, folder / "arm.json", args.seconds)
+            finally:
+                late = [
+                    line for line in (folder / "bus.log").read_text().splitlines() if "LATE" in line
+                ]
+                print(f"emulator replies late: {len(late)}", *late[:5], sep="\n")
             times = hal.times
             driver = summary(list(times.round_trip_s))
             late = list(times.late_s)
             cycles = times.cycles
             hal.disconnect()
+            bare = summary(bare_sdk(port, 2000))  # the servos as the driver set them up
         finally:
             emulator.communicate("quit\n", timeout=30)
     lateness = {**summary(late), "over_5_ms": float(sum(x > LATE_LIMIT_S for x in late))}
@@ -151,7 +157,7 @@ def main() -> int:
     table = Table(title=f"Feetech bus, so101 on the emulator, 100 Hz for {args.seconds:g} s")
     for column in ("measure", "median ms", "p99 ms", "max ms"):
         table.add_column(column, justify="left" if column == "measure" else "right")
-    table.add_row("wire time at 1 Mbaud (floor)", f"{wire_ms:.2f}", "", "")
+    table.add_row("Sync Read on the wire at 1 Mbaud (floor)", f"{wire_ms:.2f}", "", "")
     rows = (
         ("bare SDK read+write", bare),
         ("driver tick read+write", driver),

@@ -33,6 +33,7 @@ from openral_mujoco.state import JointStateSample
 from openral_real.errors import BusFault
 from openral_real.feetech_bus import FeetechBus, ServoReading
 from openral_real.motion_envelope import MotionEnvelope
+from openral_real.realtime import answer_first
 from openral_real.servo_units import ServoUnits
 
 STATS_KEPT = 100_000
@@ -88,6 +89,8 @@ class BusCycle:
         """The E-stop's effect is still to be written (set by the owner when it latches)."""
         self.torque_on_pending = False
         """Torque is to be turned on again at the measured positions (after a release)."""
+        self.realtime = False
+        """True when the loop's thread got real-time scheduling (see :func:`answer_first`)."""
         self._lock = threading.Lock()
         self._readings: list[ServoReading] | None = None
         self._sample: JointStateSample | None = None
@@ -140,6 +143,7 @@ class BusCycle:
         self._wake.set()
 
     def _run(self) -> None:
+        self.realtime = answer_first()  # granted to root or CAP_SYS_NICE, else as it is
         due = time.monotonic() + self.period_s
         while not self._stop.is_set():
             self._wake.wait(max(0.0, due - time.monotonic()))

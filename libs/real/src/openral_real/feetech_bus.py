@@ -20,7 +20,9 @@ Where the SDK falls short, and what is done here instead (with its own calls):
   a reply (a core at 100 % for the wait): the port here has a 1 ms read timeout, so the
   same loop sleeps in ``select`` until bytes arrive;
 - it opens the port non-exclusively: a second program could write to the same bus; here
-  the port is locked (``exclusive``), and a busy port is refused in one line.
+  the port is locked (``exclusive``), and a busy port is refused in one line;
+- it times replies with the wall clock (``time.time``), which can step while a reply is
+  awaited; here the port's clock is the monotonic one.
 """
 
 from __future__ import annotations
@@ -66,6 +68,10 @@ class _ExclusivePort(scs.PortHandler):  # type: ignore[misc]
         self.ser.reset_input_buffer()
         self.tx_time_per_byte = (1000.0 / self.baudrate) * 10.0
         return True
+
+    def getCurrentTime(self) -> float:  # noqa: N802 (the SDK's name)
+        """Now [ms] on the monotonic clock (the SDK's wall clock can step under a timeout)."""
+        return time.monotonic() * 1000.0
 
 
 @dataclass(frozen=True)
@@ -116,6 +122,7 @@ class FeetechBus:
         }
         self._port: Any = None
         self._packets: Any = None
+        self._dirty = False
         self._goals: Any = None
         first, _ = wiring.registers[PRESENT_FIRST]
         last, size = wiring.registers[PRESENT_LAST]
@@ -235,7 +242,9 @@ class FeetechBus:
         """
         address, length = self._present
         ids = list(self.ids)
-        self._call(self._port.ser.reset_input_buffer)  # late replies of a failed read
+        if self._dirty:  # late replies of a failed read would be taken for this one's
+            self._call(self._port.ser.reset_input_buffer)
+            self._dirty = False
         result = self._call(self._packets.syncReadTx, self._port, address, length, ids, len(ids))
         self._check(None, result, 0, "sending the Sync Read")
         readings = []
@@ -246,6 +255,7 @@ class FeetechBus:
                 data, result, error = self._call(
                     self._packets.readTxRx, self._port, servo_id, address, length
                 )
+            self._dirty = result != scs.COMM_SUCCESS
             self._check(servo_id, result, 0, "reading its present state")
             readings.append(self._reading(bytes(data[:length]), error))
         return readings
@@ -253,17 +263,21 @@ class FeetechBus:
     # -- internals ---------------------------------------------------------------------------
 
     def _receive(self, servo_id: int, length: int) -> tuple[list[int], int, int]:
-        """One motor's reply to the Sync Read. A timeout that took far longer than the
+        """One motor's reply to the Sync Read. A failure that took far longer than the
         timeout itself means this thread was held up (Python's lock, the scheduler) while
-        the reply came: when bytes are waiting, they are read once more."""
+        the reply came and went by: that motor is asked once more, on its own."""
         reply_ms = self._reply_ms(length)
         began = time.monotonic()
         self._port.setPacketTimeoutMillis(reply_ms)
         data, result, error = self._call(self._packets.readRx, self._port, servo_id, length)
         held_up = (time.monotonic() - began) * 1000.0 > reply_ms + STALL_MS
-        if result == scs.COMM_RX_TIMEOUT and held_up and self._port.getBytesAvailable():
-            self._port.setPacketTimeoutMillis(reply_ms)
-            data, result, error = self._call(self._packets.readRx, self._port, servo_id, length)
+        if result != scs.COMM_SUCCESS and held_up:
+            self._call(self._port.ser.reset_input_buffer)
+            self._port.setPacketTimeoutMillis(reply_ms + self._byte_ms * 8)
+            address = self._present[0]
+            data, result, error = self._call(
+                self._packets.readTxRx, self._port, servo_id, address, length
+            )
         return data, result, error
 
     def _reading(self, block: bytes, error: int) -> ServoReading:

@@ -23,6 +23,7 @@ rules of a real HAL:
 
 from __future__ import annotations
 
+import gc
 import sys
 import time
 from collections.abc import Callable
@@ -58,7 +59,9 @@ from openral_real.servo_units import ServoUnits
 SWITCH_INTERVAL_S = 0.001
 """Python's thread switch interval while connected [s]: the bus's thread waits at most this
 long for Python's lock after its bytes arrive (the default, 5 ms, is half a control
-period). Restored at disconnect."""
+period). Restored at disconnect. While connected, the heap found at connect is also frozen
+out of garbage collection (``gc.freeze``, unless the process froze it itself, as deploy
+real does): a full collection of it holds Python's lock for tens of milliseconds."""
 
 
 @dataclass(frozen=True)
@@ -112,6 +115,7 @@ class FeetechHal(EStopLatch):
         self._twin = KinematicTwin(robot) if robot.tables.hal_wiring is not None else None
         """The robot's model, compiled here so its frames are known before connecting."""
         self._switch_interval = sys.getswitchinterval()
+        self._froze = False
 
     # -- what the HAL is ---------------------------------------------------------------------
 
@@ -156,6 +160,10 @@ class FeetechHal(EStopLatch):
                 the servos hold another calibration, or a motor reports a fault; nothing
                 was written to the bus. CameraError: A camera device does not open.
         """
+        self._froze = not gc.get_freeze_count()
+        if self._froze:  # a full collection of the heap would stall the bus's loop for ms
+            gc.collect()
+            gc.freeze()
         calibration = read_calibration(self.calibration_file, self.description, self.bus_wiring)
         units = ServoUnits(self.robot, joint_scales(self.description, self.bus_wiring, calibration))
         twin = self._twin
@@ -202,6 +210,9 @@ class FeetechHal(EStopLatch):
         bus.close()
         session.cameras.close()
         sys.setswitchinterval(self._switch_interval)
+        if self._froze:
+            gc.unfreeze()
+            self._froze = False
 
     # -- state and commands ------------------------------------------------------------------
 

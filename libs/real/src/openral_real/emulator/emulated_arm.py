@@ -36,8 +36,8 @@ from openral_hal.protocol import Tickable
 from openral_mujoco.gripper import gripper_command, reading_map
 from openral_mujoco.state import FloatArray
 
-from openral_real.emulator.realtime import answer_first
 from openral_real.emulator.servo_motion import ServoProfile
+from openral_real.realtime import answer_first
 
 SLICE_S = 0.004
 """Simulated time per physics slice of the robot alone [s] (the servos' positions change

@@ -23,13 +23,15 @@ import tty
 from pathlib import Path
 
 from openral_real.emulator.bus_emulator import BusEmulator, Reply
-from openral_real.emulator.realtime import answer_first
 from openral_real.emulator.sts_wire import Packet, PacketReader
+from openral_real.realtime import answer_first
 
 READ_CHUNK = 4096
 """Bytes taken from the pseudo-terminal per read."""
 POLL_S = 0.05
 """Longest wait for bytes before the server looks at its stop flag again [s]."""
+LATE_S = 0.002
+"""A reply leaving this much after its time is logged as late [s]."""
 BATCH_S = 0.0005
 """Replies due this close to the previous one leave with it [s]."""
 SILENCE_S = 0.005
@@ -147,6 +149,8 @@ class PtyBus:
                 wait = arrived + due_s - time.monotonic()
                 if wait > 0:
                     time.sleep(wait)
+                elif wait < -LATE_S:
+                    self.emulator.log(f"LATE reply by {-wait * 1000:.1f} ms (a busy machine)")
                 try:
                     os.write(master, chunk)
                 except OSError:
