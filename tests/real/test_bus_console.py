@@ -65,3 +65,23 @@ def test_a_bad_command_is_one_line_and_changes_nothing(
     assert "\n" not in str(raised.value)
     assert all(not faults for faults in bus.emulator.faults.values())
     assert [s.get("Present_Position") for s in bus.emulator.servos.values()] == before
+
+
+def test_a_scene_can_move_the_emulated_shafts(so101: LoadedRobot) -> None:
+    """`openral sim bus so101 --scene ...`: the servos answer from the scene's arm."""
+    from openral_core.loader import load_scene
+    from openral_core.paths import repo_root
+
+    from tests.real.conftest import open_bus
+
+    scene = load_scene(repo_root() / "robots" / "so101" / "scenes" / "tabletop.yaml")
+    with EmulatedBus(so101, scene=scene, seed=1) as emulated:
+        bus = open_bus(so101, emulated.path)
+        try:
+            bus.check_motors()
+            readings = bus.read_present()
+        finally:
+            bus.close()
+        with pytest.raises(ConsoleError, match="not a scene's arm"):
+            obey("move shoulder_pan 0.3", emulated)
+    assert len(readings) == 6 and all(0 <= r.position < 4096 for r in readings)

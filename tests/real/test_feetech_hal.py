@@ -6,6 +6,7 @@ shafts moved by the simulation), not on hardware.
 
 from __future__ import annotations
 
+import gc
 import json
 import time
 from collections.abc import Callable
@@ -194,3 +195,42 @@ def test_the_servos_holding_another_calibration_are_refused_untouched(
     with pytest.raises(ConfigurationError, match="the servos hold another calibration"):
         hal.connect()
     assert len([line for line in rig.bus.lines if "WRITE" in line]) == written
+    assert gc.get_freeze_count() == 0  # the heap frozen for the loop is given back
+
+
+def test_an_estop_that_cuts_torque_and_a_release_that_holds_again(
+    so101: LoadedRobot, tmp_path: Path
+) -> None:
+    """`estop: torque_off`: torque off within one period; the release turns it on again at
+    the measured pose (goals first), nothing jumping."""
+    from openral_core.tables import robot_tables
+    from openral_real.emulator.emulated_bus import EmulatedBus
+
+    from tests.real.conftest import calibrate
+
+    real = so101.description.real
+    assert real is not None
+    cutting = so101.description.model_copy(
+        update={"real": real.model_copy(update={"estop": type(real.estop)("torque_off")})}
+    )
+    robot = LoadedRobot(cutting, so101.folder, robot_tables(cutting))
+    with EmulatedBus(robot, seed=4) as bus:
+        file = tmp_path / "arm.json"
+        calibrate(robot, bus.path, file)
+        hal = FeetechHal(robot, bus.path, RealOptions(calibration_file=file))
+        hal.connect()
+        try:
+            servos = list(bus.emulator.servos.values())
+            latched = time.time()
+            hal.estop()
+            assert wait_for(lambda: all(s.get("Torque_Enable") == 0 for s in servos), 1.0)
+            cut = [line for line in bus.lines if "SYNC_WRITE Torque_Enable" in line]
+            assert float(cut[-1].split()[0]) - latched < hal.control_period_s
+            released = time.time()
+            hal.release_estop()
+            assert wait_for(lambda: all(s.get("Torque_Enable") == 1 for s in servos), 1.0)
+            after = [line.split()[1:3] for line in bus.lines if float(line.split()[0]) > released]
+            first_torque = after.index(["SYNC_WRITE", "Torque_Enable"])
+            assert ["SYNC_WRITE", "Goal_Position"] in after[:first_torque]  # goals first
+        finally:
+            hal.disconnect()

@@ -50,7 +50,7 @@ from openral_real.calibration import (
     read_calibration,
 )
 from openral_real.errors import BusError, BusFault
-from openral_real.feetech_bus import FeetechBus
+from openral_real.feetech_bus import FeetechBus, ServoReading
 from openral_real.kinematic_twin import KinematicTwin
 from openral_real.motion_envelope import MotionEnvelope
 from openral_real.opencv_cameras import Cameras, camera_devices
@@ -164,22 +164,10 @@ class FeetechHal(EStopLatch):
         if self._froze:  # a full collection of the heap would stall the bus's loop for ms
             gc.collect()
             gc.freeze()
-        calibration = read_calibration(self.calibration_file, self.description, self.bus_wiring)
-        units = ServoUnits(self.robot, joint_scales(self.description, self.bus_wiring, calibration))
-        twin = self._twin
-        cameras = Cameras(self._rgb, self._devices)
-        cameras.open()  # before the bus: a missing camera leaves the arm untouched
-        bus = FeetechBus(self.port, self.bus_wiring, self.joint_names)
         try:
-            bus.open()
-            readings = bring_up(bus, calibration, self._fix_hint())
-        except BusFault as error:
-            bus.close()
-            cameras.close()
-            raise BusError(f"{error}; connecting stopped before torque was turned on") from None
+            bus, cameras, units, readings = self._bring_up()
         except BaseException:
-            bus.close()
-            cameras.close()
+            self._thaw()
             raise
         envelope = self._envelope()
         envelope.start(units.angles(readings))
@@ -188,7 +176,7 @@ class FeetechHal(EStopLatch):
         )
         cycle.seed(readings)
         self._estopped, self.estop_reason = False, None
-        self._session = _Session(bus, cycle, units, envelope, twin, cameras)
+        self._session = _Session(bus, cycle, units, envelope, self._twin, cameras)
         self._switch_interval = sys.getswitchinterval()
         sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL_S))
         cycle.start()
@@ -210,9 +198,7 @@ class FeetechHal(EStopLatch):
         bus.close()
         session.cameras.close()
         sys.setswitchinterval(self._switch_interval)
-        if self._froze:
-            gc.unfreeze()
-            self._froze = False
+        self._thaw()
 
     # -- state and commands ------------------------------------------------------------------
 
@@ -337,6 +323,33 @@ class FeetechHal(EStopLatch):
         self._running().cycle.on_cycle = hook
 
     # -- internals ---------------------------------------------------------------------------
+
+    def _bring_up(self) -> tuple[FeetechBus, Cameras, ServoUnits, list[ServoReading]]:
+        """Calibration, cameras, then the bus brought up (nothing open is left behind when
+        one of them fails)."""
+        calibration = read_calibration(self.calibration_file, self.description, self.bus_wiring)
+        units = ServoUnits(self.robot, joint_scales(self.description, self.bus_wiring, calibration))
+        cameras = Cameras(self._rgb, self._devices)
+        cameras.open()  # before the bus: a missing camera leaves the arm untouched
+        bus = FeetechBus(self.port, self.bus_wiring, self.joint_names)
+        try:
+            bus.open()
+            readings = bring_up(bus, calibration, self._fix_hint())
+        except BusFault as error:
+            bus.close()
+            cameras.close()
+            raise BusError(f"{error}; connecting stopped before torque was turned on") from None
+        except BaseException:
+            bus.close()
+            cameras.close()
+            raise
+        return bus, cameras, units, readings
+
+    def _thaw(self) -> None:
+        """Give the heap frozen at connect back to the collector (when this HAL froze it)."""
+        if self._froze:
+            gc.unfreeze()
+            self._froze = False
 
     def _fix_hint(self) -> str:
         """How to write this HAL's calibration file to the servos (for a refusal)."""
