@@ -151,9 +151,9 @@ class FeetechBus(OpenralModel):
     """
     One motor per manifest joint, the gripper included: the joint and the servo's bus id.
     """
-    reply_timeout_ms: Annotated[StrictFloat, Field(ge=1.0, le=100.0)] = 5.0
+    reply_timeout_ms: Annotated[StrictFloat, Field(ge=1.0, le=100.0)] = 6.0
     """
-    How long the driver waits for one servo's status reply before it counts the servo as silent [ms]. A silent servo latches the E-stop; keep the control period plus this below two control periods.
+    How long the driver waits for one servo's status reply, beyond the reply's own wire time, before it counts the servo as silent [ms]. A silent servo latches the E-stop: keep the control period plus this below two control periods (100 Hz: 6 ms latches within 17 ms). A servo answers within a millisecond; the rest is room for the adapter and for the operating system passing the bytes on when the machine is busy.
     """
     calibration: FeetechCalibration | None = None
     """

@@ -26,7 +26,11 @@ from collections.abc import Callable
 from openral_core.models import RobotDescription
 from openral_hal.errors import HalError
 from openral_hal.protocol import CycledHal, TwinHal
+from openral_hal.realtime import PRIORITY, answer_first
 from openral_mujoco.state import FloatArray, JointStateSample
+
+TICK_PRIORITY = PRIORITY - 1
+"""The graph's tick runs just below the driver's own loop (see :mod:`openral_hal.realtime`)."""
 
 
 class RealCadence:
@@ -67,6 +71,7 @@ class RealCadence:
         self._reading.set()
 
     def _run(self) -> None:
+        answer_first(TICK_PRIORITY)  # it holds Python's lock the driver's loop waits for
         while True:
             self._reading.wait()
             self._reading.clear()

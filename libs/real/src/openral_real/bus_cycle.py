@@ -28,12 +28,12 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 from openral_core.servo_models import fault_text
+from openral_hal.realtime import answer_first
 from openral_mujoco.state import JointStateSample
 
 from openral_real.errors import BusFault
 from openral_real.feetech_bus import FeetechBus, ServoReading
 from openral_real.motion_envelope import MotionEnvelope
-from openral_real.realtime import answer_first
 from openral_real.servo_units import ServoUnits
 
 STATS_KEPT = 100_000

@@ -33,11 +33,11 @@ from openral_core.servo_models import ServoModel
 from openral_core.tables import robot_tables
 from openral_hal.mujoco_arm import MujocoArmHAL
 from openral_hal.protocol import Tickable
+from openral_hal.realtime import answer_first
 from openral_mujoco.gripper import gripper_command, reading_map
 from openral_mujoco.state import FloatArray
 
 from openral_real.emulator.servo_motion import ServoProfile
-from openral_real.realtime import answer_first
 
 SLICE_S = 0.004
 """Simulated time per physics slice of the robot alone [s] (the servos' positions change

@@ -29,7 +29,7 @@ from openral_real.emulator.pty_bus import PtyBus
 
 SWITCH_INTERVAL_S = 0.0005
 """Longest time a thread holds Python's lock while another waits for it [s] (Python's
-default, 5 ms, is longer than the driver waits for a servo's reply)."""
+default, 5 ms, is most of the time the driver waits for a servo's reply)."""
 
 
 class EmulatedBus:

@@ -22,9 +22,10 @@ import time
 import tty
 from pathlib import Path
 
+from openral_hal.realtime import answer_first
+
 from openral_real.emulator.bus_emulator import BusEmulator, Reply
 from openral_real.emulator.sts_wire import Packet, PacketReader
-from openral_real.realtime import answer_first
 
 READ_CHUNK = 4096
 """Bytes taken from the pseudo-terminal per read."""
