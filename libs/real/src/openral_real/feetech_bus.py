@@ -22,7 +22,10 @@ Where the SDK falls short, and what is done here instead (with its own calls):
 - it opens the port non-exclusively: a second program could write to the same bus; here
   the port is locked (``exclusive``), and a busy port is refused in one line;
 - it times replies with the wall clock (``time.time``), which can step while a reply is
-  awaited; here the port's clock is the monotonic one.
+  awaited; here the port's clock is the monotonic one;
+- it drains the port's output before every packet (``tcdrain``) and writes without a time
+  limit: on a busy machine a write held the driver's loop for a third of a second; here a
+  packet is written as it comes, within :data:`WRITE_TIMEOUT_S`.
 """
 
 from __future__ import annotations
@@ -45,6 +48,9 @@ PRESENT_FIRST = "Present_Position"
 PRESENT_LAST = "Moving"
 SERIAL_READ_TIMEOUT_S = 0.001
 """How long one read of the port waits for bytes before the SDK looks at its timeout [s]."""
+WRITE_TIMEOUT_S = 0.02
+"""Longest a packet may take to be handed to the port [s]: a wedged adapter raises (and
+latches the E-stop) instead of holding the driver's loop."""
 STALL_MS = 2.0
 """A reply wait this much longer than its timeout was this thread held up [ms]."""
 CONNECT_TIMEOUT_MS = 50.0
@@ -62,12 +68,19 @@ class _ExclusivePort(scs.PortHandler):  # type: ignore[misc]
             baudrate=self.baudrate,
             bytesize=serial.EIGHTBITS,
             timeout=SERIAL_READ_TIMEOUT_S,
+            write_timeout=WRITE_TIMEOUT_S,
             exclusive=True,
         )
         self.is_open = True
         self.ser.reset_input_buffer()
         self.tx_time_per_byte = (1000.0 / self.baudrate) * 10.0
         return True
+
+    def clearPort(self) -> None:  # noqa: N802 (the SDK's name)
+        """Nothing: the SDK drains the port's output before every packet (``tcdrain``),
+        which waits for the operating system to pass the last packet on (a third of a
+        second, seen on a busy machine); packets written to one port leave in order
+        anyway."""
 
     def getCurrentTime(self) -> float:  # noqa: N802 (the SDK's name)
         """Now [ms] on the monotonic clock (the SDK's wall clock can step under a timeout)."""
