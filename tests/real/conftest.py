@@ -62,14 +62,16 @@ def calibrate(robot: LoadedRobot, path: str, file: Path) -> dict[str, MotorCalib
     return calibration
 
 
-BESIDE_OTHERS_RATE_HZ = 50.0
-BESIDE_OTHERS_REPLY_MS = 30.0
+BESIDE_OTHERS_RATE_HZ = 10.0
+BESIDE_OTHERS_REPLY_MS = 100.0
 
 
 def beside_others(robot: LoadedRobot) -> LoadedRobot:
-    """``robot`` with a real driver slow enough to run beside other tests: 50 Hz, 30 ms for a
-    reply (the emulator shares a loaded process and answers late at times there). The
-    manifest's own 100 Hz and 5 ms are what the exclusive tests measure."""
+    """``robot`` with a real driver slow enough to run beside other tests: 10 Hz, 100 ms for a
+    reply. The emulator shares the test's process and, with three workers on two cores, is
+    held up for tens of milliseconds at times (CI saw a reply 30 ms late): a control period
+    and a reply timeout of 100 ms ride that out. The manifest's own 100 Hz and 6 ms are what
+    the exclusive tests measure."""
     real = robot.description.real
     assert real is not None and real.feetech is not None
     feetech = real.feetech.model_copy(update={"reply_timeout_ms": BESIDE_OTHERS_REPLY_MS})

@@ -175,7 +175,7 @@ def test_a_stale_reading_latches_the_estop(rig: Rig) -> None:
     hal.connect()
     try:
         hal._running().cycle.stop()  # the driver falls behind: nothing reads the bus
-        time.sleep(0.05)
+        time.sleep(2.5 * hal.control_period_s)  # the latch comes at two periods
         assert hal.read_state().stale and hal.estopped
         assert "ms old" in (hal.estop_reason or "") and len(rig.faults) == 1
     finally:
@@ -234,3 +234,25 @@ def test_an_estop_that_cuts_torque_and_a_release_that_holds_again(
             assert ["SYNC_WRITE", "Goal_Position"] in after[:first_torque]  # goals first
         finally:
             hal.disconnect()
+
+
+def test_a_deferred_connect_holds_until_its_loop_starts(rig: Rig) -> None:
+    """The graph builds before the driver's loop starts: until then the arm holds at the
+    goals written at connect, the reading is the connect's and is not stale."""
+    hal = rig.hal()
+    hal.defer_cycle = True
+    hal.connect()
+    try:
+        connected = time.time()
+        first = hal.read_state()
+        time.sleep(3 * hal.control_period_s)
+        waited = hal.read_state()
+        assert not waited.stale and not hal.estopped
+        assert waited.stamp_ns == first.stamp_ns  # no loop: no new reading
+        assert rig.bus.written("Goal_Position", connected) == []
+        hal.start_cycle()
+        hal.start_cycle()  # idempotent
+        assert wait_for(lambda: hal.read_state().stamp_ns > first.stamp_ns, 2.0)
+        assert not hal.estopped, hal.estop_reason
+    finally:
+        hal.disconnect()

@@ -64,7 +64,7 @@ from openral_core.errors import OpenralError
 from openral_core.models import RobotDescription
 from openral_hal.errors import NotConnected
 from openral_hal.factory import can_tick
-from openral_hal.protocol import RobotHal
+from openral_hal.protocol import CycledHal, RobotHal
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.parameter import Parameter
 from rosgraph_msgs.msg import Clock
@@ -171,6 +171,8 @@ class ManifestLifecycleNode(LifecycleNode):
             if hal.is_real:  # both stall threads for tens of ms: before the driver starts
                 self._urdf = urdf_before_connect(hal, self._loaded)
                 self.heap.freeze()
+            if isinstance(hal, CycledHal):  # building the graph held Python's lock up to
+                hal.defer_cycle = True  # 137 ms: the driver's loop starts once it is built
             if not hal.connected:
                 hal.connect()
         except Exception as error:  # a HAL or renderer failure; report it, stay inactive
@@ -203,6 +205,8 @@ class ManifestLifecycleNode(LifecycleNode):
             self.loop.watch.restart()
         pacer.start()
         self.heap.freeze()
+        if isinstance(hal, CycledHal):
+            hal.start_cycle()
         super().on_activate(state)
         return Result.SUCCESS
 

@@ -243,6 +243,14 @@ class CycledHal(RobotHal, Protocol):
     """Run on the loop's thread after each read, before the write (None: nothing)."""
     on_fault: Callable[[str], None]
     """Called once, with one line, when a fault latches the E-stop."""
+    defer_cycle: bool
+    """True: :meth:`connect` holds the robot where it is and leaves the loop to
+    :meth:`start_cycle` (a caller with more to build first); readings stay the connect's
+    until then."""
+
+    def start_cycle(self) -> None:
+        """Start the loop after a deferred connect (idempotent)."""
+        ...
 
 
 @runtime_checkable

@@ -95,6 +95,7 @@ class BusCycle:
         self._readings: list[ServoReading] | None = None
         self._sample: JointStateSample | None = None
         self._last_ok = 0.0
+        self._started = False
         self._stop = threading.Event()
         self._wake = threading.Event()
         self._thread: threading.Thread | None = None
@@ -102,7 +103,8 @@ class BusCycle:
     # -- what it read ------------------------------------------------------------------------
 
     def latest(self) -> tuple[list[ServoReading], JointStateSample, float]:
-        """The newest present block, its sample and its age [s].
+        """The newest present block, its sample and its age [s] (0 until the loop first
+        starts: the servos hold the goals written at the seed's reading until then).
 
         Raises:
             RuntimeError: Nothing was read yet.
@@ -111,7 +113,7 @@ class BusCycle:
             readings, sample, read_at = self._readings, self._sample, self._last_ok
         if readings is None or sample is None:
             raise RuntimeError("the bus has not been read yet")
-        return readings, sample, time.monotonic() - read_at
+        return readings, sample, time.monotonic() - read_at if self._started else 0.0
 
     def seed(self, readings: list[ServoReading]) -> None:
         """The present block read at connect (the first sample)."""
@@ -121,6 +123,10 @@ class BusCycle:
 
     def start(self) -> None:
         """Cycle on a thread of its own until :meth:`stop`."""
+        if not self._started:  # the seed stood for the arm until now: nothing moved it
+            self._started = True
+            with self._lock:
+                self._last_ok = time.monotonic()
         self._stop.clear()
         self._thread = threading.Thread(target=self._run, name="feetech-bus", daemon=True)
         self._thread.start()

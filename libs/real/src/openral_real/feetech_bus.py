@@ -25,12 +25,16 @@ Where the SDK falls short, and what is done here instead (with its own calls):
   awaited; here the port's clock is the monotonic one;
 - it drains the port's output before every packet (``tcdrain``) and writes without a time
   limit: on a busy machine a write held the driver's loop for a third of a second; here a
-  packet is written as it comes, within :data:`WRITE_TIMEOUT_S`.
+  packet is written as it comes, and only a port that takes nothing for
+  :data:`WRITE_TIMEOUT_S` is a timeout (pyserial's write times out too when the bytes went
+  through but the thread got Python's lock back late).
 """
 
 from __future__ import annotations
 
 import contextlib
+import os
+import select
 import termios
 import time
 from collections.abc import Sequence
@@ -81,6 +85,21 @@ class _ExclusivePort(scs.PortHandler):  # type: ignore[misc]
         which waits for the operating system to pass the last packet on (a third of a
         second, seen on a busy machine); packets written to one port leave in order
         anyway."""
+
+    def writePort(self, packet: Sequence[int]) -> int:  # noqa: N802 (the SDK's name)
+        """Hand ``packet`` to the port; a timeout only when the port takes nothing for
+        :data:`WRITE_TIMEOUT_S` (a wedged adapter). pyserial's own write also times out
+        when the bytes went through but this thread got Python's lock back late."""
+        data, fd = bytes(packet), self.ser.fd
+        deadline, sent = time.monotonic() + WRITE_TIMEOUT_S, 0
+        while sent < len(data):
+            with contextlib.suppress(BlockingIOError):  # the port is non-blocking
+                sent += os.write(fd, data[sent:])
+                continue
+            left = deadline - time.monotonic()
+            if left <= 0 or not select.select([], [fd], [], left)[1]:
+                raise serial.SerialTimeoutException("Write timeout")
+        return sent
 
     def getCurrentTime(self) -> float:  # noqa: N802 (the SDK's name)
         """Now [ms] on the monotonic clock (the SDK's wall clock can step under a timeout)."""

@@ -108,6 +108,8 @@ class FeetechHal(EStopLatch):
         self.estop_at: float | None = None
         """When it latched [s, system clock] (None while released)."""
         self.on_fault: Callable[[str], None] = _say
+        self.defer_cycle = False
+        """True: :meth:`connect` holds the arm and leaves the loop to :meth:`start_cycle`."""
         """Called once, on the bus's thread, with the line that says why a fault latched."""
         self._rgb = {s.name: s for s in robot.description.sensors if isinstance(s, RgbSensor)}
         self._devices = camera_devices(self._rgb, self.options.cameras)
@@ -179,7 +181,14 @@ class FeetechHal(EStopLatch):
         self._session = _Session(bus, cycle, units, envelope, self._twin, cameras)
         self._switch_interval = sys.getswitchinterval()
         sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL_S))
-        cycle.start()
+        if not self.defer_cycle:
+            cycle.start()
+
+    def start_cycle(self) -> None:
+        """Start the bus's loop after a :attr:`defer_cycle` connect (idempotent)."""
+        cycle = self._running().cycle
+        if not cycle.running:
+            cycle.start()
 
     def disconnect(self) -> None:
         """Stop the loop, hold the measured pose, then leave torque as ``shutdown`` says."""
