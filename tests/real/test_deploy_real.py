@@ -102,7 +102,7 @@ def _wave_moves_the_servos(bus: RemoteBus, remote: Remote) -> None:
     seen = time.time()
     runner = openral(
         "rskill", "run", "--robot", "so101", "--policy", "wave", "-p", "amplitude=0.3",
-        "--duration", "6", "--domain-id", str(remote.domain),
+        "-p", "period_s=2.0", "--duration", "4", "--domain-id", str(remote.domain),
     )  # fmt: skip
     _, err = runner.communicate(timeout=60)
     assert runner.returncode == 0, err
