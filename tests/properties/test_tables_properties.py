@@ -49,12 +49,29 @@ def _distinct_joints(joints: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return kept
 
 
+def _repair_real(document: dict[str, Any]) -> None:
+    """Wire a drawn Feetech bus to the drawn joints (rules 20-26), so the rules can pass:
+    one motor per joint, ids 1..n, protocol 0, 1 Mbaud, revolute joints within one turn."""
+    real = document.get("real")
+    if real is None:
+        return
+    bus = real.setdefault("feetech", {"servo_model": "sts3215", "motors": []})
+    joints = document["joints"]
+    bus["motors"] = [{"joint": j["name"], "id": i + 1} for i, j in enumerate(joints)]
+    bus["protocol"], bus["baud_rate"] = 0, 1_000_000
+    bus.pop("joint_settings", None)
+    for joint in joints:
+        low = max(-3.0, min(joint.get("position_limits", [-1.0, 1.0])[0], 2.0))
+        joint.update(type="revolute", position_limits=[low, low + 1.0])
+
+
 def _repair(document: dict[str, Any]) -> dict[str, Any]:
     """Point a drawn sim block's joint references at the drawn joints, so rules can pass."""
     document["joints"] = _distinct_joints(document["joints"])
     for joint in document["joints"]:
         if "position_limits" in joint:
             joint["position_limits"] = _ordered(joint["position_limits"])
+    _repair_real(document)
     sim = document.get("sim")
     if sim is None:
         return document
