@@ -171,8 +171,11 @@ class ManifestLifecycleNode(LifecycleNode):
             if hal.is_real:  # both stall threads for tens of ms: before the driver starts
                 self._urdf = urdf_before_connect(hal, self._loaded)
                 self.heap.freeze()
-            if isinstance(hal, CycledHal):  # building the graph held Python's lock up to
-                hal.defer_cycle = True  # 137 ms: the driver's loop starts once it is built
+            # The graph is built before a real driver's loop runs (building it held Python's
+            # lock up to 137 ms). is_real first: isinstance reads control_period_s, which a
+            # simulated HAL that is not connected cannot tell.
+            if hal.is_real and isinstance(hal, CycledHal):
+                hal.defer_cycle = True
             if not hal.connected:
                 hal.connect()
         except Exception as error:  # a HAL or renderer failure; report it, stay inactive
@@ -205,7 +208,7 @@ class ManifestLifecycleNode(LifecycleNode):
             self.loop.watch.restart()
         pacer.start()
         self.heap.freeze()
-        if isinstance(hal, CycledHal):
+        if hal.is_real and isinstance(hal, CycledHal):
             hal.start_cycle()
         super().on_activate(state)
         return Result.SUCCESS
