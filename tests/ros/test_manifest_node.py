@@ -87,7 +87,7 @@ def test_deploy_publishes_joint_states_cameras_and_action_spec(deployed: Deploye
 
     probe.wait(same_tick, WAIT_S, "both joint-state views of one tick")
     joints = probe.latest("/joint_states")  # the URDF's joints, SI: the mimic finger too
-    assert list(joints.name) == [*manifest_joints, "finger_joint2"]
+    assert list(joints.name) == [*manifest_joints, "panda_finger_joint2"]
     assert all(math.isfinite(v) for v in joints.position)
     finger, mimic = joints.position[7], joints.position[8]
     # metres, both fingers; MuJoCo's limits are soft, so a finger rests up to a few nm past

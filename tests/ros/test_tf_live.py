@@ -24,6 +24,7 @@ import itertools
 import math
 import re
 import time
+import xml.etree.ElementTree as ET
 from collections.abc import Iterator
 from dataclasses import dataclass
 from functools import partial
@@ -36,7 +37,15 @@ import pytest
 import yourdfpy
 from geometry_msgs.msg import Twist
 from openral_bridge.ros_messages import LATCHED
-from openral_bridge.topics import CMD_VEL, JOINT_STATES, ODOM, ROBOT_DESCRIPTION, TF, TF_STATIC
+from openral_bridge.topics import (
+    CMD_VEL,
+    JOINT_STATES,
+    ODOM,
+    ROBOT_DESCRIPTION,
+    ROBOT_DESCRIPTION_SEMANTIC,
+    TF,
+    TF_STATIC,
+)
 from openral_core import open_robot_by_id
 from openral_core.loaded import LoadedRobot
 from openral_nodes.runtime import Spinner, claim_domain_id, ros_session
@@ -78,6 +87,7 @@ class Recorder(Probe):
         super().__init__(context, topics, name)
         self.subscribe(TF_STATIC, TFMessage, LATCHED)
         self.subscribe(ROBOT_DESCRIPTION, String, LATCHED)
+        self.subscribe(ROBOT_DESCRIPTION_SEMANTIC, String, LATCHED)
 
     def subscribe(self, topic: str, kind: Any, qos: QoSProfile) -> None:
         """Record ``topic`` too."""
@@ -287,6 +297,27 @@ def test_robot_description_moves_as_tf_says(graph: Graph) -> None:
         link: e for link, e in errors.items() if e[0] > FK_TOLERANCE_M or e[1] > FK_TOLERANCE_RAD
     }
     assert not off, f"links where the URDF's kinematics leave TF (m, rad): {off}"
+
+
+def test_the_srdf_is_latched_and_names_the_urdfs_links_and_joints(graph: Graph) -> None:
+    recorder = graph.recorder
+    recorder.wait_count(ROBOT_DESCRIPTION_SEMANTIC, 1, timeout_s=WAIT_S)
+    urdf = yourdfpy.URDF.load(
+        io.StringIO(recorder.latest(ROBOT_DESCRIPTION).data), load_meshes=False
+    )
+    srdf = ET.fromstring(recorder.latest(ROBOT_DESCRIPTION_SEMANTIC).data)
+    assert srdf.get("name") == urdf.robot.name
+    arm = next(g for g in srdf.iter("group") if g.get("name") == "arm")
+    manifest = [j.name for j in graph.robot.description.joints]
+    assert [j.get("name") for j in arm.iter("joint")] == [
+        name for name in manifest if name in [j.get("name") for j in arm.iter("joint")]
+    ]
+    for joint in srdf.iter("joint"):
+        assert joint.get("name") in urdf.joint_map, joint.get("name")
+    for element in (*srdf.iter("link"), *srdf.iter("disable_collisions")):
+        for key in ("name", "link1", "link2"):
+            if element.get(key) is not None:
+                assert element.get(key) in urdf.link_map, element.get(key)
 
 
 def test_tf_stamps_strictly_increase(graph: Graph) -> None:

@@ -19,6 +19,14 @@ class Base(StrEnum):
     mobile = "mobile"
 
 
+MjcfName = TypeAliasType(
+    "MjcfName", Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/.-]{0,126}$")]
+)
+"""
+A name of an element (joint, body, camera, site) in an MJCF model.
+"""
+
+
 class Type(StrEnum):
     """
     `revolute` (bounded rotation, radians) or `prismatic` (linear, metres).
@@ -627,26 +635,54 @@ class DriveAxes(OpenralModel):
     """
 
 
-class Frames(OpenralModel):
+FrameName = TypeAliasType(
+    "FrameName", Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")]
+)
+"""
+A TF frame id: starts with a letter; letters, digits, `_` and `/` (never a leading `/`, which tf2 refuses).
+"""
+
+
+class ExtraLink(OpenralModel):
     """
-    The frames of `/tf` that are not bodies of the model. Every body of the robot is a frame named as in its MJCF; these name the fixed frame of the simulated world and the robot's base frame, the root of its URDF and the frame depth clouds are given in. A robot with a `mobile_base` names its base frame there (`mobile_base.base_frame`, beside `odom_frame`), not here.
+    A link rigidly fixed to another, with no body in the model.
     """
 
     model_config = ConfigDict(
         extra="forbid",
     )
-    world: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")] = (
-        "world"
-    )
+    name: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")]
     """
-    The fixed frame of the simulated world (MuJoCo's world frame): the parent of the base frame (or of the odometry frame) and of cameras fixed in the scene.
+    The link's name.
     """
-    base: Annotated[
-        StrictStr,
-        Field(examples=["base_link"], pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$"),
-    ] = "base_link"
+    parent: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")]
     """
-    The robot's base frame, at its root body (the world's child that carries its first joint), turning and moving with it. It must not be the name of another body of the model; it may be the root body's own name (then that body is the base frame).
+    The link it is fixed to (as `links` names it), or the base frame.
+    """
+    joint: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")]
+    """
+    The name of the fixed joint from `parent` to it.
+    """
+    position_m: Annotated[list[StrictFloat], Field(max_length=3, min_length=3)] = [
+        0.0,
+        0.0,
+        0.0,
+    ]
+    """
+    Its origin in the parent's frame [m].
+    """
+    quat_wxyz: Annotated[list[StrictFloat], Field(max_length=4, min_length=4)] = [
+        1.0,
+        0.0,
+        0.0,
+        0.0,
+    ]
+    """
+    Its orientation in the parent's frame (unit quaternion w, x, y, z; normalised on load).
+    """
+    children: list[FrameName] = []
+    """
+    Links of the parent re-hung from this one (their world poses unchanged).
     """
 
 
@@ -784,6 +820,54 @@ class MobileBase(OpenralModel):
     ] = "base_link"
     """
     TF frame of the base (REP 105), the child frame of the odometry: on the floor plane at the yaw joint's axis, turning with the base; velocity commands are given in it.
+    """
+
+
+class Frames(OpenralModel):
+    """
+    The frames of `/tf` that are not bodies of the model, and the names the robot's links and joints take in ROS. Every body of the robot is a link named as in its MJCF unless `links` renames it (to the vendor's URDF names, which MoveIt configurations and SRDFs use); `world` and `base` name the fixed frame of the simulated world and the robot's base frame, the root of its URDF and the frame depth clouds are given in. A robot with a `mobile_base` names its base frame there (`mobile_base.base_frame`, beside `odom_frame`), not here.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    world: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")] = (
+        "world"
+    )
+    """
+    The fixed frame of the simulated world (MuJoCo's world frame): the parent of the base frame (or of the odometry frame) and of cameras fixed in the scene.
+    """
+    base: Annotated[
+        StrictStr,
+        Field(examples=["base_link"], pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$"),
+    ] = "base_link"
+    """
+    The robot's base frame, at its root body (the world's child that carries its first joint), turning and moving with it. It must not be the name of another body of the model; it may be the root body's own name (then that body is the base frame).
+    """
+    links: Annotated[
+        dict[MjcfName, FrameName],
+        Field(examples=[{"link0": "panda_link0", "hand": "panda_hand"}]),
+    ] = {}
+    """
+    Link names for bodies of the robot: MJCF body name → link name. A body not listed keeps its MJCF name. TF, the URDF, the SRDF and every frame_id (sensors mounted on a body, the TCP's parent) follow.
+    """
+    joints: Annotated[
+        dict[FrameName, FrameName],
+        Field(
+            examples=[
+                {
+                    "finger_joint2": "panda_finger_joint2",
+                    "panda_hand": "panda_hand_joint",
+                }
+            ]
+        ),
+    ] = {}
+    """
+    Names of the joints the manifest does not list: an MJCF joint's name (a finger that mimics another) or a link's name (as `links` names it) for the fixed joint into that link → joint name. Default: the MJCF name; the fixed joint into link L is `L_fixed`. Manifest joints keep the manifest's names.
+    """
+    extra_links: Annotated[list[ExtraLink], Field(validate_default=True)] = []
+    """
+    Frames with no body of their own that the vendor's URDF has (the Panda's flange `panda_link8`): each a link fixed to `parent`, optionally taking over some of the parent's children (which keep their poses in the world).
     """
 
 

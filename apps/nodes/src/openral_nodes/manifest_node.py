@@ -75,7 +75,7 @@ from openral_nodes.control_loops import start_control_loop
 from openral_nodes.heap_freeze import HeapFreeze
 from openral_nodes.lifecycle_guard import guard_change_state
 from openral_nodes.node_parameters import BOUNDS, PARAMETERS, check_rates, configured_hal
-from openral_nodes.robot_state_streams import RobotStateStreams, urdf_before_connect
+from openral_nodes.robot_state_streams import RobotStateStreams, descriptions_before_connect
 from openral_nodes.scene_bridges import SceneBridges
 
 NODE_NAME = "openral_manifest_node"
@@ -143,7 +143,7 @@ class ManifestLifecycleNode(LifecycleNode):
         self._loaded: LoadedRobot | None = None
         self._entities: list[tuple[str, Any]] = []
         self._shutdown_event = shutdown_event
-        self._urdf: str | None = None
+        self._texts: tuple[str, str] | None = None
         guard_change_state(self, WARN_EVERY_S)
 
     # -- transitions -----------------------------------------------------------------------
@@ -169,7 +169,7 @@ class ManifestLifecycleNode(LifecycleNode):
         try:
             hal = self._hal()
             if hal.is_real:  # both stall threads for tens of ms: before the driver starts
-                self._urdf = urdf_before_connect(hal, self._loaded)
+                self._texts = descriptions_before_connect(hal, self._loaded)
                 self.heap.freeze()
             # The graph is built before a real driver's loop runs (building it held Python's
             # lock up to 137 ms). is_real first: isinstance reads control_period_s, which a
@@ -334,7 +334,7 @@ class ManifestLifecycleNode(LifecycleNode):
             rate_hz,
             self._loaded,
             bool(self._param("publish_tf")),
-            self._urdf,
+            self._texts,
         )
         self.states.start(pacer)
         rules = self.description.trajectory if self.description is not None else None

@@ -28,12 +28,17 @@ from openral_bridge.joint_state_publisher import (
 )
 from openral_bridge.pacer import Pacer
 from openral_bridge.tf_publisher import TfPublisher
-from openral_bridge.topics import JOINT_STATES, MANIFEST_JOINT_STATES, TopicInfo
+from openral_bridge.topics import (
+    JOINT_STATES,
+    MANIFEST_JOINT_STATES,
+    ROBOT_DESCRIPTION_SEMANTIC,
+    TopicInfo,
+)
 from openral_core.loaded import LoadedRobot
 from openral_hal.errors import HalError
 from openral_hal.protocol import FramesHal, MobileBaseHal, RobotHal
 from openral_sim.frame_tree import FrameTree
-from openral_sim.robot_description import scene_robot_description
+from openral_sim.robot_description import scene_robot_description, scene_semantic_description
 
 if TYPE_CHECKING:
     from rclpy.node import Node
@@ -51,7 +56,7 @@ class RobotStateStreams:
         rate_hz: float,
         robot: LoadedRobot | None,
         publish_tf: bool = True,
-        urdf: str | None = None,
+        texts: tuple[str, str] | None = None,
     ) -> None:
         """Lay out the frames (nothing is published until :meth:`start`).
 
@@ -64,8 +69,8 @@ class RobotStateStreams:
             robot: The loaded robot (for its URDF).
             publish_tf: False leaves ``/tf`` and ``/tf_static`` to another node (a
                 robot_state_publisher fed by our ``/joint_states`` and ``/robot_description``).
-            urdf: The URDF made beforehand (:func:`urdf_before_connect`); None: made on a
-                thread after start.
+            texts: The URDF and SRDF made beforehand (:func:`descriptions_before_connect`);
+                None: made on threads after start.
         """
         self.node, self.loop = node, loop
         tree = self._frame_tree(hal) if loop is not None else None
@@ -81,11 +86,16 @@ class RobotStateStreams:
         self.tf = None
         if publish_tf and tree is not None and data is not None:
             self.tf = TfPublisher(node, tree, data, rate_hz)
-        self.description = None
+        self.description = self.semantic = None
         if tree is not None and robot is not None:
-            name = robot.name
+            name, loaded = robot.name, robot
             self.description = DescriptionPublisher(
-                node, (lambda: urdf) if urdf else (lambda: scene_robot_description(tree, name))
+                node, (lambda: texts[0]) if texts else (lambda: scene_robot_description(tree, name))
+            )
+            self.semantic = DescriptionPublisher(
+                node,
+                (lambda: texts[1]) if texts else (lambda: scene_semantic_description(tree, loaded)),
+                ROBOT_DESCRIPTION_SEMANTIC,
             )
 
     def start(self, pacer: Pacer) -> None:
@@ -94,8 +104,9 @@ class RobotStateStreams:
         self.states.start(pacer, self.loop if self.each_tick else None)
         if self.tf is not None and self.loop is not None:
             self.tf.start(pacer, self.loop)
-        if self.description is not None:
-            self.description.start()
+        for description in (self.description, self.semantic):
+            if description is not None:
+                description.start()
 
     def after_reset(self) -> None:
         """The static transforms again (a reset may move a camera and the odometry frame)."""
@@ -108,15 +119,18 @@ class RobotStateStreams:
         self.states.stop()
         if self.tf is not None:
             self.tf.stop()
-        if self.description is not None:
-            self.description.stop()
+        for description in (self.description, self.semantic):
+            if description is not None:
+                description.stop()
 
     def topics(self) -> list[TopicInfo]:
         """What these publish, with their nominal rates."""
         kind, rate = "sensor_msgs/msg/JointState", self.states.rate_hz
         rows = [TopicInfo(JOINT_STATES, kind, rate), TopicInfo(MANIFEST_JOINT_STATES, kind, rate)]
         rows += self.tf.topics() if self.tf is not None else []
-        return rows + (self.description.topics() if self.description is not None else [])
+        for description in (self.description, self.semantic):
+            rows += description.topics() if description is not None else []
+        return rows
 
     def _frame_tree(self, hal: RobotHal) -> FrameTree | None:
         if not isinstance(hal, FramesHal):
@@ -137,10 +151,10 @@ def _data(hal: RobotHal) -> Any:
     return handles[1] if handles is not None else None
 
 
-def urdf_before_connect(hal: RobotHal, robot: LoadedRobot | None) -> str | None:
-    """A real robot's URDF, made before its driver starts (making one holds Python's lock for
-    tens of milliseconds, which would stall the driver's loop); None for a simulated robot
-    (made on a thread after start) or one without frames.
+def descriptions_before_connect(hal: RobotHal, robot: LoadedRobot | None) -> tuple[str, str] | None:
+    """A real robot's URDF and SRDF, made before its driver starts (making them holds
+    Python's lock for tens of milliseconds, which would stall the driver's loop); None for a
+    simulated robot (made on threads after start) or one without frames.
 
     Raises:
         HalError: The robot's frames cannot be laid out as a tree.
@@ -148,4 +162,6 @@ def urdf_before_connect(hal: RobotHal, robot: LoadedRobot | None) -> str | None:
     if not hal.is_real or robot is None or not isinstance(hal, FramesHal):
         return None
     tree = hal.frame_tree()
-    return scene_robot_description(tree, robot.name) if tree is not None else None
+    if tree is None:
+        return None
+    return scene_robot_description(tree, robot.name), scene_semantic_description(tree, robot)

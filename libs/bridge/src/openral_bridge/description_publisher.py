@@ -1,4 +1,5 @@
-"""DescriptionPublisher: the robot's URDF on ``/robot_description``, latched.
+"""DescriptionPublisher: the robot's URDF on ``/robot_description`` (or its SRDF on
+``/robot_description_semantic``), latched.
 
 ``std_msgs/String`` with transient-local durability, as robot_state_publisher offers it, so
 rviz2's RobotModel display, MoveIt and Foxglove get it whenever they join. The URDF is made
@@ -28,14 +29,15 @@ STOP_WAIT_S = 10.0
 class DescriptionPublisher:
     """Makes the URDF on a thread and publishes it once, latched."""
 
-    def __init__(self, node: Node, make: Callable[[], str]) -> None:
+    def __init__(self, node: Node, make: Callable[[], str], topic: str = ROBOT_DESCRIPTION) -> None:
         """Nothing runs until :meth:`start`.
 
         Args:
             node: The node that owns the publisher and logs.
-            make: Returns the URDF text (may take a while the first time).
+            make: Returns the text (may take a while the first time).
+            topic: Where it is published.
         """
-        self.node, self.make = node, make
+        self.node, self.make, self.topic = node, make, topic
         self.text: str | None = None
         """The URDF once published."""
         self.error: str | None = None
@@ -46,7 +48,7 @@ class DescriptionPublisher:
 
     def start(self) -> None:
         """Create the publisher and start making the URDF."""
-        self._publisher = self.node.create_publisher(String, ROBOT_DESCRIPTION, LATCHED)
+        self._publisher = self.node.create_publisher(String, self.topic, LATCHED)
         self._thread = threading.Thread(target=self._run, name="openral-urdf", daemon=True)
         self._thread.start()
 
@@ -69,8 +71,8 @@ class DescriptionPublisher:
             thread.join(STOP_WAIT_S)
 
     def topics(self) -> list[TopicInfo]:
-        """``/robot_description`` (latched)."""
-        return [TopicInfo(ROBOT_DESCRIPTION, "std_msgs/msg/String", None)]
+        """Its topic (latched)."""
+        return [TopicInfo(self.topic, "std_msgs/msg/String", None)]
 
     def _run(self) -> None:
         try:
@@ -78,7 +80,7 @@ class DescriptionPublisher:
         except Exception as error:  # reported once; the graph runs on without it
             self.error = str(error) or type(error).__name__
             self.node.get_logger().warning(  # type: ignore[no-untyped-call]
-                f"{ROBOT_DESCRIPTION} is not published: {self.error}"
+                f"{self.topic} is not published: {self.error}"
             )
             return
         with self._lock:

@@ -31,6 +31,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from openral_core.link_names import LinkNaming, link_naming
 from openral_core.located import source_file
 from openral_core.models import (
     Frames,
@@ -164,6 +165,8 @@ class FrameNames:
     """The robot's base frame (a mobile base's ``base_frame``, else ``frames.base``)."""
     odom: str | None
     """A mobile base's odometry frame; None without a mobile base."""
+    naming: LinkNaming = field(default_factory=LinkNaming)
+    """The links' and joints' names in ROS (``frames.links``, ``joints``, ``extra_links``)."""
 
 
 @dataclass(frozen=True)
@@ -211,7 +214,9 @@ class RobotTables:
             vla_slots=tuple(VlaSlot(**slot) for slot in data["vla_slots"]),
             joint_name_map=dict(data["joint_name_map"]),
             mobile_base=None if base is None else MobileBaseWiring.from_dict(base),
-            frames=FrameNames(**data["frames"]),
+            frames=FrameNames(
+                **{**data["frames"], "naming": LinkNaming.from_dict(data["frames"]["naming"])}
+            ),
             real=None if real is None else RealWiring.from_dict(real),
         )
 
@@ -310,11 +315,11 @@ def mobile_base_wiring(robot: RobotDescription) -> MobileBaseWiring | None:
 
 def frame_names(robot: RobotDescription) -> FrameNames:
     """The robot's world, base and odometry frame names, defaults filled in."""
-    frames = robot.frames or Frames()
+    frames, naming = robot.frames or Frames(), link_naming(robot)
     base = robot.mobile_base
     if base is None:
-        return FrameNames(world=frames.world, base=frames.base, odom=None)
-    return FrameNames(world=frames.world, base=base.base_frame, odom=base.odom_frame)
+        return FrameNames(world=frames.world, base=frames.base, odom=None, naming=naming)
+    return FrameNames(world=frames.world, base=base.base_frame, odom=base.odom_frame, naming=naming)
 
 
 def manifest_sha256(robot: RobotDescription) -> str:

@@ -19,3 +19,7 @@ class ActionRejected(HalError):
 
 class SimulationDiverged(HalError):
     """MuJoCo met a NaN/Inf acceleration and reset the simulation to its initial state."""
+
+
+class TreeUnsupported(HalError):
+    """The model has a joint or body layout a URDF tree cannot state; the message says where."""

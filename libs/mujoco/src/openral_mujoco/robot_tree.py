@@ -29,16 +29,18 @@ from __future__ import annotations
 import functools
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import StrEnum
 
 import mujoco
 import numpy as np
 import numpy.typing as npt
+from openral_core.link_names import LinkNaming
 from openral_core.models import LimitedJoint, RobotDescription
 from openral_core.tables import RobotTables, joint_name_map
 
-from openral_mujoco.errors import HalError
+from openral_mujoco.errors import TreeUnsupported
+from openral_mujoco.extra_links import check_renames, hang_extra_links
 from openral_mujoco.joint_coupling import effort_limit, followers
 from openral_mujoco.mobile_base import drive_geometry
 from openral_mujoco.robot_addresses import RobotAddresses
@@ -53,10 +55,6 @@ ORIGIN: Vector = (0.0, 0.0, 0.0)
 IDENTITY: Quaternion = (1.0, 0.0, 0.0, 0.0)
 UNLIMITED_SLIDE_M = 1000.0
 """Range written for a slide joint the model leaves unlimited [m] (a URDF slide needs one)."""
-
-
-class TreeUnsupported(HalError):
-    """The model has a joint or body layout a URDF tree cannot state; the message says where."""
 
 
 class BaseKind(StrEnum):
@@ -120,6 +118,8 @@ class TreeLink:
     """Pose in the parent with every joint at 0 (the URDF joint origin)."""
     joint: TreeJoint | None
     """The joint that moves it relative to its parent; None: rigidly fixed."""
+    fixed_joint: str = ""
+    """The name of the fixed joint into it (``frames.joints``; default ``<name>_fixed``)."""
 
 
 @dataclass(frozen=True)
@@ -193,7 +193,8 @@ def robot_tree(
     kind = _base_kind(model, root, tables)
     zero = _zero_pose_data(model)
     base_pose = _base_pose(model, zero, root, kind, tables)
-    names = {b: _body_name(model, b) for b in bodies}
+    naming = tables.frames.naming
+    names = {b: naming.link(_body_name(model, b)) for b in bodies}
     base = tables.frames.base
     clash = [b for b in bodies if names[b] == base and b != root]
     if clash:
@@ -202,7 +203,7 @@ def robot_tree(
             f"its root body {names[root]!r}; name the base frame otherwise (frames.base, or "
             "mobile_base.base_frame), or after the root body"
         )
-    joints = _JointReader(model, robot, addresses)
+    joints = _JointReader(model, robot, addresses, naming)
     links: list[TreeLink] = []
     if names[root] != base:
         links.append(TreeLink(base, -1, None, ORIGIN, IDENTITY, None))
@@ -225,7 +226,10 @@ def robot_tree(
         position, quat = _relative(_pose(zero, parent), _pose(zero, body))
         joint = joints.of(body, names[body])
         links.append(TreeLink(names[body], body, names[parent], position, quat, joint))
-    return RobotTree(base=base, kind=kind, root=root, links=tuple(joints.with_mimics(links)))
+    links = [replace(link, fixed_joint=naming.fixed_joint(link.name)) for link in links]
+    check_renames(naming, {_body_name(model, b) for b in bodies}, links)
+    links = hang_extra_links(joints.with_mimics(links), naming.extra_links)
+    return RobotTree(base=base, kind=kind, root=root, links=tuple(links))
 
 
 # -- base ------------------------------------------------------------------------------------
@@ -264,9 +268,13 @@ class _JointReader:
     """Each body's joint as a TreeJoint, and the mimic couplings of the model."""
 
     def __init__(
-        self, model: mujoco.MjModel, robot: RobotDescription, addresses: RobotAddresses
+        self,
+        model: mujoco.MjModel,
+        robot: RobotDescription,
+        addresses: RobotAddresses,
+        naming: LinkNaming,
     ) -> None:
-        self.model = model
+        self.model, self.naming = model, naming
         mjcf_names = joint_name_map(robot)
         self.manifest = {mjcf_names[j.name]: j for j in robot.joints}
         self.followers = followers(model, robot, addresses)
@@ -302,7 +310,7 @@ class _JointReader:
             lower, upper, limited = -UNLIMITED_SLIDE_M, UNLIMITED_SLIDE_M, True
         kind = "prismatic" if slide else ("revolute" if limited else "continuous")
         return TreeJoint(
-            name=declared.name if declared is not None else mjcf,
+            name=declared.name if declared is not None else self.naming.joint(mjcf),
             mjcf_name=mjcf,
             kind=kind,
             axis=_vector(model.jnt_axis[joint]),

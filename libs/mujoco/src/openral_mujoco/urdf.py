@@ -10,9 +10,10 @@ shapes; meshes, capsules and ellipsoids are STL files (:mod:`openral_mujoco.mesh
 planes, height fields and SDFs are left out.
 
 Each other link hangs from its parent by a ``<joint>``: the tree's joint, else a fixed joint
-``<child>_fixed``. A revolute joint whose axis does not pass through the child's origin
-(a non-zero ``anchor``) becomes the joint into an extra link ``<child>_axis`` at the anchor,
-then a fixed joint ``<child>_fixed`` back to the child's origin.
+``<child>_fixed`` unless ``frames.joints`` names it. A revolute joint whose axis does not
+pass through the child's origin (a non-zero ``anchor``) becomes the joint into an extra link
+``<child>_axis`` at the anchor, then a fixed joint ``<child>_fixed`` back to the child's
+origin.
 
 The text is deterministic: the same tree and model give the same bytes (numbers as their
 shortest round-trip ``repr``, no dates).
@@ -27,8 +28,9 @@ from collections import Counter
 import mujoco
 import numpy as np
 
+from openral_mujoco.errors import TreeUnsupported
 from openral_mujoco.mesh_export import EXPORTED, MeshExporter
-from openral_mujoco.robot_tree import Quaternion, RobotTree, TreeLink, TreeUnsupported, Vector
+from openral_mujoco.robot_tree import Quaternion, RobotTree, TreeLink, Vector
 
 VISIBLE_GROUPS = (0, 1, 2)
 """Geom groups MuJoCo's viewer shows by default."""
@@ -75,7 +77,9 @@ def _require_unique_names(tree: RobotTree) -> None:
     for link in tree.links:
         if link.parent is None:
             continue
-        if link.joint is None or _anchored(link):
+        if link.joint is None:
+            joints.append(_fixed_name(link))
+        if _anchored(link):
             joints.append(f"{link.name}_fixed")
         if link.joint is not None:
             joints.append(link.joint.name)
@@ -104,7 +108,7 @@ def _add_joints(robot: ET.Element, link: TreeLink) -> None:
     assert link.parent is not None
     joint = link.joint
     if joint is None:
-        _fixed(robot, link.parent, link.name, link.position, link.quat)
+        _fixed(robot, link.parent, link.name, link.position, link.quat, _fixed_name(link))
         return
     parent_side = link.name
     position = link.position
@@ -138,8 +142,20 @@ def _add_joints(robot: ET.Element, link: TreeLink) -> None:
         _fixed(robot, parent_side, link.name, back, IDENTITY)
 
 
-def _fixed(robot: ET.Element, parent: str, child: str, position: Vector, quat: Quaternion) -> None:
-    element = ET.SubElement(robot, "joint", name=f"{child}_fixed", type="fixed")
+def _fixed_name(link: TreeLink) -> str:
+    """The fixed joint into ``link``: as ``frames.joints`` names it, else ``<link>_fixed``."""
+    return link.fixed_joint or f"{link.name}_fixed"
+
+
+def _fixed(
+    robot: ET.Element,
+    parent: str,
+    child: str,
+    position: Vector,
+    quat: Quaternion,
+    name: str = "",
+) -> None:
+    element = ET.SubElement(robot, "joint", name=name or f"{child}_fixed", type="fixed")
     _origin(element, position, quat)
     ET.SubElement(element, "parent", link=parent)
     ET.SubElement(element, "child", link=child)

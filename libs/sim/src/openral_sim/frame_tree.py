@@ -109,9 +109,12 @@ class FrameTree:
         self._base_in_root = _inverse_pose(self.root_in_base)
         frames: list[Frame] = [Frame(names.world, "", True), *self._base_frames()]
         link_of = {link.body: link.name for link in tree.links if link.body >= 0}
-        body_rows, bodies = [], []
+        body_rows, bodies, extras = [], [], []
         for link in tree.links:
-            if link.parent is not None:
+            if link.parent is not None and link.body < 0:  # an extra link: off its parent
+                extras.append((len(frames), link))
+                frames.append(Frame(link.name, link.parent, True))
+            elif link.parent is not None:
                 body_rows.append(len(frames))
                 bodies.append(link.body)
                 frames.append(Frame(link.name, link.parent, link.joint is None))
@@ -125,6 +128,12 @@ class FrameTree:
         self._check_unique()
         index = {frame.name: i for i, frame in enumerate(frames)}
         self.parent_index = np.array([index.get(f.parent, 0) for f in frames], dtype=np.intp)
+        self._extras = [
+            (row, index[link.parent or ""], np.array(link.position), np.array(link.quat))
+            for row, link in extras
+        ]
+        """Extra links (``frames.extra_links``), parents first: (row, parent row, pose in
+        the parent)."""
         self.static = np.array([i for i, f in enumerate(frames) if f.static and i], np.intp)
         self.dynamic = np.array([i for i, f in enumerate(frames) if not f.static], np.intp)
 
@@ -146,6 +155,10 @@ class FrameTree:
             quats[self._odom_row] = (np.cos(heading / 2), 0.0, 0.0, np.sin(heading / 2))
         positions[self._body_rows] = data.xpos[self._bodies]
         quats[self._body_rows] = data.xquat[self._bodies]
+        for row, parent, position, quat in self._extras:
+            mujoco.mju_mulPose(
+                positions[row], quats[row], positions[parent], quats[parent], position, quat
+            )
         for row, sensor in self._sensors:
             positions[row], quats[row] = _sensor_pose(data, sensor)
         return FrameSample(float(data.time), positions, quats)

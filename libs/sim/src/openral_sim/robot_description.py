@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from openral_core.loaded import LoadedRobot
 from openral_mujoco.robot_tree import robot_tree
+from openral_mujoco.srdf import srdf_text
 from openral_mujoco.urdf import urdf_text
 
 from openral_sim.frame_tree import FrameTree
@@ -38,6 +39,18 @@ def robot_description(robot: LoadedRobot) -> str:
     return urdf_text(tree, alone.model, robot.name)
 
 
+def robot_semantic_description(robot: LoadedRobot) -> str:
+    """The robot's SRDF text (:mod:`openral_mujoco.srdf`), on the URDF's names.
+
+    Raises:
+        ManifestError: The robot's model does not load or disagrees with its manifest.
+        TreeUnsupported: The model has a joint or body layout a URDF cannot state.
+    """
+    alone = robot_alone(robot)
+    tree = robot_tree(alone.model, robot.description, robot.tables, alone.addresses)
+    return srdf_text(tree, alone.model, robot.description, robot.tables)
+
+
 def scene_robot_description(frames: FrameTree, name: str) -> str:
     """The URDF of robot ``name`` as a running scene holds it, read from the scene's model
     through its frame tree: the text :func:`robot_description` returns.
@@ -47,3 +60,9 @@ def scene_robot_description(frames: FrameTree, name: str) -> str:
         MeshExportFailed: A mesh file could not be written.
     """
     return urdf_text(frames.tree, frames.model, name)
+
+
+def scene_semantic_description(frames: FrameTree, robot: LoadedRobot) -> str:
+    """The SRDF of ``robot`` as a running scene holds it (its frame tree's model): the
+    text :func:`robot_semantic_description` returns."""
+    return srdf_text(frames.tree, frames.model, robot.description, robot.tables)

@@ -22,8 +22,9 @@ import typer
 from openral_core.errors import ManifestError, OpenralError, one_line
 
 from openral_cli.commands.robot_calibrate import calibrate
+from openral_cli.commands.robot_files import manifest_file as _manifest_file
+from openral_cli.commands.robot_texts import srdf, urdf
 from openral_cli.console import err, highlighted, line, out, styled
-from openral_cli.console import error as print_error
 from openral_cli.help_text import command_group
 
 if TYPE_CHECKING:
@@ -33,6 +34,8 @@ if TYPE_CHECKING:
 
 app = command_group("Inspect and validate robot manifests.")
 app.command("calibrate")(calibrate)
+app.command("urdf")(urdf)
+app.command("srdf")(srdf)
 
 
 @app.command("list")
@@ -206,18 +209,6 @@ def _named_manifests(targets: list[str] | None, all_robots: bool, verb: str) -> 
     return files
 
 
-def _manifest_file(target: str) -> Path:
-    from openral_core import manifest_path
-    from openral_core.registry import MANIFEST_NAME
-
-    path = Path(target)
-    if path.is_dir():
-        return path / MANIFEST_NAME
-    if path.suffix in (".yaml", ".yml") or path.exists():
-        return path
-    return manifest_path(target)
-
-
 @app.command("check")
 def check(
     targets: Annotated[
@@ -349,39 +340,3 @@ def scaffold(
         f"`openral robot validate {typed}` and `openral robot check {typed}`",
         highlight=True,
     )
-
-
-@app.command("urdf")
-def urdf(
-    target: Annotated[str, typer.Argument(help="Robot id, manifest file or robot folder.")],
-    out_file: Annotated[
-        Path | None,
-        typer.Option("--out", help="File to write the URDF to.", show_default="standard output"),
-    ] = None,
-) -> None:
-    """The robot's URDF, as the ROS graph publishes it on /robot_description.
-
-    Mesh files (STL) are written once to the model cache and named by absolute path.
-    Exits 1 when the robot does not load or its model has no URDF form.
-    """
-    from openral_core import open_robot
-    from openral_core.registry import MANIFEST_NAME
-    from openral_mujoco.robot_tree import TreeUnsupported
-    from openral_sim.robot_description import robot_description
-
-    file = _manifest_file(target)
-    robot = open_robot(file, check_folder_name=file.name == MANIFEST_NAME)
-    try:
-        text = robot_description(robot)
-    except TreeUnsupported as problem:
-        print_error(f"robot {robot.name!r} has no URDF: {one_line(str(problem))}")
-        raise typer.Exit(1) from None
-    if out_file is None:
-        typer.echo(text, nl=False)
-        return
-    try:
-        out_file.write_text(text, encoding="utf-8")
-    except OSError as problem:
-        print_error(f"cannot write {out_file}: {problem.strerror or problem}")
-        raise typer.Exit(1) from None
-    err.print(f"wrote the URDF of {robot.name} to {out_file}", highlight=True)

@@ -1,0 +1,73 @@
+"""`openral robot urdf` and `openral robot srdf`: the robot's descriptions as the ROS graph
+publishes them (/robot_description, /robot_description_semantic)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from openral_core.errors import one_line
+
+from openral_cli.commands.robot_files import manifest_file as _manifest_file
+from openral_cli.console import err
+from openral_cli.console import error as print_error
+
+
+def urdf(
+    target: Annotated[str, typer.Argument(help="Robot id, manifest file or robot folder.")],
+    out_file: Annotated[
+        Path | None,
+        typer.Option("--out", help="File to write the URDF to.", show_default="standard output"),
+    ] = None,
+) -> None:
+    """The robot's URDF, as the ROS graph publishes it on /robot_description.
+
+    Mesh files (STL) are written once to the model cache and named by absolute path.
+    Exits 1 when the robot does not load or its model has no URDF form.
+    """
+    from openral_core import open_robot
+    from openral_core.registry import MANIFEST_NAME
+    from openral_mujoco.errors import TreeUnsupported
+    from openral_sim.robot_description import robot_description
+
+    file = _manifest_file(target)
+    robot = open_robot(file, check_folder_name=file.name == MANIFEST_NAME)
+    try:
+        text = robot_description(robot)
+    except TreeUnsupported as problem:
+        print_error(f"robot {robot.name!r} has no URDF: {one_line(str(problem))}")
+        raise typer.Exit(1) from None
+    if out_file is None:
+        typer.echo(text, nl=False)
+        return
+    try:
+        out_file.write_text(text, encoding="utf-8")
+    except OSError as problem:
+        print_error(f"cannot write {out_file}: {problem.strerror or problem}")
+        raise typer.Exit(1) from None
+    err.print(f"wrote the URDF of {robot.name} to {out_file}", highlight=True)
+
+
+def srdf(
+    target: Annotated[str, typer.Argument(help="Robot id, manifest file or robot folder.")],
+) -> None:
+    """The robot's SRDF (MoveIt's semantic description), as the ROS graph publishes it on
+    /robot_description_semantic: arm and gripper groups, the end effector, named states and
+    the collision pairs a planner need not check.
+
+    Exits 1 when the robot does not load or its model has no URDF form.
+    """
+    from openral_core import open_robot
+    from openral_core.registry import MANIFEST_NAME
+    from openral_mujoco.errors import TreeUnsupported
+    from openral_sim.robot_description import robot_semantic_description
+
+    file = _manifest_file(target)
+    robot = open_robot(file, check_folder_name=file.name == MANIFEST_NAME)
+    try:
+        text = robot_semantic_description(robot)
+    except TreeUnsupported as problem:
+        print_error(f"robot {robot.name!r} has no SRDF: {one_line(str(problem))}")
+        raise typer.Exit(1) from None
+    typer.echo(text, nl=False)
