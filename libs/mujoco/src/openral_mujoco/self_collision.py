@@ -14,19 +14,30 @@ welded together (MuJoCo never collides them) and pairs the MJCF excludes.
 
 from __future__ import annotations
 
+import contextlib
+import hashlib
+import json
+import os
 from dataclasses import dataclass
 from itertools import combinations
 
 import mujoco
 import numpy as np
 
+from openral_mujoco.mesh_export import mesh_folder
 from openral_mujoco.robot_tree import RobotTree
 
+CACHE_VERSION = 1
+"""Bumped when the way pairs are found changes (old cache files are then not read)."""
 SAMPLES = 4000
 """Poses drawn per model."""
 MARGIN_M = 0.01
 """Geometry this close counts as touching [m] (a pose between two samples may be closer)."""
 SEED = 0
+
+
+KINDS = ("adjacent", "never", "touching")
+_MEMO: dict[str, LinkPairs] = {}
 
 
 @dataclass(frozen=True)
@@ -37,6 +48,27 @@ class LinkPairs:
     never: tuple[tuple[str, str], ...]
     touching: tuple[tuple[str, str], ...]
     """Pairs some sampled pose brought together (not adjacent): checked by a planner."""
+
+
+def cached_link_pairs(tree: RobotTree, model: mujoco.MjModel) -> LinkPairs:
+    """:func:`link_pairs`, found once per robot geometry and kept in the model cache (a
+    graph's start-up would otherwise sample 1-6 s of poses each time)."""
+    key = _geometry_key(tree, model)
+    if key in _MEMO:
+        return _MEMO[key]
+    file = mesh_folder().parent / "link_pairs" / f"{key}.json"
+    with contextlib.suppress(OSError, ValueError, KeyError, TypeError):
+        saved = json.loads(file.read_text(encoding="utf-8"))
+        _MEMO[key] = pairs = LinkPairs(*(tuple(tuple(p) for p in saved[k]) for k in KINDS))
+        return pairs
+    pairs = link_pairs(tree, model)
+    with contextlib.suppress(OSError):  # a cache that cannot be written is only slower
+        file.parent.mkdir(parents=True, exist_ok=True)
+        temporary = file.with_suffix(f".{os.getpid()}.part")
+        temporary.write_text(json.dumps({k: getattr(pairs, k) for k in KINDS}), "utf-8")
+        temporary.replace(file)
+    _MEMO[key] = pairs
+    return pairs
 
 
 def link_pairs(tree: RobotTree, model: mujoco.MjModel, samples: int = SAMPLES) -> LinkPairs:
@@ -51,6 +83,28 @@ def link_pairs(tree: RobotTree, model: mujoco.MjModel, samples: int = SAMPLES) -
         never=tuple(sorted(every - adjacent - touched)),
         touching=tuple(sorted(touched - adjacent)),
     )
+
+
+def _geometry_key(tree: RobotTree, model: mujoco.MjModel) -> str:
+    """A digest of everything the pairs depend on: the tree (names, poses, joints), each
+    link's collision geoms (type, size, pose, mesh vertices) and the sampling settings."""
+    digest = hashlib.sha256(repr((CACHE_VERSION, SAMPLES, MARGIN_M, SEED)).encode())
+    for link in tree.links:
+        digest.update(repr((link.name, link.parent, link.position, link.quat)).encode())
+        if link.joint is not None:
+            joint = link.joint
+            digest.update(repr((joint.name, joint.lower, joint.upper, joint.mimic)).encode())
+    for name, geoms in sorted(_links_with_geometry(tree, model).items()):
+        digest.update(name.encode())
+        for geom in geoms:
+            for values in (model.geom_type[geom], model.geom_size[geom], model.geom_pos[geom]):
+                digest.update(np.asarray(values, dtype=np.float64).tobytes())
+            digest.update(np.asarray(model.geom_quat[geom], dtype=np.float64).tobytes())
+            mesh = int(model.geom_dataid[geom])
+            if model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_MESH and mesh >= 0:
+                first, count = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
+                digest.update(np.asarray(model.mesh_vert[first : first + count]).tobytes())
+    return digest.hexdigest()[:32]
 
 
 def _adjacent(tree: RobotTree, geometric: dict[str, list[int]]) -> set[tuple[str, str]]:

@@ -24,7 +24,7 @@ from openral_core.models import RobotDescription
 from openral_core.tables import RobotTables
 
 from openral_mujoco.robot_tree import RobotTree, TreeLink
-from openral_mujoco.self_collision import LinkPairs, link_pairs
+from openral_mujoco.self_collision import LinkPairs, cached_link_pairs
 from openral_mujoco.start_pose import set_start_pose
 
 ARM_GROUP = "arm"
@@ -39,8 +39,8 @@ def srdf_text(
     pairs: LinkPairs | None = None,
 ) -> str:
     """The SRDF of the robot whose ``tree`` was read from ``model`` (see the module doc);
-    ``pairs`` default to :func:`link_pairs` of the tree."""
-    pairs = pairs if pairs is not None else link_pairs(tree, model)
+    ``pairs`` default to the tree's (:func:`cached_link_pairs`)."""
+    pairs = pairs if pairs is not None else cached_link_pairs(tree, model)
     root = ET.Element("robot", name=robot.name)
     gripper_joints = {g.joint for g in tables.hal_wiring.grippers} if tables.hal_wiring else set()
     arm = [j.name for j in robot.joints if j.name not in gripper_joints]
