@@ -72,6 +72,8 @@ def _repair(document: dict[str, Any]) -> dict[str, Any]:
         if "position_limits" in joint:
             joint["position_limits"] = _ordered(joint["position_limits"])
     _repair_real(document)
+    for extra in document.get("frames", {}).get("extra_links", []):
+        extra["quat_wxyz"] = [1.0, 0.0, 0.0, 0.0]  # rule 27
     sim = document.get("sim")
     if sim is None:
         return document

@@ -172,6 +172,13 @@ RULE_BREAKS = (
     ),
     RuleBreak(
         SchemaName.ROBOT,
+        27,
+        ROBOT_FILE,
+        "position_m: [0.0, 0.0, 0.107],",
+        "position_m: [0.0, 0.0, 0.107], quat_wxyz: [0.0, 0.0, 0.0, 0.0],",
+    ),
+    RuleBreak(
+        SchemaName.ROBOT,
         19,
         ROBOT_FILE,
         "tcp: {body: hand,",

