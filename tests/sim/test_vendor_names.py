@@ -3,7 +3,10 @@ franka_description's link and joint names, and its SRDF matches its URDF."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -17,6 +20,8 @@ from openral_mujoco.srdf import srdf_text
 from openral_sim.frame_tree import scene_frame_tree
 from openral_sim.robot_description import robot_description
 from openral_sim.scene_base import robot_alone
+
+from tests.conftest import ROBOTS
 
 PANDA_LINKS = [f"panda_link{i}" for i in range(9)] + [
     "panda_hand",
@@ -159,3 +164,22 @@ def test_a_name_that_names_nothing_is_one_line(frames: dict[str, object], expect
     with pytest.raises(TreeUnsupported, match=expected) as caught:
         robot_tree(alone.model, robot.description, robot.tables, alone.addresses)
     assert "\n" not in str(caught.value)
+
+
+def test_openral_robot_srdf_prints_it_and_a_robot_without_a_tree_is_one_line(
+    tmp_path: Path,
+) -> None:
+    openral = Path(sys.executable).parent / "openral"
+    done = subprocess.run(
+        [openral, "robot", "srdf", "franka_panda"], capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    arm = ET.fromstring(done.stdout).find("group")
+    assert arm is not None and [j.get("name") for j in arm] == PANDA_JOINTS[:7]
+    broken = tmp_path / "franka_panda" / "robot.yaml"
+    broken.parent.mkdir()
+    text = (ROBOTS / "franka_panda" / "robot.yaml").read_text()
+    broken.write_text(text.replace("hand: panda_hand,", "hand: panda_hand, nope: x,"))
+    done = subprocess.run([openral, "robot", "srdf", str(broken)], capture_output=True, text=True)
+    assert done.returncode == 1 and "frames.links: 'nope' is no body" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1, done.stderr

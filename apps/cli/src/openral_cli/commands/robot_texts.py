@@ -3,11 +3,13 @@ publishes them (/robot_description, /robot_description_semantic)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated
 
 import typer
 from openral_core.errors import one_line
+from openral_core.loaded import LoadedRobot
 
 from openral_cli.commands.robot_files import manifest_file as _manifest_file
 from openral_cli.console import err
@@ -26,18 +28,9 @@ def urdf(
     Mesh files (STL) are written once to the model cache and named by absolute path.
     Exits 1 when the robot does not load or its model has no URDF form.
     """
-    from openral_core import open_robot
-    from openral_core.registry import MANIFEST_NAME
-    from openral_mujoco.errors import TreeUnsupported
     from openral_sim.robot_description import robot_description
 
-    file = _manifest_file(target)
-    robot = open_robot(file, check_folder_name=file.name == MANIFEST_NAME)
-    try:
-        text = robot_description(robot)
-    except TreeUnsupported as problem:
-        print_error(f"robot {robot.name!r} has no URDF: {one_line(str(problem))}")
-        raise typer.Exit(1) from None
+    name, text = _text_of(target, robot_description, "URDF")
     if out_file is None:
         typer.echo(text, nl=False)
         return
@@ -46,7 +39,7 @@ def urdf(
     except OSError as problem:
         print_error(f"cannot write {out_file}: {problem.strerror or problem}")
         raise typer.Exit(1) from None
-    err.print(f"wrote the URDF of {robot.name} to {out_file}", highlight=True)
+    err.print(f"wrote the URDF of {name} to {out_file}", highlight=True)
 
 
 def srdf(
@@ -58,16 +51,22 @@ def srdf(
 
     Exits 1 when the robot does not load or its model has no URDF form.
     """
+    from openral_sim.robot_description import robot_semantic_description
+
+    _, text = _text_of(target, robot_semantic_description, "SRDF")
+    typer.echo(text, nl=False)
+
+
+def _text_of(target: str, make: Callable[[LoadedRobot], str], what: str) -> tuple[str, str]:
+    """The robot's name and ``make(robot)``; exit 1 with one line when it has no tree."""
     from openral_core import open_robot
     from openral_core.registry import MANIFEST_NAME
     from openral_mujoco.errors import TreeUnsupported
-    from openral_sim.robot_description import robot_semantic_description
 
     file = _manifest_file(target)
     robot = open_robot(file, check_folder_name=file.name == MANIFEST_NAME)
     try:
-        text = robot_semantic_description(robot)
+        return robot.name, make(robot)
     except TreeUnsupported as problem:
-        print_error(f"robot {robot.name!r} has no SRDF: {one_line(str(problem))}")
+        print_error(f"robot {robot.name!r} has no {what}: {one_line(str(problem))}")
         raise typer.Exit(1) from None
-    typer.echo(text, nl=False)
