@@ -39,7 +39,8 @@ from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from tests.conftest import REPO
 
-# Upstream Jazzy's hashes (tf2_msgs 0.36, control_msgs 5.x from its jazzy branch).
+# Upstream Jazzy's hashes (tf2_msgs 0.36, control_msgs 5.8 and ros2_control's
+# controller_manager_msgs 4.46 from their jazzy branches: generated from upstream's own files).
 TF_MESSAGE = "RIHS01_e369d0f05a23ae52508854b66f6aa0437f3449d652e8cbf22d5abe85d020f087"
 FOLLOW_JOINT_TRAJECTORY = "RIHS01_738ebcb7a2d7cfa42f9f1001cc99ce3a4383d1cfe508015d9be8485e4b1c66f6"
 FJT_FEEDBACK_MESSAGE = "RIHS01_80398fcb9674a79081a9906e2ccf0c804dd7cb15e22e362e606ee87186beab71"
@@ -47,6 +48,18 @@ JOINT_TOLERANCE = "RIHS01_c254f9cece0f3b733017b6990fd46d1326e25242d6b8844398c97d
 JOINT_COMPONENT_TOLERANCE = (
     "RIHS01_739ea7566931944d33830fa10f1bf5e7a7fbdc3172bce7a7eaac642bd6e3ffa4"
 )
+GRIPPER_COMMAND = "RIHS01_e17c0e644eccf14bea84a0a93e0977182872c2eb7873ca6694900059b46dbc84"
+GRIPPER_COMMAND_MSG = "RIHS01_57eb8f326c9889ca8bb34ead82cc94cc09bf6bc5c3b6c09546dca3a00b589890"
+JTC_STATE = "RIHS01_51d8dd89cc624cbe9daaeeb4d80d6de9b86168ffdc3be41fefc0953e3c26e480"
+DYNAMIC_JOINT_STATE = "RIHS01_18024c98a62697680f581108eeed40b28fb4542fa0ac5a8e36f56c62b6813d26"
+INTERFACE_VALUE = "RIHS01_74a12144ef6b7af67533195cb30f7f607d3301b66950208a72d280695f3e190c"
+CONTROLLER_STATE = "RIHS01_9a8780ab9814b6032978a07c6c7033cf1a7894ac8d948a6fb72afea07b04cc83"
+HARDWARE_INTERFACE = "RIHS01_b4c556991db81ca56a49338b5e8f0675a6707faee54fba161d2bbd4d963d418a"
+LIST_CONTROLLERS = "RIHS01_4f8e36bb1fa5afdeba45c2d56ae6a2097b1493a253f961dd6290c085033bd189"
+LIST_HARDWARE_INTERFACES = (
+    "RIHS01_c3e561a6e8cc7b9d577d8065c783038e51f6950cbe9bed67fb117a3e2e04d8f1"
+)
+SWITCH_CONTROLLER = "RIHS01_d4ad10aa5da7808bc522d55d4123d8ef79de73d049d165639d7663ac37cc9895"
 SHARE = Path(sys.prefix) / "share"
 WAIT_S = 10.0
 ACTION = "/arm/follow_joint_trajectory"
@@ -75,6 +88,16 @@ def _rihs01(type_description_msg: dict[str, Any]) -> str:
         ("control_msgs/action/FollowJointTrajectory", FOLLOW_JOINT_TRAJECTORY),
         ("control_msgs/msg/JointTolerance", JOINT_TOLERANCE),
         ("control_msgs/msg/JointComponentTolerance", JOINT_COMPONENT_TOLERANCE),
+        ("control_msgs/action/GripperCommand", GRIPPER_COMMAND),
+        ("control_msgs/msg/GripperCommand", GRIPPER_COMMAND_MSG),
+        ("control_msgs/msg/JointTrajectoryControllerState", JTC_STATE),
+        ("control_msgs/msg/DynamicJointState", DYNAMIC_JOINT_STATE),
+        ("control_msgs/msg/InterfaceValue", INTERFACE_VALUE),
+        ("controller_manager_msgs/msg/ControllerState", CONTROLLER_STATE),
+        ("controller_manager_msgs/msg/HardwareInterface", HARDWARE_INTERFACE),
+        ("controller_manager_msgs/srv/ListControllers", LIST_CONTROLLERS),
+        ("controller_manager_msgs/srv/ListHardwareInterfaces", LIST_HARDWARE_INTERFACES),
+        ("controller_manager_msgs/srv/SwitchController", SWITCH_CONTROLLER),
     ],
 )
 def test_the_generated_type_hash_is_upstream_jazzys(interface: str, expected: str) -> None:

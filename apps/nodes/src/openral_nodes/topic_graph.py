@@ -37,6 +37,7 @@ POLL_S = 0.05
 DECODABLE_PACKAGES = (
     "builtin_interfaces",
     "control_msgs",
+    "controller_manager_msgs",
     "geometry_msgs",
     "lifecycle_msgs",
     "nav_msgs",
@@ -48,7 +49,7 @@ DECODABLE_PACKAGES = (
     "trajectory_msgs",
 )
 """ROS message packages whose types are decoded (the ``ros`` extra, rclpy's own and the
-interface packages built at setup: tf2_msgs, control_msgs)."""
+interface packages built at setup: tf2_msgs, control_msgs, controller_manager_msgs)."""
 SERVICE_PACKAGES = (
     "lifecycle_msgs",
     "nav_msgs",
