@@ -32,7 +32,7 @@ def test_the_view_shows_the_arm_and_a_camera_in_headless_chromium(tmp_path: Path
     port = free_port_pair()
     process = start_view(port)
     try:
-        assert listening(port + 1) == ["127.0.0.1"], "the data stream listens on loopback only"
+        assert listening(port) == listening(port + 1) == ["127.0.0.1"], "loopback only"
         seen = photograph(view_url(port), tmp_path / "view.png")
         print(f"screenshot: {seen}")
         assert seen.drawn(), seen
@@ -66,7 +66,7 @@ def test_a_policy_episode_is_viewed_and_served_until_ctrl_c() -> None:
     process, text = serve("sim", "run", "--config", SCENE, *args)
     try:
         assert f"view: {view_url(port)}" in text and "scripted_lift" in text, text
-        assert listening(port + 1) == ["127.0.0.1"]
+        assert listening(port) == listening(port + 1) == ["127.0.0.1"]
     finally:
         code, err = stop(process)
     assert code == 0 and "Traceback" not in err, err

@@ -1,6 +1,6 @@
 """``openral deploy sim --view`` from outside: the franka tabletop graph prints the page's
-address beside its interfaces, serves the data stream on 127.0.0.1 only, and ends cleanly
-on SIGTERM. What the graph sends to the view is tested in process
+address beside its interfaces, serves the page and the data stream on 127.0.0.1 only, and
+ends cleanly on SIGTERM. What the graph sends to the view is tested in process
 (``tests/bridge/test_view_bridge.py``), and what a browser draws of a view in
 ``tests/docs/test_browser_view.py`` (a deploy graph and Chromium on two cores take 90 s to
 show the same picture).
@@ -32,7 +32,7 @@ def test_the_running_graph_serves_its_view_on_loopback(tmp_path: Path) -> None:
         line = re.search(r"view:\s+(\S+)", deploy_output(tmp_path)[0])
         assert line, deploy_output(tmp_path)
         assert line.group(1) == view_url(port)
-        assert listening(port + 1) == ["127.0.0.1"]
+        assert listening(port) == listening(port + 1) == ["127.0.0.1"]
         process.terminate()
         assert process.wait(30) == 0
     out, err = deploy_output(tmp_path)

@@ -1,8 +1,9 @@
 """``--view`` and ``--view-port`` of ``sim run``, ``sim replay`` and ``deploy sim``: one
 definition of the options, opening the view on a HAL, and serving it after a run ends.
 
-The page is ``http://127.0.0.1:PORT/`` (Rerun's web viewer, from the wheel); the data stream
-listens on 127.0.0.1 at PORT + 1 (:mod:`openral_sim.browser_view`).
+The page (Rerun's web viewer, from the wheel) is ``http://127.0.0.1:PORT/`` and the data
+stream ``127.0.0.1:PORT + 1``; both listen on 127.0.0.1 only and stop when the view closes
+(:mod:`openral_sim.browser_view`).
 """
 
 from __future__ import annotations

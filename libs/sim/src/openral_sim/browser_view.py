@@ -5,9 +5,9 @@ nothing fetched) and a data stream the page connects to, then draws what
 :mod:`openral_sim.view_geometry` reads from the model: the robot's and the scene's bodies as
 meshes and primitives along the frame tree, posed from ``data`` at each :meth:`pose`; camera
 images and depth frames; one plot line per joint and per action slot, all on the simulated
-time line ``sim_time``. The data stream listens on ``host`` only (127.0.0.1 by default);
-Rerun 0.41 has no address option for the page's static files, which it serves on every
-interface (they carry no data).
+time line ``sim_time``. The page and the data stream listen on ``host`` only (127.0.0.1 by
+default): the data stream is Rerun's, the page is served by :mod:`openral_sim.viewer_page`
+(Rerun 0.41's own page server listens on every interface). Both stop at :meth:`close`.
 
 Logging is cheap (Rerun batches and sends on threads of its own); :meth:`pose` skips ticks
 closer than ``1 / max_rate_hz`` in simulated time, so a 1 kHz loop sends at most 30 poses a
@@ -28,16 +28,10 @@ import rerun.blueprint as rrb
 
 from openral_sim.view_geometry import WORLD, BodyTree, Geom, GeomShape, body_tree, relative_poses
 from openral_sim.view_geometry import visible_geoms as _visible_geoms
+from openral_sim.viewer_page import PageServer, ViewUnavailable, viewer_files
 
-_PAGES_SERVED: set[int] = set()
-"""Ports this process serves the viewer's page on (a view opened again, after a lifecycle
-deactivate and activate, reuses its page and opens a new data stream)."""
 AXIS_LENGTH_M = 0.1
 """Length of the axes drawn at a frame of :meth:`BrowserView.transform` [m]."""
-
-
-class ViewUnavailable(RuntimeError):
-    """The browser view cannot start (Rerun missing, a port taken)."""
 
 
 @dataclass(frozen=True)
@@ -82,7 +76,8 @@ class BrowserView:
             max_rate_hz: Most poses sent per second of simulated time [Hz].
 
         Raises:
-            ViewUnavailable: A port is taken.
+            ViewUnavailable: A port is taken, or Rerun's page files cannot be copied
+                (:func:`~openral_sim.viewer_page.viewer_files`).
         """
         self.ports = ports or ViewPorts()
         self.tree = (
@@ -91,20 +86,15 @@ class BrowserView:
         self._period_s = 1.0 / max_rate_hz
         self._last_s = -np.inf
         self._posed_static = False
-        page_served = self.ports.web in _PAGES_SERVED
-        for port in (self.ports.data,) if page_served else (self.ports.web, self.ports.data):
+        for port in (self.ports.web, self.ports.data):
             _check_free(self.ports.host, port)
+        self._page = PageServer(viewer_files(), self.ports.host, self.ports.web)
         self.stream = rr.RecordingStream("openral", recording_id=title)
         self.stream.send_recording_name(title)
         try:
-            sink = rr.GrpcServerSink(bind_ip=self.ports.host, port=self.ports.data)
-            self.stream.set_sinks(sink)
-            if not page_served:  # Rerun serves the page until the process ends
-                rr.serve_web_viewer(
-                    web_port=self.ports.web, open_browser=False, connect_to=sink.uri
-                )
-                _PAGES_SERVED.add(self.ports.web)
+            self.stream.set_sinks(rr.GrpcServerSink(bind_ip=self.ports.host, port=self.ports.data))
         except Exception as error:  # Rerun raises plain errors for a port in use
+            self._page.close()
             raise ViewUnavailable(f"the view cannot listen: {error}") from None
         self.stream.send_blueprint(_layout(cameras, _eye(model) if model is not None else None))
         self.stream.log(WORLD, rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
@@ -165,9 +155,12 @@ class BrowserView:
         self.stream.log(f"cameras/{camera}/depth", rr.DepthImage(depth_m, meter=1.0))
 
     def close(self) -> None:
-        """Flush what was logged and stop serving."""
-        self.stream.flush()
-        self.stream.disconnect()
+        """Flush what was logged and stop serving the data stream and the page."""
+        try:
+            self.stream.flush()
+            self.stream.disconnect()
+        finally:
+            self._page.close()
 
 
 def _check_free(host: str, port: int) -> None:
