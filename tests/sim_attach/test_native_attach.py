@@ -45,7 +45,7 @@ def test_action_slots_are_the_scene_actuators(hal: SimAttachedHAL) -> None:
 def test_hold_ticks_keep_the_start_pose(hal: SimAttachedHAL) -> None:
     start = hal.read_state()
     hold = hal.hold_action()
-    for _ in range(40):  # two seconds of scene time
+    for _ in range(40 * hal.state_parts):  # two seconds of scene time (a tick: one part)
         assert hal.tick(None)
     later = hal.read_state()
     assert later.sim_time_s is not None and start.sim_time_s is not None
@@ -62,14 +62,14 @@ def test_hold_ticks_finish_the_last_move_and_the_frame_follows(hal: SimAttachedH
     hal.send_action(target)
     moved_once = hal.read_state().positions[0]
     frames = [hal.read_images()["agentview"]]
-    for _ in range(30):
+    for _ in range(30 * hal.state_parts):
         assert hal.tick(None)
         frames.append(hal.read_images()["agentview"])
     settled = hal.read_state().positions[0]
     np.testing.assert_allclose(hal.hold_action(), target)  # hold ticks keep the command
     np.testing.assert_allclose(hal.last_env_action, target)
     assert abs(settled - target[0]) < 0.05 < abs(moved_once - target[0])
-    assert _changed(frames[0], frames[10]) > 0.1, "hold ticks did not advance the picture"
+    assert _changed(frames[0], frames[10 * hal.state_parts]) > 0.1, "the picture did not follow"
 
 
 def test_estop_freezes_the_scene(hal: SimAttachedHAL) -> None:
@@ -94,3 +94,37 @@ def test_camera_fovy_comes_from_the_camera_that_renders_the_sensor(hal: SimAttac
         assert hal.camera_fovy_deg(sensor) == pytest.approx(float(model.cam_fovy[index]))
     assert hal.camera_fovy_deg("wrist") == pytest.approx(75.0)  # the manifest's, mounted
     assert hal.camera_fovy_deg("belly") is None
+
+
+def test_a_period_stepped_in_parts_is_the_whole_step_bit_for_bit() -> None:
+    """Fresh state at the state rate changes nothing of the motion: a control period stepped
+    in its parts (the command, then holds) ends exactly where one whole step does, and every
+    part is a new instant."""
+    scene = ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml"
+    whole, parted = (
+        build_hal(open_robot_by_id("franka_panda"), mode="sim", scene=load_scene(scene))
+        for _ in range(2)
+    )
+    assert isinstance(whole, SimAttachedHAL) and isinstance(parted, SimAttachedHAL)
+    whole.connect()
+    parted.connect()
+    try:
+        assert parted.state_parts == 5  # 20 Hz actions, 100 Hz state on the tabletop
+        times = []
+        for offset in (0.3, -0.2, 0.1):
+            target = whole.hold_action()
+            target[0] += offset
+            whole.send_action(target)
+            assert parted.tick(target)
+            times.append(parted.read_state().sim_time_s)
+            for _ in range(parted.state_parts - 1):
+                assert parted.tick(None)
+                times.append(parted.read_state().sim_time_s)
+            np.testing.assert_array_equal(
+                parted.read_state().positions, whole.read_state().positions
+            )
+        steps = np.diff(np.asarray(times, dtype=np.float64))
+        np.testing.assert_allclose(steps, whole.control_period_s / parted.state_parts, atol=1e-9)
+    finally:
+        whole.disconnect()
+        parted.disconnect()

@@ -129,6 +129,10 @@ class SceneOptions(OpenralModel):
     """
     How often an action is applied [Hz], 1 to 2000; each env.step advances 1/control_freq_hz seconds of physics.
     """
+    state_rate_hz: Annotated[StrictFloat, Field(ge=1.0, le=1000.0)] = 100.0
+    """
+    How often the physics state advances and is published under `deploy sim` [Hz] (native only), 1 to 1000, at least control_freq_hz: each control period is stepped in parts of about 1/state_rate_hz (a whole number of physics steps that divides the period), and /joint_states, /tf, /odom and the TCP pose carry every part's new state, as a robot's driver does at its update rate. Actions keep control_freq_hz.
+    """
     horizon: Annotated[StrictInt | None, Field(ge=1, le=100000000)] = None
     """
     Steps after which an episode is truncated (robosuite); native scenes never end on their own.

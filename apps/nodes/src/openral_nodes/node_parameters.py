@@ -22,7 +22,7 @@ PARAMETERS: dict[str, Any] = {
     "sim_env_yaml": "",
     "viewer_enabled": True,
     "camera_publish_rate_hz": 0.0,
-    "joint_state_rate_hz": 50.0,
+    "joint_state_rate_hz": 100.0,
     "publish_tf": True,
     "view_port": 0,
     "transport": "",

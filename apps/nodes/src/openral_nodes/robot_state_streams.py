@@ -1,8 +1,9 @@
 """RobotStateStreams: what the manifest node publishes about the robot's own state.
 
 - ``/joint_states`` and ``/openral/manifest_joint_states``
-  (:class:`~openral_bridge.joint_state_publisher.JointStatePublisher`): at the joint-state
-  rate, or, for a real robot, once per reading of its driver (each a new stamp);
+  (:class:`~openral_bridge.joint_state_publisher.JointStatePublisher`): after every tick of
+  the control loop (a scene's state rate, a real driver's every reading: each a new stamp),
+  or at a slower joint-state rate;
 - ``/tf`` and ``/tf_static`` (:class:`~openral_bridge.tf_publisher.TfPublisher`; off with
   the ``publish_tf`` parameter) and the URDF on ``/robot_description``
   (:class:`~openral_bridge.description_publisher.DescriptionPublisher`), for a HAL with a
@@ -79,9 +80,8 @@ class RobotStateStreams:
         source: StateSource = HalStates(hal, lock)
         if loop is not None:
             source = TickStates(loop, tree.tree if tree else None, data, base)
-        self.each_tick = loop is not None and hal.is_real  # a reading per driver cycle
-        if self.each_tick and loop is not None:
-            rate_hz = 1.0 / loop.period_s
+        if loop is not None and hal.is_real:  # a reading per driver cycle
+            rate_hz = 1.0 / loop.tick_period_s
         self.states = JointStatePublisher(node, rate_hz, source)
         self.tf = None
         if publish_tf and tree is not None and data is not None:
@@ -101,7 +101,7 @@ class RobotStateStreams:
     def start(self, pacer: Pacer) -> None:
         """Publish the joint states and transforms once now, then on ``pacer``; start
         making the URDF."""
-        self.states.start(pacer, self.loop if self.each_tick else None)
+        self.states.start(pacer, self.loop)
         if self.tf is not None and self.loop is not None:
             self.tf.start(pacer, self.loop)
         for description in (self.description, self.semantic):

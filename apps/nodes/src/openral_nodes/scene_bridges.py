@@ -82,7 +82,7 @@ class SceneBridges:
             served |= self.state.served
         self.base = None
         if isinstance(hal, MobileBaseHal) and hal.base is not None:
-            self.base = BaseBridge(node, hal, odom_rate_hz, lock)
+            self.base = BaseBridge(node, hal, odom_rate_hz, lock, loop)
         self.ee = _ee_bridge(node, hal, loop, robot, odom_rate_hz, lock)
         self.sensors = SimSensorBridge(
             node,

@@ -8,8 +8,8 @@
   taken without them, with a throttled warning. A non-finite value, or a command while the
   E-stop is latched (the base is already halted), is refused with a throttled warning and
   changes nothing.
-- ``/odom`` (``nav_msgs/Odometry``) at the joint-state rate, a job of the node's
-  :class:`~openral_bridge.pacer.Pacer`: header frame ``odom_frame``,
+- ``/odom`` (``nav_msgs/Odometry``) after every control tick (or at a slower joint-state
+  rate, on the node's :class:`~openral_bridge.pacer.Pacer`): header frame ``odom_frame``,
   child frame ``base_frame`` (both from the manifest), pose in the odometry frame (where
   the base frame was at the last reset, REP 105), twist in the base frame, stamped in
   simulated time. The simulation knows the pose exactly, so the covariances are zero.
@@ -30,11 +30,14 @@ from openral_hal.protocol import MobileBaseHal
 from openral_sim.base_drive import BaseOdometry
 
 from openral_bridge import ros_messages
-from openral_bridge.pacer import PacedJob, Pacer
+from openral_bridge.paced_publishers import Cadence
+from openral_bridge.pacer import Pacer
 from openral_bridge.topics import CMD_VEL, ODOM, TopicInfo
 
 if TYPE_CHECKING:
     from rclpy.node import Node
+
+    from openral_bridge.control_loop import ControlLoop
 
 WARN_EVERY_S = 2.0
 """At most one warning per this many seconds for a stream of refused commands [s]."""
@@ -62,7 +65,12 @@ class BaseBridge:
     """``/cmd_vel`` subscription, ``/odom`` publisher and job of one mobile-base HAL."""
 
     def __init__(
-        self, node: Node, hal: MobileBaseHal, rate_hz: float, lock: threading.Lock
+        self,
+        node: Node,
+        hal: MobileBaseHal,
+        rate_hz: float,
+        lock: threading.Lock,
+        loop: ControlLoop | None = None,
     ) -> None:
         """Nothing is created until :meth:`start`.
 
@@ -71,17 +79,19 @@ class BaseBridge:
             hal: A connected HAL whose ``base`` is not None.
             rate_hz: ``/odom`` publish rate [Hz].
             lock: The HAL's lock, held for every call into it.
+            loop: The control loop: ``/odom`` goes out after each of its ticks when
+                ``rate_hz`` is as fast (each message a new state).
         """
         self.node = node
         self.hal = hal
         self.rate_hz = rate_hz
         self.lock = lock
+        self.loop = loop
         self.accepted = 0
         """Velocity commands taken (possibly clamped)."""
         self.refused = 0
         self._entities: list[tuple[str, Any]] = []
-        self._pacer: Pacer | None = None
-        self._job: PacedJob | None = None
+        self._cadence = Cadence()
 
     def topics(self) -> list[TopicInfo]:
         """What the bridge publishes (``/cmd_vel`` is subscribed, not listed)."""
@@ -100,15 +110,14 @@ class BaseBridge:
             ("subscription", self.node.create_subscription(Twist, CMD_VEL, self.on_cmd_vel, 10)),
         ]
         self.publish_odometry()
-        self._pacer = pacer
-        self._job = pacer.every(1.0 / self.rate_hz, self.publish_odometry, ODOM)
+        self.rate_hz = self._cadence.start(
+            pacer, self.rate_hz, self.publish_odometry, ODOM, self.loop
+        )
 
     def stop(self) -> None:
         """Cancel the job (it has finished when this returns) and destroy the publisher and
         subscription (idempotent)."""
-        if self._pacer is not None and self._job is not None:
-            self._pacer.cancel(self._job)
-        self._pacer = self._job = None
+        self._cadence.stop()
         destroy: dict[str, Callable[[Any], object]] = {
             "publisher": self.node.destroy_publisher,
             "subscription": self.node.destroy_subscription,

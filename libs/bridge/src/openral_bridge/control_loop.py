@@ -2,42 +2,40 @@
 
 A real arm's controller runs at its own rate whatever its clients do; this loop gives a
 simulated one the same behaviour. A job on the node's :class:`~openral_bridge.pacer.Pacer`
-(its thread for periodic work) runs once per control period (:attr:`Tickable.control_period_s`,
-the scene's ``control_freq_hz``) and each tick advances the scene by exactly one period:
+runs once per state period: a control period (:attr:`Tickable.control_period_s`, the
+scene's ``control_freq_hz``) stepped in :attr:`StateParted.state_parts
+<openral_hal.protocol.StateParted.state_parts>` equal parts (its ``state_rate_hz``), so the
+state is new at every tick. The first tick of a period starts it:
 
-- with the newest action that arrived since the last tick (:meth:`ControlLoop.offer`, from
-  any thread); an action replaced by a newer one before a tick, or dropped (by :meth:`stop`,
-  or because the E-stop latched before the tick), is counted in :attr:`superseded`, never
-  applied and never silently lost;
-- with no new action, holding what is commanded (:meth:`Tickable.tick` with None: the targets
-  in force on a position-controlled scene, the backend's hold on a delta controller);
-- with no new action while a joint trajectory runs (:attr:`ControlLoop.follower`), gliding
-  to the trajectory's point at the end of the period; an offered action pre-empts the
-  trajectory, and a tick the E-stop keeps from stepping aborts it;
-- else, with an end-effector target in force (:attr:`ControlLoop.ee`), gliding to the IK's
-  step towards it; an offered action, a trajectory, the E-stop and a reset end the target.
+- with the newest action offered since (:meth:`ControlLoop.offer`, any thread); one replaced
+  before a tick, or dropped (by :meth:`stop`, or the E-stop), is counted in
+  :attr:`superseded`, never applied and never silently lost;
+- else, while a joint trajectory runs (:attr:`ControlLoop.follower`), gliding to its point
+  at the period's end; an offered action pre-empts it, and a tick the E-stop keeps from
+  stepping aborts it;
+- else, with an end-effector target (:attr:`ControlLoop.ee`), gliding to the IK's step
+  towards it; an action, a trajectory, the E-stop and a reset end the target;
+- else holding what is commanded (:meth:`Tickable.tick` with None).
+
+The other ticks of a period step on with what it started with: an action offered meanwhile
+waits for the next period (actions keep the control rate).
 
 A reset (:meth:`ControlLoop.reset`, any thread) is carried out by the next tick instead of
-a step, so it never races one: the scene is reset, stepped once with its hold (as
-:meth:`ControlLoop.start` does) and ``on_reset`` runs on the loop's thread before any other
-periodic job, so sensors can publish the start state again.
+a step: the scene is reset, stepped once with its hold and ``on_reset`` runs on the loop's
+thread before any other periodic job, so sensors can publish the start state again.
 
-Malformed actions are refused where they arrive (the node validates them), so they never
-reach, delay or stop the loop. While the E-stop is latched the HAL does not advance (time
-freezes too). A tick that is late is not made up: the loop never runs faster than real
-time, and when the machine cannot keep up it says so once per slow spell with the measured
+Malformed actions are refused where they arrive (the node validates them). While the E-stop
+is latched the HAL does not advance (time freezes too). A late tick is not made up: the loop
+never runs faster than real time, and says so once per slow spell with the measured
 real-time factor (:class:`~openral_bridge.real_time.RealTimeWatch`).
 
-Threads: a tick steps the HAL while holding ``lock``, the lock every other user of the HAL
-takes (the node's E-stop services, the joint-state and camera jobs), so nothing reads or
-changes the scene in the middle of a step. :meth:`offer` takes a lock of its own and never
-waits for a tick.
+Threads: a tick steps the HAL holding ``lock``, the lock every other user of the HAL takes,
+so nothing reads or changes the scene mid-step. :meth:`offer` never waits for a tick.
 
-A real robot is driven, not ticked: its driver's own loop calls :meth:`ControlLoop.tick`
-after each reading (:meth:`ControlLoop.start_driven`, through
-:class:`~openral_bridge.real_cadence.RealCadence`). Its state goes on changing while the
-E-stop is latched, so each such tick still reads it (and runs the readers and watchers),
-but applies nothing and aborts a trajectory in flight.
+A real robot is driven, not ticked: its driver's loop calls :meth:`ControlLoop.tick` after
+each reading (:meth:`ControlLoop.start_driven`, through
+:class:`~openral_bridge.real_cadence.RealCadence`). While its E-stop is latched each tick
+still reads it (and runs the readers and watchers), applies nothing and aborts a trajectory.
 
 This replaces the design record's idle stepper, which stepped only while nobody commanded
 the scene and at the camera rate (so simulated time ran at the camera rate's pace).
@@ -48,10 +46,11 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
-from openral_hal.protocol import Tickable
+from openral_hal.protocol import StateParted, Tickable
 from openral_mujoco.state import FloatArray, JointStateSample
 
 from openral_bridge.pacer import PacedJob, Pacer
@@ -89,17 +88,17 @@ class ResetFailed(RuntimeError):
     """A reset was not carried out (the loop stopped, timed out, or the HAL raised)."""
 
 
+@dataclass
 class _ResetRequest:
     """One reset handed to the loop's thread, and its outcome."""
 
-    def __init__(self) -> None:
-        self.done = threading.Event()
-        self.text = ""
-        self.error: str | None = None
+    done: threading.Event = field(default_factory=threading.Event)
+    text: str = ""
+    error: str | None = None
 
 
 class ControlLoop:
-    """Steps one :class:`Tickable` HAL once per control period on a :class:`Pacer`."""
+    """Steps one :class:`Tickable` HAL once per state period on a :class:`Pacer`."""
 
     def __init__(
         self,
@@ -117,23 +116,25 @@ class ControlLoop:
         Args:
             node: The node whose logger reports.
             hal: A connected simulated HAL.
-            on_tick: Called after every tick that advanced the scene with its simulated
-                time [s] (None for a HAL without one), e.g. to publish ``/clock``; the HAL
-                lock is not held.
-            lock: The HAL's lock, held while a tick steps and reads it (default: a lock of
-                the loop's own).
+            on_tick: Called after every tick that stepped with its simulated time [s]
+                (None for a HAL without one), e.g. to publish ``/clock``.
+            lock: The HAL's lock, held while a tick steps and reads it (default: own).
             follower: The joint trajectories to follow (None: this loop follows none).
             on_sample: Called with the desired point after each tick that followed a
-                trajectory (the HAL lock is not held).
-            on_reset: Called on the loop's thread right after a reset's tick (the HAL lock
-                is not held).
+                trajectory.
+            on_reset: Called on the loop's thread right after a reset's tick. The HAL lock
+                is not held during these three.
         """
         self.node, self.hal, self.on_tick = node, hal, on_tick
         self.lock = lock if lock is not None else threading.Lock()
         self.period_s = float(hal.control_period_s)
+        """The control period: actions, trajectory samples and ee steps at its start [s]."""
+        self.parts = hal.state_parts if isinstance(hal, StateParted) else 1
+        self.tick_period_s = self.period_s / self.parts
+        """Simulated time one tick advances: the state period [s]."""
+        self._phase = 0  # ticks of the current control period stepped, modulo parts
         self.ticks = self.applied = self.superseded = self.failed = 0
-        """Ticks that advanced the scene; actions applied by a tick; actions replaced by a
-        newer one, or dropped, before any tick applied them; ticks that raised."""
+        """Ticks that stepped; actions applied; superseded (see above); ticks that raised."""
         self.watch = RealTimeWatch()
         self.state: JointStateSample | None = None
         """The HAL's state right after the last tick that stepped (read holding the lock);
@@ -142,8 +143,7 @@ class ControlLoop:
         self.followed = 0
         """Ticks that glided along a trajectory or towards an end-effector target."""
         self.ee: Following | None = None
-        """The end-effector target (wired by :mod:`openral_bridge.ee_bridge`); its points
-        go to :attr:`on_ee_sample`."""
+        """The end-effector target (:mod:`openral_bridge.ee_bridge`), to :attr:`on_ee_sample`."""
         self.on_ee_sample: Callable[[DesiredPoint], None] | None = None
         self.watchers: list[Callable[[JointStateSample], None]] = []
         """Called in order with the state after every tick that stepped the scene (the HAL
@@ -165,11 +165,11 @@ class ControlLoop:
 
     def start(self, pacer: Pacer) -> None:
         """Tick once now (so simulated time has advanced before anything is published),
-        then once per control period on ``pacer``."""
+        then once per state period on ``pacer``."""
         self.stop()
         self.watch.restart()
         self.tick()
-        self._job = (pacer, pacer.every(self.period_s, self.tick, "control"))
+        self._job = (pacer, pacer.every(self.tick_period_s, self.tick, "control"))
 
     def start_driven(self, drive: Drive) -> None:
         """Tick once now, then whenever the robot's driver calls back: ``drive(tick)``
@@ -250,8 +250,11 @@ class ControlLoop:
     def tick(self) -> None:
         """Advance the scene one control period (see the module doc); a HAL error is
         counted and logged, never raised (``on_tick``'s own errors are)."""
+        starts = self._phase == 0  # a control period starts: actions and samples are taken
         with self._pending_lock:
-            action, self._pending = self._pending, None
+            action = None
+            if starts:
+                action, self._pending = self._pending, None
             reset, self._reset = self._reset, None
         if reset is not None:
             self._carry_out(reset)
@@ -264,9 +267,11 @@ class ControlLoop:
                 dropped = action if held else None
                 if held:
                     action = None
-                elif action is None:
+                elif action is None and starts:
                     action, sample, toward_ee = self._follow_step()
                 stepped = self.hal.tick(action, glide=sample is not None)
+                if stepped:
+                    self._phase = (self._phase + 1) % self.parts
                 state = self.hal.read_state() if stepped else self.state
                 self.state = state
                 if stepped:
@@ -339,6 +344,7 @@ class ControlLoop:
                     self.ee.cancel("the scene was reset")
                 request.text = self.hal.reset()
                 stepped = self.hal.tick(None)
+                self._phase = 1 % self.parts if stepped else 0  # it started a period
                 self.state = self.hal.read_state() if stepped else None
                 if stepped:
                     self._read()
@@ -378,7 +384,7 @@ class ControlLoop:
             self._log().warning(
                 f"the simulation runs at {factor:.2f}x real time over the last "
                 f"{self.watch.window_s:g} s: this machine cannot keep up with the "
-                f"{1.0 / self.period_s:g} Hz control loop"
+                f"{1.0 / self.tick_period_s:g} Hz control loop"
             )
 
     def _failed(self, error: Exception) -> None:

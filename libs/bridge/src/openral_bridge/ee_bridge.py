@@ -11,7 +11,7 @@
 - ``/openral/ee_target/state`` (``sensor_msgs/JointState``): the arm's targets of each
   tick's IK step (and their speed), stamped in simulated time, while a target is followed.
 - ``/openral/tcp_pose`` (``geometry_msgs/PoseStamped``): the TCP's pose in the base frame,
-  stamped in simulated time, at the joint-state rate (a job of the node's pacer).
+  stamped in simulated time, after every control tick (or at a slower joint-state rate).
 
 Every call into the HAL holds ``lock`` (the node's HAL lock).
 """
@@ -28,7 +28,8 @@ from openral_sim.ee_modes import EeCommand
 from openral_bridge import ros_messages
 from openral_bridge.control_loop import ControlLoop
 from openral_bridge.ee_target import EeTargetFollower, EeTargetRefused, checked_pose
-from openral_bridge.pacer import PacedJob, Pacer
+from openral_bridge.paced_publishers import Cadence
+from openral_bridge.pacer import Pacer
 from openral_bridge.topics import (
     EE_TARGET,
     EE_TARGET_REFUSED,
@@ -85,7 +86,7 @@ class EeBridge:
         self.follower = EeTargetFollower(hal, ee)
         self.refused = 0
         self._entities: list[tuple[str, Any]] = []
-        self._job: tuple[Pacer, PacedJob] | None = None
+        self._cadence = Cadence()
 
     def topics(self) -> list[TopicInfo]:
         """What the bridge publishes (the target topic is subscribed, not listed)."""
@@ -119,17 +120,16 @@ class EeBridge:
         ]
         self.loop.ee, self.loop.on_ee_sample = self.follower, self.publish_state
         self.publish_tcp()
-        self._job = (pacer, pacer.every(1.0 / self.rate_hz, self.publish_tcp, TCP_POSE))
+        self.rate_hz = self._cadence.start(
+            pacer, self.rate_hz, self.publish_tcp, TCP_POSE, self.loop
+        )
 
     def stop(self) -> None:
         """Unwire the follower, cancel the job and destroy the entities (idempotent)."""
         if self.loop.ee is self.follower:
             self.follower.cancel("the bridge stopped")
             self.loop.ee, self.loop.on_ee_sample = None, None
-        if self._job is not None:
-            pacer, job = self._job
-            self._job = None
-            pacer.cancel(job)
+        self._cadence.stop()
         for kind, entity in reversed(self._entities):
             if kind == "publisher":
                 self.node.destroy_publisher(entity)

@@ -1,5 +1,5 @@
-"""JointStatePublisher: ``/joint_states`` and ``/openral/manifest_joint_states`` at a fixed
-rate, from a pacer job.
+"""JointStatePublisher: ``/joint_states`` and ``/openral/manifest_joint_states`` after every
+control tick (or at a slower fixed rate, from a pacer job).
 
 Two views of the same instant, both stamped in simulated time (the node clock for a HAL
 without one):
@@ -16,11 +16,10 @@ both.
 
 Where a reading comes from (a :class:`StateSource`):
 
-- :class:`TickStates`: a simulated scene changes only when the control loop ticks, so the
-  loop copies both views right after each tick, holding the HAL's lock
-  (:attr:`~openral_bridge.control_loop.ControlLoop.readers`); the publisher builds the
-  messages once per tick and sends them until the next (at 50 Hz over a 20 Hz loop each
-  state goes out 2-3 times, as reading the HAL each time would send it);
+- :class:`TickStates`: a simulated scene changes only when the control loop ticks (at the
+  scene's state rate), so the loop copies both views right after each tick, holding the
+  HAL's lock (:attr:`~openral_bridge.control_loop.ControlLoop.readers`), and the publisher
+  sends them after that tick: every message a new state and a new stamp;
 - :class:`HalStates`: a HAL without a control loop is read, holding its lock, at every
   publication.
 """
@@ -155,11 +154,12 @@ class JointStatePublisher:
         """Readings published since :meth:`start`."""
         self._out = PacedPublishers(node)
         self._messages: tuple[StateReading, Any, Any] | None = None
-        self._ticks: ControlLoop | None = None
 
-    def start(self, pacer: Pacer, each_tick_of: ControlLoop | None = None) -> None:
-        """Create the publishers, publish once, then once per period on ``pacer`` (or after
-        every tick of ``each_tick_of``: a real robot's every reading, freshly stamped)."""
+    def start(self, pacer: Pacer, loop: ControlLoop | None = None) -> None:
+        """Create the publishers, publish once, then at :attr:`rate_hz` on ``pacer``, or after
+        every tick of ``loop`` when that is as often (each a new state, freshly stamped:
+        :class:`~openral_bridge.paced_publishers.Cadence`); :attr:`rate_hz` becomes the
+        rate it runs at."""
         self.stop()
         node = self.node
         self._out.open(
@@ -168,23 +168,14 @@ class JointStatePublisher:
         )
         self.published = 0
         self.publish()
-        if each_tick_of is not None:
-            self._ticks = each_tick_of
-            each_tick_of.watchers.append(self._after_tick)
-        else:
-            self._out.schedule(pacer, 1.0 / self.rate_hz, self.publish, "joint_states")
+        self.rate_hz = self._out.schedule(
+            pacer, 1.0 / self.rate_hz, self.publish, "joint_states", loop
+        )
 
     def stop(self) -> None:
         """Unschedule the job and destroy the publishers (idempotent)."""
-        if self._ticks is not None:
-            ticks, self._ticks = self._ticks, None
-            if self._after_tick in ticks.watchers:
-                ticks.watchers.remove(self._after_tick)
         self._out.close()
         self._messages = None
-
-    def _after_tick(self, state: JointStateSample) -> None:
-        self.publish()
 
     def publish(self) -> None:
         """Publish the newest reading."""

@@ -69,7 +69,8 @@ class TfPublisher:
 
     def start(self, pacer: Pacer, loop: ControlLoop) -> None:
         """Capture after every tick of ``loop``, publish the static transforms and the
-        dynamic ones once now, then ``/tf`` at :attr:`rate_hz` on ``pacer``."""
+        dynamic ones once now, then ``/tf`` at :attr:`rate_hz` on ``pacer`` (after every tick
+        when that is as often)."""
         self.stop()
         node = self.node
         self._out.open(
@@ -77,10 +78,10 @@ class TfPublisher:
             node.create_publisher(TFMessage, TF_STATIC, TF_STATIC_QOS),
         )
         loop.add_reader(self.capture)
-        self._tick_hz = 1.0 / loop.period_s
+        self._tick_hz = 1.0 / loop.tick_period_s
         self.publish_static()
         self.publish()
-        self._out.schedule(pacer, 1.0 / self.rate_hz, self.publish, "tf")
+        self._out.schedule(pacer, 1.0 / self.rate_hz, self.publish, "tf", loop)
 
     def stop(self) -> None:
         """Unschedule the job and destroy the publishers (idempotent)."""

@@ -153,6 +153,18 @@ class Tickable(RobotHal, Protocol):
 
 
 @runtime_checkable
+class StateParted(Protocol):
+    """A tickable HAL whose :meth:`Tickable.tick` advances one of ``state_parts`` equal parts
+    of a control period (a native scene at its ``state_rate_hz``): an action starts a new
+    period; a tick with None steps the next part of the period in force."""
+
+    @property
+    def state_parts(self) -> int:
+        """Ticks per control period (1: a tick is a whole period)."""
+        ...
+
+
+@runtime_checkable
 class MujocoBacked(Protocol):
     """A HAL whose robot lives in a MuJoCo model it can hand out."""
 

@@ -1,16 +1,14 @@
 """SimAttachedHAL: a HAL that drives a scene it does not own the physics of.
 
 Under ``deploy sim`` with a scene file, the scene backend (a :class:`SimRollout`) owns
-physics and pixels; this HAL is the robot-side view of it. Every action is one ``env.step``
-and camera frames come from the last observation. A native scene drives its robot by the
-manifest's contract (:class:`~openral_sim.rollout.ManifestRollout`): then the action is one
-value per manifest joint and the joint state is the scene's own, in manifest units. Another
-backend (robosuite) keeps its controller's action; its joint state is read from the MuJoCo
-data by joint name (or from ``obs.joints`` for a non-MuJoCo backend).
-The deploy control loop advances the scene one step per control period with
-:meth:`SimAttachedHAL.tick`, which exists only on simulated HALs. A robot on a mobile base
-in a native scene also takes base velocity commands (:meth:`SimAttachedHAL.command_base`,
-refused while E-stopped; the E-stop halts the base) and reports odometry.
+physics and pixels; this HAL is the robot-side view of it: an action is one ``env.step``,
+camera frames come from the last observation. A native scene drives its robot by the
+manifest's contract (:class:`~openral_sim.rollout.ManifestRollout`: one value per manifest
+joint, its own joint state in manifest units); robosuite keeps its controller's action and
+its joint state is read from the MuJoCo data by joint name. The deploy control loop
+advances the scene with :meth:`SimAttachedHAL.tick` (one state period: a part of a step on a
+native scene). A mobile base in a native scene also takes velocity commands
+(:meth:`SimAttachedHAL.command_base`, refused while E-stopped) and reports odometry.
 """
 
 from __future__ import annotations
@@ -262,14 +260,19 @@ class SimAttachedHAL(AttachedSensors, EStopLatch):
         """Simulated time one scene step advances [s]."""
         return self.env.control_period_s
 
-    def tick(self, action: object | None, *, glide: bool = False) -> bool:
-        """One scene step: with ``action`` (see :meth:`send_action`; ``glide`` as
-        :meth:`Tickable.tick <openral_hal.protocol.Tickable.tick>` says, on a native scene),
-        or with :meth:`hold_action` when None (the targets in force on a position-controlled
-        scene, the backend's hold on a delta controller); the commanded action is kept.
+    @property
+    def state_parts(self) -> int:
+        """Parts of a control period one :meth:`tick` steps (a native scene's state rate;
+        1 for another backend)."""
+        return self._scene.parts if self._scene is not None else 1
 
-        Returns:
-            True when the scene stepped; False (nothing done) while E-stopped.
+    def tick(self, action: object | None, *, glide: bool = False) -> bool:
+        """One of :attr:`state_parts` parts of a scene step: ``action`` starts a new step
+        with it (see :meth:`send_action`; ``glide`` as :meth:`Tickable.tick
+        <openral_hal.protocol.Tickable.tick>` says, on a native scene); None steps the next
+        part, or starts a step with :meth:`hold_action` (the targets in force on a
+        position-controlled scene, the backend's hold on a delta controller). Returns True
+        when the scene stepped, False (nothing done) while E-stopped.
 
         Raises:
             ActionRejected: ``action`` is malformed; nothing is changed.
@@ -278,10 +281,13 @@ class SimAttachedHAL(AttachedSensors, EStopLatch):
         if self._estopped:
             return False
         if action is not None:
-            self._command(action, glide=glide)
+            self._command(action, glide=glide, part=True)
             return True
         self._reset_if_done()
-        self._step(self.hold_action())
+        if self._scene is not None:
+            self._stepped(self._scene.step_part(None))
+        else:
+            self._step(self.hold_action())
         return True
 
     def reset(self) -> str:
@@ -358,7 +364,7 @@ class SimAttachedHAL(AttachedSensors, EStopLatch):
             self._observed(self.env.reset(seed=self.env_reset_seed))
             self._outcome = Outcome()
 
-    def _command(self, action: object, *, glide: bool) -> None:
+    def _command(self, action: object, *, glide: bool, part: bool = False) -> None:
         """Validate everything first (a refused action changes nothing), then step."""
         self._require_obs()
         joints, twist = split_action(action, self._action_names, self.hold_action, self._gripper)
@@ -369,16 +375,21 @@ class SimAttachedHAL(AttachedSensors, EStopLatch):
         if base is not None and twist is not None:
             base.command(twist.vx_m_s, twist.vy_m_s, twist.wz_rad_s)
         self._last_env_action = self.merge(values)
-        self._step(self._last_env_action.copy(), glide=glide)
+        self._step(self._last_env_action.copy(), glide=glide, part=part)
 
-    def _step(self, action: npt.NDArray[Any], *, glide: bool = False) -> StepResult:
-        if glide and self._manifest_env is not None:
+    def _step(self, action: npt.NDArray[Any], *, glide: bool = False, part: bool = False) -> None:
+        """One scene step with ``action`` (``part``: its first part only, on a native scene)."""
+        if part and self._scene is not None:
+            result = self._scene.step_part(action, glide=glide)
+        elif glide and self._manifest_env is not None:
             result = self._manifest_env.step(action, glide=True)
         else:
             result = self.env.step(action)
+        self._stepped(result)
+
+    def _stepped(self, result: StepResult) -> None:
         self._observed(result.obs)
         self._outcome = result.outcome
-        return result
 
     def _slot_names(self, width: int) -> tuple[str, ...]:
         if isinstance(self.env, HoldingRollout) and len(self.env.action_names) == width:

@@ -1,30 +1,22 @@
 """The native scene backend: any manifest's robot composed into a tabletop with MjSpec.
 
 The scene adds a floor, lights, optionally a table and a pedestal, the objects the scene file
-lists, and a camera for every manifest camera sensor the scene file names (composed as
-:mod:`openral_sim.scene_compose` says, cameras placed as :mod:`openral_sim.scene_cameras`
-says). Before composing, the manifest is checked against the robot's own model; every fault
-of the scene file or the manifest is reported at its field's line and column.
+lists, and a camera per manifest camera sensor it names (:mod:`openral_sim.scene_compose`,
+:mod:`openral_sim.scene_cameras`); every fault of the scene file or the manifest is reported
+at its field's line and column. The robot is driven by ``MujocoArmHAL``'s
+:class:`~openral_mujoco.joint_driver.JointDriver` (one value per manifest joint in manifest
+units, clamped and slewed by the manifest's limits); only the addresses differ.
 
-The robot is driven by the same :class:`~openral_mujoco.joint_driver.JointDriver` as
-``MujocoArmHAL``: an action is one value per manifest joint in manifest units (positions,
-gripper commands of their write mode), clamped to the manifest's limits and slewed by its
-velocity limits; the joint state is read in the same units. Only the addresses differ: the
-robot's joints are found in the composed model by name.
+A robot with a ``mobile_base`` rides its base (:mod:`openral_sim.scene_base`):
+:attr:`NativeScene.base` takes velocity commands and reads odometry, updated every
+:data:`~openral_sim.base_drive.BASE_UPDATE_STEPS` physics steps; it is no slot of the action.
 
-A robot with a ``mobile_base`` rides its base (composed by :mod:`openral_sim.scene_base`);
-:attr:`NativeScene.base` (a :class:`~openral_sim.base_drive.BaseDrive`, None for a fixed
-robot) takes velocity commands and reads odometry, and :meth:`NativeScene.step` updates it
-every :data:`~openral_sim.base_drive.BASE_UPDATE_STEPS` physics steps. The base is no slot
-of the action: the arm's contract stays exactly the robot's own.
-
-Every ``reset``/``step`` returns a typed :class:`~openral_sim.observation.Observation`:
-the joint sample, the base's odometry, the objects' poses, and the frames of the sensors
-due at that instant (:mod:`openral_sim.sensor_schedule`: each at its manifest rate, capped
-at the control rate). With ``render_observations`` off no frame is made (``deploy sim``
-renders snapshots on threads of its own through :attr:`NativeScene.sensors`, the scene's
-:mod:`sensor sources <openral_sim.sensor_sources>`); :attr:`NativeScene.observed` narrows
-the frames to the sensors a caller reads (a sweep: its policy's cameras and its video).
+``reset``/``step`` return an :class:`~openral_sim.observation.Observation` (joints, odometry,
+objects' poses, frames of the sensors due: :mod:`openral_sim.sensor_schedule`). ``step``
+advances one control period; :meth:`NativeScene.step_part` steps it in parts at the scene's
+``state_rate_hz`` (``deploy sim``'s fresh state). With ``render_observations`` off no frame
+is made (``deploy sim`` renders on threads of its own through :attr:`NativeScene.sensors`);
+:attr:`NativeScene.observed` narrows the frames to the sensors a caller reads.
 """
 
 from __future__ import annotations
@@ -53,9 +45,13 @@ from openral_sim.observation import Observation, Outcome, StepResult
 from openral_sim.randomization import Randomizer
 from openral_sim.range_sensors import RangeSensors
 from openral_sim.scene_cameras import camera_sensors
-from openral_sim.scene_checks import physics_steps_per_control
-from openral_sim.scene_compose import BASE_WELD, compose
-from openral_sim.scene_geometry import place_floating_base
+from openral_sim.scene_checks import physics_steps_per_control, state_parts_per_control
+from openral_sim.scene_compose import compose
+from openral_sim.scene_geometry import (
+    hold_base_where_it_is,
+    object_poses,
+    place_floating_base,
+)
 from openral_sim.scene_sensors import SceneSensors
 from openral_sim.success import SuccessCheck
 
@@ -109,6 +105,10 @@ class NativeScene:
         self._height = scene.scene.observation.height
         options = scene.scene.options
         self.substeps = physics_steps_per_control(scene, self.model.opt.timestep)
+        self.parts = state_parts_per_control(scene, self.substeps, self.model.opt.timestep)
+        """Parts of a control period :meth:`step_part` steps (``options.state_rate_hz``)."""
+        self._part = self.parts  # parts of the current period stepped (all: it has ended)
+        self._outcome = Outcome()
         self.horizon = options.horizon if options and options.horizon else None
         self.render_observations = render_observations
         """Whether observations carry sensor frames; may be changed at any time."""
@@ -256,14 +256,14 @@ class NativeScene:
             self._place_floating_base()
         self.randomizer.apply(self.data, seed, self._arm_qpos)
         self.success.reset()
-        self._hold_base_where_it_is()
+        hold_base_where_it_is(self.model, self.data, self._root_body)
         self.driver.start(self.model, self.data)
         if self.base is not None:
             self.base.reset()
         self._advance(self.wiring.settle_steps_default)
         if self.base is not None:  # the odometry frame: where the base settled, exactly
             self.base.reset()
-        self._steps = 0
+        self._steps, self._part, self._outcome = 0, self.parts, Outcome()
         self.sensors.schedule.restart()
         return self._observe()
 
@@ -282,11 +282,38 @@ class NativeScene:
         glide_s = self.control_period_s if glide else None
         self.driver.command(action, self.data, glide_s=glide_s)
         self._advance(self.substeps)
+        self._part = self.parts
+        return StepResult(self._observe(), self._period_ended())
+
+    def step_part(self, action: FloatArray | None, *, glide: bool = False) -> StepResult:
+        """One of the :attr:`parts` of a control period (they step it exactly as
+        :meth:`step` does): ``action`` starts a new period with it (``glide`` as in
+        :meth:`step`); None steps the next part of the period in force, or, once it has
+        ended, starts the next one with the targets in force. The outcome is updated when a
+        period ends.
+
+        Raises:
+            ActionRejected: As :meth:`step`; nothing is changed.
+            SimulationDiverged: As :meth:`step`.
+        """
+        if action is not None or self._part >= self.parts:
+            held = action is None
+            command = self.hold_action() if held else action
+            glide_s = self.control_period_s if glide and not held else None
+            self.driver.command(command, self.data, glide_s=glide_s)
+            self._part = 0
+        self._advance(self.substeps // self.parts)
+        self._part += 1
+        ended = self._part == self.parts
+        return StepResult(self._observe(), self._period_ended() if ended else self._outcome)
+
+    def _period_ended(self) -> Outcome:
+        """Count a control period and judge the episode (success, horizon)."""
         self._steps += 1
         success = self.success.update(self.data, self.control_period_s)
         truncated = self.horizon is not None and self._steps >= self.horizon
-        outcome = Outcome(success=success, truncated=truncated, steps=self._steps)
-        return StepResult(self._observe(), outcome)
+        self._outcome = Outcome(success=success, truncated=truncated, steps=self._steps)
+        return self._outcome
 
     def joint_state(self) -> JointStateSample:
         """Every manifest joint, in manifest order and units (as ``MujocoArmHAL`` reports)."""
@@ -345,16 +372,8 @@ class NativeScene:
             scans=scans,
             readings=readings,
             odometry=self.base.odometry() if self.base is not None else None,
-            task_state=self._object_poses(),
+            task_state=object_poses(self.data, self._objects),
         )
-
-    def _object_poses(self) -> dict[str, FloatArray]:
-        """``<object>_pos`` [m] and ``<object>_quat`` (w, x, y, z) of every scene object."""
-        state: dict[str, FloatArray] = {}
-        for name, body in self._objects.items():
-            state[f"{name}_pos"] = self.data.xpos[body].copy()
-            state[f"{name}_quat"] = self.data.xquat[body].copy()
-        return state
 
     def _advance(self, steps: int) -> None:
         """``steps`` physics steps; a mobile base's drive is updated before every
@@ -374,22 +393,6 @@ class NativeScene:
         # that /tf, cameras, lidars and sensors show the instant they are stamped with
         # (15 us on the Panda; the trajectory is bit for bit the same).
         mujoco.mj_forward(model, data)
-
-    def _hold_base_where_it_is(self) -> None:
-        """Aim the base weld (if any) at the root body's pose now: relpose is the world's
-        pose in the root body's frame."""
-        weld = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_EQUALITY, BASE_WELD)
-        if weld < 0:
-            return
-        mujoco.mj_kinematics(self.model, self.data)
-        body = self._root_body
-        inverse = np.empty(4)
-        mujoco.mju_negQuat(inverse, self.data.xquat[body])
-        position = np.empty(3)
-        mujoco.mju_rotVecQuat(position, -self.data.xpos[body], inverse)
-        self.model.eq_data[weld, 0:3] = 0.0
-        self.model.eq_data[weld, 3:6] = position
-        self.model.eq_data[weld, 6:10] = inverse
 
     def _place_floating_base(self) -> None:
         """Keyframe free-joint poses are world poses: move them to the scene's base pose

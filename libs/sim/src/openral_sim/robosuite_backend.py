@@ -51,7 +51,7 @@ from openral_sim.gl_guard import claim_gl
 from openral_sim.observation import Observation, Outcome, StepResult
 from openral_sim.sensor_schedule import SensorSchedule, sensor_rates
 
-_NATIVE_ONLY_OPTIONS = ("table_height_m", "objects")
+_NATIVE_ONLY_OPTIONS = ("table_height_m", "objects", "state_rate_hz")
 
 
 class RobosuiteError(OpenralError):
@@ -338,8 +338,8 @@ def _check_scene_options(scene: DeployScene) -> None:
     """Refuse native-only options, an unknown controller and a base pose (located)."""
     options = scene.scene.options
     if options is not None:
-        for key in _NATIVE_ONLY_OPTIONS:
-            if getattr(options, key) is not None:
+        for key in _NATIVE_ONLY_OPTIONS:  # given in the file (a default is not)
+            if key in options.model_fields_set:
                 message = "applies to the native backend only"
                 raise error_at(scene, ("scene", "options", key), message)
         controller = options.controller

@@ -136,6 +136,15 @@ class SceneRollout(ManifestRollout, Protocol):
     """Steps per episode (None: none)."""
     addresses: RobotAddresses
     """Where the robot's joints are in the scene's model, per manifest joint."""
+    parts: int
+    """Parts of a control period ``step_part`` steps (the scene's state rate)."""
+
+    def step_part(
+        self, action: npt.NDArray[np.floating[Any]] | None, *, glide: bool = False
+    ) -> StepResult:
+        """One part of a control period: ``action`` starts a new period with it; None steps
+        the next part of the period in force (after its end: a new one, holding)."""
+        ...
 
     def frames(self) -> FrameTree:
         """The TF frames of the robot and of the sensors it serves, laid out once.

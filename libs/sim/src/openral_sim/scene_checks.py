@@ -86,3 +86,26 @@ def check_scene_cameras(scene: DeployScene, robot: RobotDescription) -> None:
                 f"{', '.join(known) or '(none)'}"
             )
             raise error_at(scene, ("scene", "cameras", index), message)
+
+
+def state_parts_per_control(scene: DeployScene, substeps: int, timestep_s: float) -> int:
+    """In how many equal parts a control period of ``substeps`` physics steps of
+    ``timestep_s`` [s] is stepped, so the state advances at about ``options.state_rate_hz``:
+    the divisor of ``substeps`` nearest the asked rate (ties: the faster).
+
+    Raises:
+        ManifestError: At ``scene.options.state_rate_hz`` when it is slower than the control
+            rate (rule 7 of the scene schema).
+    """
+    options = scene.scene.options
+    state_hz = options.state_rate_hz if options else 100.0
+    control_hz = 1.0 / (substeps * timestep_s)
+    if state_hz < control_hz * (1.0 - 1e-9):
+        message = (
+            f"{state_hz:g} Hz is slower than the control rate ({control_hz:g} Hz); the state "
+            f"advances at least once per action: use at least {control_hz:g} Hz"
+        )
+        raise error_at(scene, ("scene", "options", "state_rate_hz"), message)
+    wanted = state_hz / control_hz
+    divisors = [n for n in range(1, substeps + 1) if substeps % n == 0]
+    return min(divisors, key=lambda n: (abs(n - wanted), -n))

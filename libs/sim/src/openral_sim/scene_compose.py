@@ -42,13 +42,11 @@ from openral_sim.scene_base import (
 )
 from openral_sim.scene_cameras import add_fixed_cameras, add_mounted_cameras, rotate_about_z
 from openral_sim.scene_checks import check_object_names, check_weld
-from openral_sim.scene_geometry import lowest_static_point, yaw_quat
+from openral_sim.scene_geometry import BASE_WELD, lowest_static_point, yaw_quat
 from openral_sim.scene_lighting import add_scene_lights, balance_lights
 from openral_sim.state_sensors import add_state_sensors
 
 DEFAULT_TABLE_HEIGHT_M = 0.75
-BASE_WELD = "scene_base_weld"
-"""Name of the equality constraint that holds a welded floating base."""
 PHYSICS_OPTIONS = tuple(key for key in dir(mujoco.MjSpec().option) if not key.startswith("_"))
 """Every ``<option>`` of MjSpec (timestep, integrator, solver, tolerances, gravity, flags…)."""
 

@@ -16,6 +16,9 @@ from openral_core.models import BasePose, RobotDescription
 from openral_mujoco.robot_bodies import root_body
 from openral_mujoco.start_pose import set_start_pose
 
+BASE_WELD = "scene_base_weld"
+"""Name of the equality constraint that holds a welded floating base."""
+
 CORNERS = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
 """The eight corners of a box of half-size 1."""
 
@@ -77,3 +80,29 @@ def place_floating_base(data: mujoco.MjData, free: int, pose: BasePose | None) -
 def yaw_quat(yaw: float) -> npt.NDArray[np.float64]:
     """The quaternion (w, x, y, z) of a turn by ``yaw`` [rad] about the world z axis."""
     return np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
+
+
+def hold_base_where_it_is(model: mujoco.MjModel, data: mujoco.MjData, root: int) -> None:
+    """Aim the base weld (if any) at body ``root``'s pose now: relpose is the world's pose
+    in the root body's frame."""
+    weld = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_EQUALITY, BASE_WELD)
+    if weld < 0:
+        return
+    mujoco.mj_kinematics(model, data)
+    inverse = np.empty(4)
+    mujoco.mju_negQuat(inverse, data.xquat[root])
+    position = np.empty(3)
+    mujoco.mju_rotVecQuat(position, -data.xpos[root], inverse)
+    model.eq_data[weld, 0:3] = 0.0
+    model.eq_data[weld, 3:6] = position
+    model.eq_data[weld, 6:10] = inverse
+
+
+def object_poses(data: mujoco.MjData, bodies: dict[str, int]) -> dict[str, npt.NDArray[np.float64]]:
+    """``<object>_pos`` [m] and ``<object>_quat`` (w, x, y, z) of every scene object, by its
+    body id in ``bodies``."""
+    state: dict[str, npt.NDArray[np.float64]] = {}
+    for name, body in bodies.items():
+        state[f"{name}_pos"] = data.xpos[body].copy()
+        state[f"{name}_quat"] = data.xquat[body].copy()
+    return state

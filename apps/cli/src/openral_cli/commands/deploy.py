@@ -92,8 +92,14 @@ def sim(
     ] = None,
     joint_state_rate: Annotated[
         float,
-        typer.Option("--joint-state-rate", min=0.1, max=1000.0, help="/joint_states rate [Hz]."),
-    ] = 50.0,
+        typer.Option(
+            "--joint-state-rate",
+            min=0.1,
+            max=1000.0,
+            help="/joint_states, /tf, /odom rate [Hz]; at or above the scene's state_rate_hz "
+            "every new state goes out once.",
+        ),
+    ] = 100.0,
     no_tf: NoTf = False,
     duration: Duration = None,
     domain_id: DomainId = None,
