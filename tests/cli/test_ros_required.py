@@ -19,6 +19,9 @@ SCENE = str(ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml")
     [
         ["deploy", "sim", "--config", SCENE, "--no-viewer"],
         ["ros", "topics"],
+        ["ros", "services"],
+        ["ros", "actions"],
+        ["ros", "nodes", "--all"],
         ["ros", "echo", "/joint_states", "--once"],
         ["ros", "snapshot", "/openral/cameras/agentview/image", "--out", "x.png"],
         ["rskill", "run", "--robot", "franka_panda"],

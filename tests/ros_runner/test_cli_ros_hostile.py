@@ -12,7 +12,7 @@ from pathlib import Path
 from types import ModuleType
 
 import pytest
-from action_msgs.msg import GoalStatusArray
+from control_msgs.action import FollowJointTrajectory
 from openral_nodes.topic_graph import (
     DECODABLE_PACKAGES,
     MessageTypeError,
@@ -22,15 +22,20 @@ from openral_nodes.topic_graph import (
 )
 from rclpy.node import Node
 from sensor_msgs.msg import Image
+from unique_identifier_msgs.msg import UUID
 
 from tests.ros_runner.conftest import RosHarness
 from tests.ros_runner.conftest import run_cli as run_entry_point
 
 HOSTILE_TYPES = {
-    "os/msg/system": "which openral does not decode; decodable packages: builtin_interfaces,",
+    "os/msg/system": "which openral does not decode; decodable packages: action_msgs, builtin",
     "subprocess/msg/Popen": "which openral does not decode",
     "evil_pkg/msg/Thing": "which openral does not decode",
-    "action_msgs/msg/GoalStatusArray": "which openral does not decode",  # installed, not listed
+    "unique_identifier_msgs/msg/UUID": "which openral does not decode",  # installed, not listed
+    "evil_pkg/action/Thing_FeedbackMessage": "which openral does not decode",
+    "sensor_msgs/action/__class___FeedbackMessage": "'__class___FeedbackMessage' is not a",
+    "sensor_msgs/action/Image": "'Image' is not a message name",  # only an action's feedback
+    "control_msgs/action/FollowJointTrajectory_SendGoal": "is not a message name",
     "../x/msg/Y": "which is not a message type (expected pkg/msg/Name)",
     "sensor_msgs/msg/Image/x": "which is not a message type",
     "sensor_msgs/srv/Image": "which is not a message type",
@@ -75,8 +80,18 @@ def test_an_allowed_type_is_imported_from_its_package_only(imports: list[str]) -
     with pytest.raises(MessageTypeError, match="sensor_msgs/msg/Nope, which sensor_msgs does not"):
         message_class("sensor_msgs/msg/Nope", "/cam")
     assert imports == ["sensor_msgs.msg", "sensor_msgs.msg"]
-    assert "action_msgs" not in DECODABLE_PACKAGES
+    assert "unique_identifier_msgs" not in DECODABLE_PACKAGES
     assert {"sensor_msgs", "std_msgs", "rcl_interfaces"} <= set(DECODABLE_PACKAGES)
+
+
+def test_an_action_feedback_type_is_the_actions_own_feedback_message(imports: list[str]) -> None:
+    feedback = "control_msgs/action/FollowJointTrajectory_FeedbackMessage"
+    assert (
+        message_class(feedback, "/f/_action/feedback") is FollowJointTrajectory.Impl.FeedbackMessage
+    )
+    with pytest.raises(MessageTypeError, match="Nope_FeedbackMessage, which control_msgs does not"):
+        message_class("control_msgs/action/Nope_FeedbackMessage", "/f")
+    assert imports == ["control_msgs.action", "control_msgs.action"]
 
 
 @pytest.mark.parametrize(
@@ -111,14 +126,14 @@ def test_echo_of_a_peer_type_outside_the_allow_list_is_one_line_and_exit_1(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     peer = ros.add(Node("hostile_peer", context=ros.context))
-    peer.create_publisher(GoalStatusArray, "/hostile/status", 1)
+    peer.create_publisher(UUID, "/hostile/status", 1)
     code, output = run_cli(monkeypatch, capsys, "ros", "echo", "/hostile/status", "--once")
     assert code == 1, output
     assert output == (
-        "error: topic /hostile/status has type action_msgs/msg/GoalStatusArray, which openral "
+        "error: topic /hostile/status has type unique_identifier_msgs/msg/UUID, which openral "
         f"does not decode; decodable packages: {', '.join(DECODABLE_PACKAGES)}\n"
     )
-    assert not any(name.startswith("action_msgs") for name in imports), imports
+    assert not any(name.startswith("unique_identifier_msgs") for name in imports), imports
 
 
 def test_snapshot_writes_to_a_bracketed_path_and_names_it_verbatim(

@@ -20,7 +20,16 @@ from openral_cli.optional_values import with_optional_values
 
 render_offscreen_when_headless()  # before any command module imports mujoco
 
-from openral_cli.commands import deploy, robot, ros, ros_record, ros_view, rskill, sim  # noqa: E402, F401
+from openral_cli.commands import (  # noqa: E402, F401
+    deploy,
+    robot,
+    ros,
+    ros_graph,
+    ros_record,
+    ros_view,
+    rskill,
+    sim,
+)
 
 app = typer.Typer(
     name="openral",

@@ -13,8 +13,9 @@ from __future__ import annotations
 import importlib
 import re
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 from openral_core.errors import OpenralError, escaped
 from rclpy.exceptions import InvalidTopicNameException
@@ -32,9 +33,12 @@ def is_hidden(name: str) -> bool:
     return name in HIDDEN_TOPICS or any(token.startswith("_") for token in name.split("/"))
 
 
+T = TypeVar("T")
+
 POLL_S = 0.05
 """Interval between discovery-cache reads while waiting (s)."""
 DECODABLE_PACKAGES = (
+    "action_msgs",
     "builtin_interfaces",
     "control_msgs",
     "controller_manager_msgs",
@@ -49,7 +53,8 @@ DECODABLE_PACKAGES = (
     "trajectory_msgs",
 )
 """ROS message packages whose types are decoded (the ``ros`` extra, rclpy's own and the
-interface packages built at setup: tf2_msgs, control_msgs, controller_manager_msgs)."""
+interface packages built at setup: tf2_msgs, control_msgs, controller_manager_msgs), and
+whose actions' feedback is (see :data:`ACTION_FEEDBACK`)."""
 SERVICE_PACKAGES = (
     "lifecycle_msgs",
     "nav_msgs",
@@ -62,6 +67,9 @@ SERVICE_PACKAGES = (
 the ``ros`` extra)."""
 MESSAGE_NAME = re.compile(r"[A-Z][A-Za-z0-9]*")
 """A ROS message or service name: CamelCase, letters and digits."""
+ACTION_FEEDBACK = re.compile(r"([A-Z][A-Za-z0-9]*)_FeedbackMessage")
+"""The message of an action's ``<name>/_action/feedback`` topic, ``pkg/action/<this>``:
+the action's name and ``_FeedbackMessage``."""
 _KINDS = {
     "msg": ("message", "decode", "decodable", DECODABLE_PACKAGES),
     "srv": ("service", "call", "callable", SERVICE_PACKAGES),
@@ -141,44 +149,62 @@ def settled_topics(
     """The topics after ``wait_s`` of discovery, once the list has stayed the same for
     :data:`SETTLED_S` (or ``longest_s`` in all, whatever it is then; empty: nothing came);
     and the seconds waited."""
+    return settled(
+        lambda: graph_topics(node, include_hidden=include_hidden),
+        wait_s=wait_s,
+        longest_s=longest_s,
+        found=bool,
+    )
+
+
+def settled(
+    read: Callable[[], T], *, wait_s: float, longest_s: float, found: Callable[[T], bool]
+) -> tuple[T, float]:
+    """What ``read`` returns after ``wait_s`` of discovery, once it has stayed the same for
+    :data:`SETTLED_S` while ``found`` holds (or ``longest_s`` in all, whatever it is then);
+    and the seconds waited."""
     start = time.monotonic()
     time.sleep(wait_s)
-    infos = graph_topics(node, include_hidden=include_hidden)
+    seen = read()
     changed = time.monotonic()
     while True:
         now = time.monotonic()
-        if (infos and now - changed >= SETTLED_S) or now - start >= longest_s:
-            return infos, now - start
+        if (found(seen) and now - changed >= SETTLED_S) or now - start >= longest_s:
+            return seen, now - start
         time.sleep(POLL_S)
-        latest = graph_topics(node, include_hidden=include_hidden)
-        if latest != infos:
-            infos, changed = latest, time.monotonic()
+        latest = read()
+        if latest != seen:
+            seen, changed = latest, time.monotonic()
 
 
 def wait_for_topic(node: Node, topic: str, timeout_s: float) -> TopicInfo:
-    """Block until ``topic`` has a publisher; raise TopicNotFound after ``timeout_s`` [s]."""
+    """Block until ``topic`` (hidden ones too) has a publisher; raise TopicNotFound after
+    ``timeout_s`` [s], naming the other topics (hidden ones only when ``topic`` is)."""
     topic = topic_name(topic)
     deadline = time.monotonic() + timeout_s
     while True:
-        topics = graph_topics(node)
+        topics = graph_topics(node, include_hidden=True)
         for info in topics:
             if info.name == topic and info.publishers > 0:
                 return info
         if time.monotonic() >= deadline:
-            existing = [info.name for info in topics]
+            shown = [info for info in topics if is_hidden(topic) or not is_hidden(info.name)]
+            existing = [info.name for info in shown]
             raise TopicNotFound(topic, timeout_s, existing, node.context.get_domain_id())
         time.sleep(POLL_S)
 
 
 def message_class(type_name: str, topic: str) -> type[Any]:
-    """The class of ``topic``'s type, e.g. ``sensor_msgs/msg/Image``, from an allowed package.
+    """The class of ``topic``'s type, e.g. ``sensor_msgs/msg/Image`` (or an action's
+    feedback, ``control_msgs/action/FollowJointTrajectory_FeedbackMessage``), from an
+    allowed package.
 
     ``type_name`` is whatever a peer advertised: the package must be one of
     ``DECODABLE_PACKAGES`` and the name a ROS message name before anything is imported.
 
     Raises:
-        MessageTypeError: not ``pkg/msg/Name``, a package outside the allow-list, or a
-            name that package does not define as a message.
+        MessageTypeError: not ``pkg/msg/Name`` (or ``pkg/action/Name_FeedbackMessage``), a
+            package outside the allow-list, or a name that package does not define.
     """
     return _interface_class(type_name, "msg", f"topic {topic}")
 
@@ -198,26 +224,32 @@ def _interface_class(type_name: str, kind: str, subject: str) -> type[Any]:
     noun, verb, adjective, packages = _KINDS[kind]
     shown = escaped(type_name)
     parts = type_name.split("/")
-    if len(parts) != 3 or parts[1] != kind:
+    feedback = kind == "msg" and len(parts) == 3 and parts[1] == "action"
+    if len(parts) != 3 or not (parts[1] == kind or feedback):
         raise MessageTypeError(
             f"{subject} has type {shown}, which is not a {noun} type (expected pkg/{kind}/Name)"
         )
-    package, _, name = parts
+    package, folder, name = parts
     if package not in packages:
         raise MessageTypeError(
             f"{subject} has type {shown}, which openral does not {verb}; "
             f"{adjective} packages: {', '.join(packages)}"
         )
-    if not MESSAGE_NAME.fullmatch(name):
+    action = ACTION_FEEDBACK.fullmatch(name) if feedback else None
+    if not (action or (not feedback and MESSAGE_NAME.fullmatch(name))):
         raise MessageTypeError(f"{subject} has type {shown}: {name!r} is not a {noun} name")
     try:
-        module = importlib.import_module(f"{package}.{kind}")
+        module = importlib.import_module(f"{package}.{folder}")
     except ImportError as error:
         raise MessageTypeError(
             f"{subject} has type {shown}, but {package} is not installed ({error}); "
             f"install the ros-{package.replace('_', '-')} wheel"
         ) from None
-    cls = getattr(module, name, None)
+    if action:  # pkg.action.Name.Impl.FeedbackMessage
+        impl = getattr(getattr(module, action.group(1), None), "Impl", None)
+        cls = getattr(impl, "FeedbackMessage", None)
+    else:
+        cls = getattr(module, name, None)
     member = "get_fields_and_field_types" if kind == "msg" else "Request"
     if not isinstance(cls, type) or not hasattr(cls, member):
         raise MessageTypeError(f"{subject} has type {shown}, which {package} does not define")

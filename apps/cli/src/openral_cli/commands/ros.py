@@ -3,6 +3,9 @@
 Examples::
 
     openral ros topics --rate
+    openral ros services
+    openral ros actions
+    openral ros nodes
     openral ros echo /joint_states --once
     openral ros snapshot /openral/cameras/agentview/image --out agentview.png
     openral ros pub /cmd_vel geometry_msgs/msg/Twist "{linear: {x: 0.3}}" --count 40 --rate 20
@@ -38,8 +41,8 @@ if TYPE_CHECKING:
     from rclpy.node import Node
 
 app = command_group(
-    "Inspect the ROS 2 graph: topics, messages, camera frames, TF; publish a message, call a "
-    "service."
+    "Inspect the ROS 2 graph: topics, services, actions, nodes, messages, camera frames, TF; "
+    "publish a message, call a service."
 )
 
 DomainId = Annotated[
@@ -47,6 +50,9 @@ DomainId = Annotated[
     typer.Option(
         "--domain-id", min=0, max=232, help="ROS domain.", show_default="$ROS_DOMAIN_ID or 0"
     ),
+]
+DiscoveryWait = Annotated[
+    float, typer.Option("--wait", min=0.0, help="Seconds to let discovery run first.")
 ]
 Timeout = Annotated[
     float,
@@ -60,13 +66,17 @@ def _probe_node(domain_id: int | None, *, events: bool = False) -> Iterator[Node
     ``events``: spun by rclpy's EventsExecutor (see :class:`~openral_nodes.runtime.Spinner`)."""
     from openral_nodes.runtime import Spinner, ros_session
     from rclpy.node import Node
+    from rclpy.parameter import Parameter
 
+    # no ~/get_type_description service either: `ros services` would list it
+    overrides = [Parameter("start_type_description_service", value=False)]  # type: ignore[no-untyped-call]
     with _quiet_ctrl_c(), ros_session(domain_id) as context:
         node = Node(
             f"openral_cli_{os.getpid()}",
             context=context,
             enable_rosout=False,
             start_parameter_services=False,
+            parameter_overrides=overrides,
         )
         try:
             with Spinner(context, events=events) as spinner:
@@ -86,16 +96,15 @@ def _quiet_ctrl_c() -> Iterator[None]:
 
 
 LATE_DISCOVERY_S = 3.0
-"""How much longer ``topics`` may look after ``--wait`` while the graph is empty or still
-changing: FastDDS announces a participant again every 3 s, so a peer that missed the first
-announcement (a loaded machine) shows up within that [s]."""
+"""How much longer ``topics`` (``services``, ``actions``, ``nodes``) may look after
+``--wait`` while the graph is empty or still changing: FastDDS announces a participant
+again every 3 s, so a peer that missed the first announcement (a loaded machine) shows up
+within that [s]."""
 
 
 @app.command("topics")
 def topics(
-    wait: Annotated[
-        float, typer.Option("--wait", min=0.0, help="Seconds to let discovery run first.")
-    ] = 2.0,
+    wait: DiscoveryWait = 2.0,
     rate: Annotated[bool, typer.Option("--rate", help="Measure each topic's rate.")] = False,
     window: Annotated[
         float, typer.Option("--window", min=0.1, help="Seconds to measure rates over.")
