@@ -110,6 +110,12 @@ class TrajectoryActionClient:
         assert handle.accepted, "the server rejected the goal"
         return Sent(handle, feedback)
 
+    def rejected(self, message: Any, timeout_s: float = 10.0) -> bool:
+        """Send ``message``; True when the server rejected it at goal time."""
+        future = self.client.send_goal_async(message)
+        wait_until(future.done, timeout_s, "the goal's response")
+        return not future.result().accepted
+
     def result(self, sent: Sent, timeout_s: float = 30.0) -> tuple[int, Any]:
         """(status, result) once the goal has ended."""
         future = sent.handle.get_result_async()

@@ -35,6 +35,7 @@ import mujoco
 import numpy as np
 import pytest
 import yourdfpy
+from control_msgs.msg import DynamicJointState, JointTrajectoryControllerState
 from geometry_msgs.msg import Twist
 from openral_bridge.ros_messages import LATCHED
 from openral_bridge.topics import (
@@ -78,6 +79,9 @@ ODOM_TOLERANCE = 1e-6
 """[m and rad]"""
 TF_MESSAGES = 20
 """/tf messages whose stamps are compared (a second at 20 Hz)."""
+
+JOINT_SPACE = (JointState, DynamicJointState, JointTrajectoryControllerState)
+"""Messages in joint space: an empty frame_id names no frame."""
 
 
 class Recorder(Probe):
@@ -245,7 +249,7 @@ def _named_frames(graph: Graph) -> dict[str, str]:
                     named.setdefault(t.header.frame_id, topic)
                     named.setdefault(t.child_frame_id, topic)
             elif hasattr(msg, "header"):
-                if msg.header.frame_id or not isinstance(msg, JointState):
+                if msg.header.frame_id or not isinstance(msg, JOINT_SPACE):
                     named.setdefault(msg.header.frame_id, topic)
                 if getattr(msg, "child_frame_id", None) is not None:
                     named.setdefault(msg.child_frame_id, topic)

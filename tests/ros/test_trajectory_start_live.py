@@ -8,6 +8,7 @@ robot's start tolerance is refused with both distances.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -15,8 +16,10 @@ import pytest
 from action_msgs.msg import GoalStatus
 from control_msgs.action import FollowJointTrajectory
 from openral_bridge.topics import ACTION_SPEC, JOINT_STATES
+from openral_bridge.topics import JOINT_TRAJECTORY_REFUSED as REFUSED
 from openral_nodes.runtime import Spinner, claim_domain_id, ros_session
 from sensor_msgs.msg import JointState
+from std_msgs.msg import String
 
 from tests.conftest import ROBOTS
 from tests.ros.action_client import TrajectoryActionClient, goal
@@ -34,7 +37,7 @@ def h1(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Probe, Trajec
     logs: Path = tmp_path_factory.mktemp("trajectory_start")
     domain = claim_domain_id()
     with ros_session(domain_id=domain) as context:
-        topics = {JOINT_STATES: JointState, ACTION_SPEC: JointState}
+        topics = {JOINT_STATES: JointState, ACTION_SPEC: JointState, REFUSED: String}
         probe = Probe(context, topics, name="start_client")
         with Spinner(context) as spinner, deploy_sim(H1_SCENE, domain, logs) as process:
             spinner.add_node(probe.node)
@@ -82,10 +85,12 @@ def test_a_goal_beyond_the_start_tolerance_is_refused_with_both_distances(
     probe, action = h1
     measured, _ = _measured_and_commanded(probe)
     away = measured - 0.06 if measured - 0.06 > -1.5 else measured + 0.06
-    status, result, _ = action.run(goal((JOINT,), [(0.0, [away]), (2.0, [away])]))
-    assert (status, result.error_code) == (GoalStatus.STATUS_ABORTED, Result.INVALID_GOAL)
-    assert f"{JOINT} is commanded to" in result.error_string
-    assert "measured at" in result.error_string
-    assert "trajectory.start_tolerance" in result.error_string
+    since = time.monotonic()
+    assert action.rejected(goal((JOINT,), [(0.0, [away]), (2.0, [away])]))
+    probe.wait(lambda: probe.since(REFUSED, since), 5.0, "the refusal's reason")
+    reason = probe.since(REFUSED, since)[-1].msg.data
+    assert f"{JOINT} is commanded to" in reason
+    assert "measured at" in reason
+    assert "trajectory.start_tolerance" in reason
     still = probe.latest(JOINT_STATES)
     assert abs(still.position[list(still.name).index(JOINT)] - measured) < 0.005

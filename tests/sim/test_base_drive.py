@@ -177,7 +177,7 @@ def test_an_estop_stops_the_base_and_refuses_its_commands() -> None:
     assert isinstance(hal, SimAttachedHAL)
     hal.connect()
     try:
-        for _ in range(20 * hal.state_parts):  # 1 s: a tick is one part of a control period
+        for _ in range(20):
             hal.command_base(0.3, 0.0, 0.0)
             hal.tick(None)
         assert hal.base_odometry().vx_m_s == pytest.approx(0.3, abs=0.01)

@@ -34,11 +34,14 @@ from openral_bridge.topics import (
     JOINT_TRAJECTORY,
     JOINT_TRAJECTORY_REFUSED,
     JOINT_TRAJECTORY_STATE,
+    JTC_JOINT_TRAJECTORY,
+    JTC_NAME,
     RESET,
     SAFE_ACTION,
     TopicInfo,
 )
 from openral_bridge.trajectory_follower import DesiredPoint
+from openral_core.loaded import LoadedRobot
 from openral_core.models import TrajectoryRules
 from openral_hal.errors import EStopLatched, HalError
 from openral_hal.protocol import ActionScreen, RobotHal
@@ -47,12 +50,14 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, String
 from trajectory_msgs.msg import JointTrajectory
 
+from openral_nodes.control_surface import ControlSurface
 from openral_nodes.safety_services import SafetyServices
 from openral_nodes.trajectory_action import TrajectoryAction
 from openral_nodes.trajectory_request import request_from_msg
 from openral_nodes.trajectory_wire import trajectory_from_wire
 
 if TYPE_CHECKING:
+    from openral_bridge.joint_state_publisher import JointStatePublisher
     from rclpy.node import Node
 
 Entity = tuple[str, Any]
@@ -73,6 +78,7 @@ class CommandInterfaces:
         *,
         warn_every_s: float,
         rules: TrajectoryRules | None = None,
+        robot: LoadedRobot | None = None,
     ) -> None:
         """Nothing is created until :meth:`create`.
 
@@ -83,6 +89,7 @@ class CommandInterfaces:
             loop: The control loop of a simulated HAL (None for a real one).
             warn_every_s: At most one warning per this long for a stream of refusals [s].
             rules: The robot's trajectory rules (default: the schema's defaults).
+            robot: The loaded robot (its gripper for the gripper action).
         """
         self.node = node
         self.hal = hal
@@ -98,12 +105,15 @@ class CommandInterfaces:
         self.rules = rules or TrajectoryRules()
         self.action: TrajectoryAction | None = None
         """The FollowJointTrajectory action while created (None: no trajectories here)."""
-        self._safety = SafetyServices(node.context, node.get_name())
+        self.surface = ControlSurface(node, hal, lock, loop, robot, self._publish_refused)
+        """The controllers at ros2_control's names (:mod:`openral_nodes.control_surface`)."""
+        self._safety = SafetyServices(node.context, node.get_name(), node.get_namespace())
         self._state_pub: Any = None
         self._refused_pub: Any = None
 
-    def create(self) -> list[Entity]:
-        """Create the subscriptions, the publishers, the action and the safety services."""
+    def create(self, states: JointStatePublisher | None = None) -> list[Entity]:
+        """Create the subscriptions, the publishers, the actions, the controller manager
+        (``states``: the joint state broadcaster's publisher) and the safety services."""
         node = self.node
         self._state_pub = node.create_publisher(JointState, JOINT_TRAJECTORY_STATE, 10)
         self._refused_pub = node.create_publisher(String, JOINT_TRAJECTORY_REFUSED, 10)
@@ -114,26 +124,40 @@ class CommandInterfaces:
                 "subscription",
                 node.create_subscription(Float64MultiArray, SAFE_ACTION, self._on_action, 10),
             ),
-            (
-                "subscription",
-                node.create_subscription(
-                    JointTrajectory, JOINT_TRAJECTORY, self._on_trajectory, 10, raw=True
-                ),
+            *(
+                (
+                    "subscription",
+                    node.create_subscription(
+                        JointTrajectory, topic, self._on_trajectory, 10, raw=True
+                    ),
+                )
+                for topic in (JOINT_TRAJECTORY, JTC_JOINT_TRAJECTORY)
             ),
         ]
         loop = self.loop
         if loop is not None:
             loop.on_sample = self._publish_desired
         if loop is not None and loop.follower is not None:
-            action = TrajectoryAction(node, self.hal, self.lock, loop, loop.follower, self.rules)
+            action = TrajectoryAction(
+                node,
+                self.hal,
+                self.lock,
+                loop,
+                loop.follower,
+                self.rules,
+                on_refused=self._publish_refused,
+                active=self.surface.trajectories_active,
+            )
             action.create()
             self.action = action
+        entities += self.surface.create(states, self.action)
         self._safety.start(self._on_estop, self._on_release_estop, self._on_reset)
         return entities
 
     def destroy(self) -> None:
         """Stop the safety thread and the action (the node removes the other entities)."""
         self._safety.stop()
+        self.surface.destroy()
         if self.action is not None:
             self.action.destroy()
             self.action = None
@@ -151,6 +175,7 @@ class CommandInterfaces:
         return [
             TopicInfo(JOINT_TRAJECTORY_STATE, "sensor_msgs/msg/JointState", rate, "while moving"),
             TopicInfo(JOINT_TRAJECTORY_REFUSED, "std_msgs/msg/String", None, "on a refusal"),
+            *self.surface.topics(),
         ]
 
     # -- topics ----------------------------------------------------------------------------
@@ -182,6 +207,8 @@ class CommandInterfaces:
                 raise PathRefused(self._why_no_trajectories())
             if self.hal.estopped:
                 raise PathRefused("the E-stop is latched")
+            if not self.surface.trajectories_active():
+                raise PathRefused(f"the {JTC_NAME} is inactive (switch_controller activates it)")
             msg = trajectory_from_wire(data, len(self.hal.action_names))
             request = request_from_msg(msg, TOPIC_SOURCE)
             with self.lock:
@@ -193,7 +220,7 @@ class CommandInterfaces:
         except PathRefused as error:
             self.trajectories_refused += 1
             self._warn(f"{JOINT_TRAJECTORY}: trajectory refused: {error}")
-            self._refused_pub.publish(String(data=str(error)))
+            self._publish_refused(str(error))
             return
         self.trajectories_accepted += 1
         self._log().debug(
@@ -201,6 +228,11 @@ class CommandInterfaces:
             f"{len(path.times_s) - 1} point(s) from t={path.start_s:.3f} s to "
             f"t={path.end_s:.3f} s (simulated)"
         )
+
+    def _publish_refused(self, reason: str) -> None:
+        """One refusal's reason on the refusals topic (a topic, an action goal)."""
+        if self._refused_pub is not None:
+            self._refused_pub.publish(String(data=reason))
 
     def _publish_desired(self, point: DesiredPoint) -> None:
         """The desired point after a tick that followed a trajectory (loop thread)."""
@@ -219,6 +251,7 @@ class CommandInterfaces:
             self.hal.estop()
         follower = self.loop.follower if self.loop is not None else None
         aborted = follower is not None and follower.cancel("the E-stop latched")
+        self.surface.stop_goals("the E-stop latched")
         note = "; the joint trajectory is aborted" if aborted else ""
         held = "the arm is held" if self.hal.is_real else "the scene is frozen"
         self._log().warning(f"E-stop latched: actions are refused and {held}{note}")
@@ -241,6 +274,7 @@ class CommandInterfaces:
             )
             self._log().warning(f"{RESET}: refused: {response.message}")
             return response
+        self.surface.stop_goals("the scene was reset")
         try:
             text = self.loop.reset()
         except ResetFailed as error:

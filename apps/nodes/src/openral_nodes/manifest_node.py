@@ -6,10 +6,8 @@ Parameters (all read at configure):
   ``sim_env_yaml`` scene names. A ``manifest_path`` runs that file as it reads (not the
   repository's manifest of the same id); a scene naming another robot is refused;
 - ``hal_mode`` (``sim`` | ``real``), ``sim_env_yaml`` (a deploy-scene file, ``""`` for none);
-- ``viewer_enabled`` (bool); ``joint_state_rate_hz`` (float) within :data:`RATE_RANGE_HZ`;
-  ``camera_publish_rate_hz`` (float) within it too, or 0 for each sensor's own ``rate_hz``;
-  ``view_port`` (int): serve the browser view's page on it and its data on the next port
-  (0: no view).
+- ``viewer_enabled``; ``joint_state_rate_hz`` and ``camera_publish_rate_hz`` (0: each
+  sensor's own) within :data:`RATE_RANGE_HZ`; ``view_port`` (0: no browser view).
 
 Transitions:
 
@@ -29,9 +27,9 @@ Transitions:
 - cleanup / shutdown / error → also disconnect and drop the HAL; shutdown also sets the
   ``shutdown_event`` the owner passed, so a process can end when told to over ROS.
 
-A ChangeState request for a transition the current state does not allow (by id or label)
-is answered ``success=false`` with a throttled warning, never raised into the executor
-(:mod:`openral_nodes.lifecycle_guard`).
+A ChangeState request the current state does not allow is answered ``success=false``
+(:mod:`openral_nodes.lifecycle_guard`). With a namespace, every name of the graph goes under
+it (:mod:`openral_nodes.graph_names`).
 
 The command on ``/openral/safe_action`` (``std_msgs/Float64MultiArray``) is ``data`` = one
 value per HAL action slot, in the order and meaning ``/openral/action_spec`` announces
@@ -50,6 +48,7 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -72,6 +71,7 @@ from sensor_msgs.msg import JointState
 
 from openral_nodes.command_interfaces import CommandInterfaces
 from openral_nodes.control_loops import start_control_loop
+from openral_nodes.graph_names import NamespacedEntities, graph_name
 from openral_nodes.heap_freeze import HeapFreeze
 from openral_nodes.lifecycle_guard import guard_change_state
 from openral_nodes.node_parameters import BOUNDS, PARAMETERS, check_rates, configured_hal
@@ -87,7 +87,7 @@ Result = TransitionCallbackReturn
 """Transition outcome (a pybind enum, typed Any; hence the ``-> Any`` of the callbacks)."""
 
 
-class ManifestLifecycleNode(LifecycleNode):
+class ManifestLifecycleNode(NamespacedEntities, LifecycleNode):
     """Any robot of ``robots/`` as a lifecycle node, through its HAL (see the module doc)."""
 
     def __init__(
@@ -240,8 +240,7 @@ class ManifestLifecycleNode(LifecycleNode):
 
     @property
     def lifecycle_state(self) -> str:
-        """Label of the current lifecycle state (``unconfigured``, ``inactive``, ``active``,
-        ``finalized``); rclpy 7 has no public accessor."""
+        """Label of the current lifecycle state (rclpy 7 has no public accessor)."""
         label: str = self._state_machine.current_state[1]
         return label
 
@@ -254,7 +253,8 @@ class ManifestLifecycleNode(LifecycleNode):
         if self.loop is not None and self.hal is not None and can_tick(self.hal):
             rows.insert(0, TopicInfo(CLOCK, "rosgraph_msgs/msg/Clock", 1.0 / self.loop.period_s))
         rows += self.commands.topics() if self.commands is not None else []
-        return rows + (self.bridge.topics() if self.bridge else [])
+        rows += self.bridge.topics() if self.bridge else []
+        return [replace(row, name=graph_name(self, row.name)) for row in rows]
 
     def action_layout(self) -> tuple[tuple[str, ...], list[float]]:
         """Slot names and hold action of the connected HAL (what ``action_spec`` carries)."""
@@ -339,9 +339,15 @@ class ManifestLifecycleNode(LifecycleNode):
         self.states.start(pacer)
         rules = self.description.trajectory if self.description is not None else None
         self.commands = CommandInterfaces(
-            self, hal, self.hal_lock, self.loop, warn_every_s=WARN_EVERY_S, rules=rules
+            self,
+            hal,
+            self.hal_lock,
+            self.loop,
+            warn_every_s=WARN_EVERY_S,
+            rules=rules,
+            robot=self._loaded,
         )
-        self._entities += [("publisher", spec), *self.commands.create()]
+        self._entities += [("publisher", spec), *self.commands.create(self.states.states)]
 
     def _job_failed(self, job: PacedJob, error: Exception) -> None:
         """A periodic job raised (the pacer's thread goes on)."""

@@ -24,6 +24,7 @@ PARAMETERS: dict[str, Any] = {
     "camera_publish_rate_hz": 0.0,
     "joint_state_rate_hz": 100.0,
     "publish_tf": True,
+    "publish_static_tf": True,
     "view_port": 0,
     "transport": "",
     "calibration_file": "",

@@ -17,6 +17,7 @@ from rclpy.context import Context
 from rclpy.node import Node
 from std_srvs.srv import Trigger
 
+from openral_nodes.graph_names import graph_name
 from openral_nodes.runtime import Spinner
 
 Handler = Callable[[Any, Any], Any]
@@ -26,19 +27,25 @@ Handler = Callable[[Any, Any], Any]
 class SafetyServices:
     """The safety services of one active manifest node (see the module doc)."""
 
-    def __init__(self, context: Context, node_name: str) -> None:
-        """Nothing runs until :meth:`start`."""
+    def __init__(self, context: Context, node_name: str, namespace: str = "/") -> None:
+        """Nothing runs until :meth:`start`; the services go under ``namespace``
+        (:mod:`openral_nodes.graph_names`)."""
         self.context = context
         self.node_name = f"{node_name}_safety"
+        self.namespace = namespace
         self._node: Node | None = None
         self._spinner: Spinner | None = None
 
     def start(self, estop: Handler, release: Handler, reset: Handler) -> None:
         """Offer the three services, each answered by its handler on the safety thread."""
-        node = Node(self.node_name, context=self.context, start_parameter_services=False)
-        node.create_service(Trigger, ESTOP, estop)
-        node.create_service(Trigger, RELEASE_ESTOP, release)
-        node.create_service(Trigger, RESET, reset)
+        node = Node(
+            self.node_name,
+            namespace=self.namespace,
+            context=self.context,
+            start_parameter_services=False,
+        )
+        for name, handler in ((ESTOP, estop), (RELEASE_ESTOP, release), (RESET, reset)):
+            node.create_service(Trigger, graph_name(node, name), handler)
         spinner = Spinner(self.context)
         spinner.add_node(node)
         self._node, self._spinner = node, spinner.start()

@@ -1,54 +1,54 @@
 """The ``control_msgs/action/FollowJointTrajectory`` server of the manifest node.
 
-At :data:`~openral_bridge.topics.FOLLOW_JOINT_TRAJECTORY`, the name MoveIt's
-``moveit_simple_controller_manager`` reaches for a controller called
-``joint_trajectory_controller``. It follows ros2_control's joint_trajectory_controller:
+At :data:`~openral_bridge.topics.FOLLOW_JOINT_TRAJECTORY`, where ros2_control's
+``joint_trajectory_controller`` serves it and MoveIt's simple controller manager looks for
+it. It behaves as that controller does:
 
-- every goal is accepted, then checked: a bad one ends at once, ABORTED, with the controller's
-  result codes and the reason in ``error_string`` (INVALID_JOINTS for an unknown, repeated or
-  missing joint name, OLD_HEADER_TIMESTAMP for a trajectory that ended before now,
-  INVALID_GOAL for anything else: NaN, too many points, time going backwards, a bad
-  tolerance, the E-stop latched). Unlike ros2_control, which rejects such goals with no
-  reason, the client learns why;
-- a valid goal becomes the path of the control loop's
-  :class:`~openral_bridge.trajectory_follower.TrajectoryFollower`, the one that
-  ``/openral/joint_trajectory`` also feeds, under the same rules (start tolerance, limits);
-- every control tick sends feedback (desired, actual and error of the goal's joints, stamped
-  in simulated time) and judges the goal (:mod:`openral_bridge.trajectory_goal`): SUCCEEDED,
-  or ABORTED with PATH_TOLERANCE_VIOLATED / GOAL_TOLERANCE_VIOLATED (the joints then hold
-  where they are);
-- a newer goal pre-empts the running one (ABORTED, INVALID_GOAL, "pre-empted by a newer
-  goal", as the controller does); so does a trajectory on the topic, a ``safe_action``, the
-  E-stop or a reset (ABORTED, INVALID_GOAL, with what ended it);
-- a cancel request of the running goal stops the path at once: the next tick holds the
-  joints where their set points are, and the goal ends CANCELED.
+- a goal is checked when it arrives and REJECTED when it cannot run (an unknown, repeated or
+  missing joint name, a trajectory that ended before now or starts implausibly late (a
+  wall-clock stamp under simulated time), NaN, too many points, time going backwards, a
+  first point too far from the joints, a bad tolerance, the E-stop latched, the controller
+  deactivated); a rejection carries no reason in ROS, so the reason goes to the log and to
+  ``/openral/joint_trajectory/refused``;
+- an accepted goal's path is the one the control loop's
+  :class:`~openral_bridge.trajectory_follower.TrajectoryFollower` follows next, the one that
+  the ``joint_trajectory`` topic also feeds, under the same rules;
+- every tick sends feedback (desired, actual and error of the goal's joints, stamped in
+  simulated time) and judges the goal (:mod:`openral_bridge.trajectory_goal`): SUCCEEDED,
+  or ABORTED with PATH_TOLERANCE_VIOLATED / GOAL_TOLERANCE_VIOLATED (the joints then hold);
+- a newer goal pre-empts the running one, and so do a trajectory on the topic, a
+  ``safe_action``, the E-stop, a reset and deactivating the controller: ABORTED,
+  INVALID_GOAL (the controller's code for a goal it did not finish), the cause in
+  ``error_string``;
+- a cancel request of the running goal stops the path at once (the next tick holds the
+  joints at their set points) and the goal ends CANCELED.
 
-rclpy runs an action's execute callback as a coroutine that its executor polls on every
-spin while it waits (a busy loop on the only executor thread); here no callback waits: a
-goal is started by its accept callback and finished by the control loop, which schedules the
-ending on the executor (:class:`_LoopDrivenServer`).
+Goals are ended by the control loop (:class:`~openral_nodes.loop_driven_server.LoopDrivenServer`).
 """
 
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from control_msgs.action import FollowJointTrajectory
 from openral_bridge.control_loop import ControlLoop
-from openral_bridge.joint_path import JointPath, PathRefused, Refusal
+from openral_bridge.joint_path import JointPath, PathRefused
 from openral_bridge.joint_state_publisher import sim_stamp
-from openral_bridge.topics import FOLLOW_JOINT_TRAJECTORY
+from openral_bridge.topics import FOLLOW_JOINT_TRAJECTORY, JTC_NAME
 from openral_bridge.trajectory_follower import TrajectoryFollower
 from openral_bridge.trajectory_goal import Outcome, Progress, Tolerances, judge
 from openral_core.models import TrajectoryRules
 from openral_hal.protocol import RobotHal
 from openral_mujoco.state import JointStateSample
-from rclpy.action.server import ActionServer, CancelResponse, GoalResponse
+from rclpy.action.server import CancelResponse, GoalResponse
 from trajectory_msgs.msg import JointTrajectoryPoint
 
+from openral_nodes.graph_names import graph_name
+from openral_nodes.loop_driven_server import LoopDrivenServer
 from openral_nodes.trajectory_request import goal_request
 
 if TYPE_CHECKING:
@@ -58,11 +58,6 @@ Result = FollowJointTrajectory.Result
 RESULT_TIMEOUT_S = 30
 """How long a finished goal's result is kept for a client that asks late [s] (bounds what a
 flood of goals can hold)."""
-CODES = {
-    Refusal.INVALID_GOAL: Result.INVALID_GOAL,
-    Refusal.INVALID_JOINTS: Result.INVALID_JOINTS,
-    Refusal.OLD_HEADER_TIMESTAMP: Result.OLD_HEADER_TIMESTAMP,
-}
 VIOLATIONS = {
     Outcome.PATH_TOLERANCE_VIOLATED: Result.PATH_TOLERANCE_VIOLATED,
     Outcome.GOAL_TOLERANCE_VIOLATED: Result.GOAL_TOLERANCE_VIOLATED,
@@ -81,30 +76,6 @@ class _Goal:
     finished: bool = False
 
 
-class _LoopDrivenServer(ActionServer):
-    """An ActionServer whose goals end when the control loop says so (see the module doc):
-    ``goal_handle.execute()`` only marks the goal executing; :meth:`finish` ends it."""
-
-    def notify_execute(self, goal_handle: Any, execute_callback: Any) -> None:
-        if execute_callback is not None:
-            super().notify_execute(goal_handle, execute_callback)  # type: ignore[no-untyped-call]
-
-    def finish(self, goal_handle: Any, status: str, result: Any) -> None:
-        """End ``goal_handle`` (any thread): on the executor, move it to ``status``
-        (``succeed``, ``abort`` or ``canceled``) and hand ``result`` to its client."""
-
-        def end(handle: Any) -> Any:
-            try:
-                if handle.is_active:
-                    getattr(handle, status)()
-            except Exception:  # a transition the goal's state no longer allows: abort it
-                if handle.is_active:
-                    handle.abort()
-            return result
-
-        super().notify_execute(goal_handle, end)  # type: ignore[no-untyped-call]
-
-
 class TrajectoryAction:
     """The FollowJointTrajectory action of one active manifest node (see the module doc)."""
 
@@ -116,27 +87,33 @@ class TrajectoryAction:
         loop: ControlLoop,
         follower: TrajectoryFollower,
         rules: TrajectoryRules,
+        on_refused: Callable[[str], None] = lambda reason: None,
+        active: Callable[[], bool] = lambda: True,
     ) -> None:
+        """Nothing is served until :meth:`create`; ``on_refused`` gets each rejection's
+        reason, ``active`` says whether the controller takes goals."""
         self.node, self.hal, self.lock, self.loop = node, hal, lock, loop
         self.follower, self.rules = follower, rules
+        self.on_refused, self.active = on_refused, active
+        self._planned: tuple[Any, JointPath, Tolerances] | None = None
         self.accepted = 0
         """Goals that became the follower's path."""
         self.refused = 0
-        """Goals ended at once for a bad trajectory."""
+        """Goals rejected."""
         self._active: _Goal | None = None
         self._goals_lock = threading.Lock()
-        self._server: _LoopDrivenServer | None = None
+        self._server: LoopDrivenServer | None = None
 
     def create(self) -> None:
         """Start serving; the follower tells this action when a path ends early."""
         self.follower.on_end = self._path_ended
         self.loop.watchers.append(self._on_tick)
-        self._server = _LoopDrivenServer(  # type: ignore[no-untyped-call]
+        self._server = LoopDrivenServer(  # type: ignore[no-untyped-call]
             self.node,
             FollowJointTrajectory,
-            FOLLOW_JOINT_TRAJECTORY,
+            graph_name(self.node, FOLLOW_JOINT_TRAJECTORY),
             execute_callback=lambda handle: Result(),
-            goal_callback=lambda goal: GoalResponse.ACCEPT,
+            goal_callback=self._on_goal,
             handle_accepted_callback=self._on_accepted,
             cancel_callback=self._on_cancel,
             result_timeout=RESULT_TIMEOUT_S,
@@ -156,26 +133,41 @@ class TrajectoryAction:
 
     # -- goals (executor thread) -------------------------------------------------------------
 
-    def _on_accepted(self, handle: Any) -> None:
-        handle.execute()
+    def _on_goal(self, goal: Any) -> Any:
+        """Check ``goal`` and make its path the follower's next one: ACCEPT, or REJECT with
+        the reason logged and published."""
         try:
-            goal = self._start(handle)
+            if not self.active():
+                raise PathRefused(f"the {JTC_NAME} is inactive (switch_controller activates it)")
+            path, tolerances = self._plan(goal)
         except PathRefused as error:
             self.refused += 1
             self._log().warning(
-                f"{FOLLOW_JOINT_TRAJECTORY}: goal refused: {error}", throttle_duration_sec=2.0
+                f"{FOLLOW_JOINT_TRAJECTORY}: goal rejected: {error}", throttle_duration_sec=2.0
             )
-            self._finish_now(handle, "abort", CODES[error.kind], str(error))
+            self.on_refused(str(error))
+            return GoalResponse.REJECT
+        self._planned = (goal, path, tolerances)
+        return GoalResponse.ACCEPT
+
+    def _on_accepted(self, handle: Any) -> None:
+        handle.execute()
+        planned, self._planned = self._planned, None
+        if planned is None or planned[0] is not handle.request:  # never: accepted = planned
+            self._finish_now(handle, "abort", Result.INVALID_GOAL, "the goal was not planned")
             return
+        _, path, tolerances = planned
+        feedback = FollowJointTrajectory.Feedback(joint_names=list(path.names))
+        goal = _Goal(handle, path, tolerances, feedback)
         self.accepted += 1
         with self._goals_lock:
             previous, self._active = self._active, goal
         if previous is not None:
             self._end(previous, "abort", Result.INVALID_GOAL, "pre-empted by a newer goal")
 
-    def _start(self, handle: Any) -> _Goal:
+    def _plan(self, goal: Any) -> tuple[JointPath, Tolerances]:
         """Check the goal and make its path the follower's next one."""
-        request, tolerances = goal_request(handle.request, self.rules)
+        request, tolerances = goal_request(goal, self.rules)
         if self.hal.estopped:
             raise PathRefused("the E-stop is latched")
         with self.lock:
@@ -183,9 +175,15 @@ class TrajectoryAction:
             state = self.loop.state
         if state is None or state.sim_time_s is None:
             raise PathRefused("the scene has no simulated time yet")
-        path = self.follower.submit(request, hold, state.sim_time_s, state.positions)
-        feedback = FollowJointTrajectory.Feedback(joint_names=list(path.names))
-        return _Goal(handle, path, tolerances, feedback)
+        return self.follower.submit(request, hold, state.sim_time_s, state.positions), tolerances
+
+    def stop_goal(self, reason: str) -> None:
+        """End the running goal (ABORTED, INVALID_GOAL, ``reason``) and its path: the
+        controller was deactivated."""
+        goal = self._active
+        if goal is not None:
+            self._end(goal, "abort", Result.INVALID_GOAL, reason)
+            self.follower.cancel(reason, goal.path)
 
     def _on_cancel(self, handle: Any) -> Any:
         goal = self._active

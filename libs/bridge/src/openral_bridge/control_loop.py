@@ -46,13 +46,13 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from openral_hal.protocol import StateParted, Tickable
 from openral_mujoco.state import FloatArray, JointStateSample
 
+from openral_bridge.loop_terms import RESET_TIMEOUT_S, Drive, Following, ResetFailed, ResetRequest
 from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.real_time import RealTimeWatch
 from openral_bridge.trajectory_follower import DesiredPoint, TrajectoryFollower
@@ -60,41 +60,10 @@ from openral_bridge.trajectory_follower import DesiredPoint, TrajectoryFollower
 if TYPE_CHECKING:
     from rclpy.node import Node
 
+__all__ = ["ControlLoop", "Drive", "Following", "ResetFailed"]
+
 WARN_EVERY_S = 2.0
 """At most one warning per this many seconds for a stream of failing ticks [s]."""
-RESET_TIMEOUT_S = 10.0
-"""Longest wait of :meth:`ControlLoop.reset` for a tick to carry the reset out [s]."""
-
-
-class Following(Protocol):
-    """What a control loop follows between offered actions: a path, a target."""
-
-    def next_action(
-        self, hold: FloatArray, now_s: float, period_s: float
-    ) -> tuple[FloatArray, DesiredPoint] | None:
-        """The action of the coming period and its desired point (None: nothing to follow)."""
-        ...
-
-    def cancel(self, reason: str = "cancelled") -> bool:
-        """Stop following; True when something was followed."""
-        ...
-
-
-Drive = Callable[[Callable[[], None] | None], None]
-"""Hands a driver the tick to call after each of its readings (None: takes it back)."""
-
-
-class ResetFailed(RuntimeError):
-    """A reset was not carried out (the loop stopped, timed out, or the HAL raised)."""
-
-
-@dataclass
-class _ResetRequest:
-    """One reset handed to the loop's thread, and its outcome."""
-
-    done: threading.Event = field(default_factory=threading.Event)
-    text: str = ""
-    error: str | None = None
 
 
 class ControlLoop:
@@ -129,7 +98,9 @@ class ControlLoop:
         self.lock = lock if lock is not None else threading.Lock()
         self.period_s = float(hal.control_period_s)
         """The control period: actions, trajectory samples and ee steps at its start [s]."""
-        self.parts = hal.state_parts if isinstance(hal, StateParted) else 1
+        parted = hal if isinstance(hal, StateParted) else None
+        self.parts = parted.state_parts if parted is not None else 1
+        self._step = parted.tick_part if parted is not None else hal.tick
         self.tick_period_s = self.period_s / self.parts
         """Simulated time one tick advances: the state period [s]."""
         self._phase = 0  # ticks of the current control period stepped, modulo parts
@@ -148,12 +119,16 @@ class ControlLoop:
         self.watchers: list[Callable[[JointStateSample], None]] = []
         """Called in order with the state after every tick that stepped the scene (the HAL
         lock not held), e.g. to judge a trajectory goal against its path."""
+        self.reporters: list[Callable[[], None]] = []
+        """Called after every tick that did not fail, stepped or E-stopped (the HAL lock not
+        held): what publishes the state (a frozen scene's too, with its frozen stamp)."""
         self.readers: list[Callable[[], None]] = []
         """Called in order, holding the HAL lock, right after every tick that stepped the scene
         (and a reset's tick): each copies what it publishes from the live scene, so nothing
         reads the scene in the middle of a step and the copies all show the same state."""
         self._pending: FloatArray | None = None
-        self._reset: _ResetRequest | None = None
+        self._slots: dict[int, float] = {}
+        self._reset: ResetRequest | None = None
         self._pending_lock = threading.Lock()
         self._job: tuple[Pacer, PacedJob] | None = None
         self._driven: Drive | None = None
@@ -172,8 +147,8 @@ class ControlLoop:
         self._job = (pacer, pacer.every(self.tick_period_s, self.tick, "control"))
 
     def start_driven(self, drive: Drive) -> None:
-        """Tick once now, then whenever the robot's driver calls back: ``drive(tick)``
-        hands :meth:`tick` to it (``drive(None)`` at :meth:`stop` takes it back)."""
+        """Tick once now, then whenever the robot's driver calls back (``drive(tick)``;
+        ``drive(None)`` at :meth:`stop` takes it back)."""
         self.stop()
         self.watch.restart()
         self.tick()
@@ -196,10 +171,9 @@ class ControlLoop:
         if reset is not None:
             reset.error = "the control loop stopped before the reset"
             reset.done.set()
-        if self.follower is not None:
-            self.follower.cancel("the control loop stopped")
-        if self.ee is not None:
-            self.ee.cancel("the control loop stopped")
+        for following in (self.follower, self.ee):
+            if following is not None:
+                following.cancel("the control loop stopped")
 
     def add_reader(self, read: Callable[[], None]) -> None:
         """Run ``read`` after every tick that steps (see :attr:`readers`), and once now,
@@ -210,8 +184,8 @@ class ControlLoop:
                 read()
 
     def offer(self, action: FloatArray) -> bool:
-        """Make ``action`` (already validated) the one the next tick applies (any thread);
-        it pre-empts a joint trajectory. True when it ended one."""
+        """Make ``action`` (validated) the next period's (any thread); it pre-empts a joint
+        trajectory. True when it ended one."""
         follower = self.follower
         preempted = follower.cancel("a safe_action pre-empted it") if follower else False
         if self.ee is not None:
@@ -232,7 +206,7 @@ class ControlLoop:
         """
         if not self.running:
             raise ResetFailed("the control loop is not running")
-        request = _ResetRequest()
+        request = ResetRequest()
         with self._pending_lock:
             self._drop_pending()
             self._reset = request
@@ -267,9 +241,9 @@ class ControlLoop:
                 dropped = action if held else None
                 if held:
                     action = None
-                elif action is None and starts:
-                    action, sample, toward_ee = self._follow_step()
-                stepped = self.hal.tick(action, glide=sample is not None)
+                elif starts:
+                    action, sample, toward_ee = self._period_action(action)
+                stepped = self._step(action, glide=sample is not None)
                 if stepped:
                     self._phase = (self._phase + 1) % self.parts
                 state = self.hal.read_state() if stepped else self.state
@@ -289,8 +263,38 @@ class ControlLoop:
                 with self._pending_lock:
                     self.superseded += 1
             if not stepped:
+                self._report()  # a frozen scene's state is still published
                 return
         self._after_step(state, action is not None and sample is None, sample, toward_ee)
+        self._report()
+
+    def _report(self) -> None:
+        for report in self.reporters:
+            report()
+
+    def command_slots(self, values: dict[int, float]) -> None:
+        """Have the next period set these action slots (index → value, already validated)
+        on top of whatever it applies: an offered action, a trajectory's sample or the hold
+        (any thread; e.g. a gripper command that must not end the arm's trajectory)."""
+        with self._pending_lock:
+            self._slots.update(values)
+
+    def _period_action(
+        self, offered: FloatArray | None
+    ) -> tuple[FloatArray | None, DesiredPoint | None, bool]:
+        """The action starting a period: ``offered``, else what :meth:`_follow_step` gives,
+        with the slots of :meth:`command_slots` set on top (under the HAL lock)."""
+        action, sample, toward_ee = (
+            (offered, None, False) if offered is not None else self._follow_step()
+        )
+        with self._pending_lock:
+            slots, self._slots = self._slots, {}
+        if slots:
+            hold = self.hal.hold_action() if action is None else action
+            action = np.array(hold, dtype=np.float64)
+            for index, value in slots.items():
+                action[index] = value
+        return action, sample, toward_ee
 
     def _follow_step(self) -> tuple[FloatArray | None, DesiredPoint | None, bool]:
         """(action, desired point, towards the ee target) of this tick: a running trajectory
@@ -311,11 +315,7 @@ class ControlLoop:
         return None, None, False
 
     def _after_step(
-        self,
-        state: JointStateSample | None,
-        applied: bool,
-        sample: DesiredPoint | None,
-        toward_ee: bool,
+        self, state: JointStateSample | None, applied: bool, sample: DesiredPoint | None, ee: bool
     ) -> None:
         self.ticks += 1
         self.applied += int(applied)
@@ -324,7 +324,7 @@ class ControlLoop:
             self.on_tick(sim_time)
         if sample is not None:
             self.followed += 1
-            publish = self.on_ee_sample if toward_ee else self.on_sample
+            publish = self.on_ee_sample if ee else self.on_sample
             if publish is not None:
                 publish(sample)
         if state is not None:
@@ -333,7 +333,7 @@ class ControlLoop:
         if sim_time is not None:
             self._check_pace(sim_time)
 
-    def _carry_out(self, request: _ResetRequest) -> None:
+    def _carry_out(self, request: ResetRequest) -> None:
         """Reset, step once with the hold, tell ``on_tick`` and ``on_reset``; the outcome
         goes to ``request``."""
         try:
@@ -343,7 +343,7 @@ class ControlLoop:
                 if self.ee is not None:
                     self.ee.cancel("the scene was reset")
                 request.text = self.hal.reset()
-                stepped = self.hal.tick(None)
+                stepped = self._step(None)
                 self._phase = 1 % self.parts if stepped else 0  # it started a period
                 self.state = self.hal.read_state() if stepped else None
                 if stepped:

@@ -45,6 +45,9 @@ from openral_bridge.path_segment import Segment
 START_TOLERANCE = 0.01
 """Largest distance of a point at time 0 from where its joint is commanded now [rad or m]."""
 MAX_POINTS = 10_000
+FAR_FUTURE_S = 300.0
+"""Latest start after now a trajectory may ask for [s]; a later one is taken for a clock
+mismatch (a goal stamped in wall time, ~1.7e9 s, under simulated time) and refused."""
 """Most points one trajectory may have (a point per millisecond for 10 s; resource use and
 the time a check takes stay bounded)."""
 SPEED_SLACK = 1e-9
@@ -179,6 +182,12 @@ def plan_path(request: TrajectoryRequest, limits: PathLimits, start: PathStart) 
         raise PathRefused(f"the trajectory has {len(points)} points; at most {MAX_POINTS}")
     positions, velocities, offsets = _point_arrays(request, slots, limits)
     begin = start.time_s if request.start_s is None else request.start_s
+    if begin - start.time_s > FAR_FUTURE_S:
+        raise PathRefused(
+            f"the trajectory starts at t={begin:.3f} s, {begin - start.time_s:.0f} s after now "
+            f"(t={start.time_s:.3f} s, simulated): a clock mismatch? stamp it in simulated time "
+            "(use_sim_time, /clock) or leave header.stamp 0 to start at once"
+        )
     times = begin + offsets
     keep = times > start.time_s
     first, first_speed = start.positions[slots], start.velocities[slots]

@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import mujoco
 import numpy as np
+from control_msgs.msg import DynamicJointState, InterfaceValue
 from openral_hal.protocol import RobotHal
 from openral_mujoco.robot_tree import RobotTree
 from openral_mujoco.state import JointStateSample
@@ -41,7 +42,7 @@ from sensor_msgs.msg import JointState
 from openral_bridge import ros_messages
 from openral_bridge.paced_publishers import PacedPublishers
 from openral_bridge.pacer import Pacer
-from openral_bridge.topics import JOINT_STATES, MANIFEST_JOINT_STATES
+from openral_bridge.topics import DYNAMIC_JOINT_STATES, JOINT_STATES, MANIFEST_JOINT_STATES
 
 if TYPE_CHECKING:
     from rclpy.node import Node
@@ -50,6 +51,8 @@ if TYPE_CHECKING:
 
 QUEUE_DEPTH = 10
 """Queue of each publisher."""
+INTERFACES = ("position", "velocity", "effort")
+"""The state interfaces ``/dynamic_joint_states`` carries per joint."""
 
 
 def sim_stamp(node: Node, sim_time_s: float | None) -> Any:
@@ -152,6 +155,8 @@ class JointStatePublisher:
         self.source = source
         self.published = 0
         """Readings published since :meth:`start`."""
+        self.enabled = True
+        """False while the joint state broadcaster is deactivated: nothing is published."""
         self._out = PacedPublishers(node)
         self._messages: tuple[StateReading, Any, Any] | None = None
 
@@ -165,6 +170,7 @@ class JointStatePublisher:
         self._out.open(
             node.create_publisher(JointState, JOINT_STATES, QUEUE_DEPTH),
             node.create_publisher(JointState, MANIFEST_JOINT_STATES, QUEUE_DEPTH),
+            node.create_publisher(DynamicJointState, DYNAMIC_JOINT_STATES, QUEUE_DEPTH),
         )
         self.published = 0
         self.publish()
@@ -180,11 +186,12 @@ class JointStatePublisher:
     def publish(self) -> None:
         """Publish the newest reading."""
         publishers = self._out.publishers
-        if not publishers:
+        if not publishers or not self.enabled:
             return
         joints, manifest = self._messages_of(self.source.reading())
         publishers[0].publish(joints)
         publishers[1].publish(manifest)
+        publishers[2].publish(dynamic_joint_state(joints))
         self.published += 1
 
     def _messages_of(self, reading: StateReading) -> tuple[Any, Any]:
@@ -202,6 +209,19 @@ class JointStatePublisher:
         return ros_messages.joint_state_msg(
             sample.names, sample.positions, sample.velocities, sample.efforts, stamp
         )
+
+
+def dynamic_joint_state(joints: Any) -> Any:
+    """``control_msgs/DynamicJointState`` of a ``JointState``: each joint's position,
+    velocity and effort interfaces (joint_state_broadcaster's ``/dynamic_joint_states``)."""
+    return DynamicJointState(
+        header=joints.header,
+        joint_names=joints.name,
+        interface_values=[
+            InterfaceValue(interface_names=list(INTERFACES), values=[q, v, e])
+            for q, v, e in zip(joints.position, joints.velocity, joints.effort, strict=True)
+        ],
+    )
 
 
 def _joined(first: JointStateSample, second: JointStateSample) -> JointStateSample:

@@ -4,7 +4,8 @@ down together.
 A stream such as ``/joint_states`` or ``/tf`` owns a few publishers and one periodic job
 (:class:`Cadence`): on the node's :class:`~openral_bridge.pacer.Pacer`, or, when its rate is
 at least the control loop's tick rate, right after every tick of the loop, so each message
-carries a new state (never the same one twice, none skipped). Stopping it must unschedule
+carries a new state (never the same one twice, none skipped; while the E-stop freezes the
+scene, its frozen state at the tick rate). Stopping it must unschedule
 the job first (so no callback runs on a destroyed publisher), then destroy the publishers;
 doing so twice does nothing.
 
@@ -25,7 +26,6 @@ from typing import TYPE_CHECKING, Any
 from openral_bridge.pacer import PacedJob, Pacer
 
 if TYPE_CHECKING:
-    from openral_mujoco.state import JointStateSample
     from rclpy.node import Node
 
     from openral_bridge.control_loop import ControlLoop
@@ -40,7 +40,7 @@ class Cadence:
     def __init__(self) -> None:
         self._job: tuple[Pacer, PacedJob] | None = None
         self._loop: ControlLoop | None = None
-        self._watch: Callable[[JointStateSample], None] | None = None
+        self._report: Callable[[], None] | None = None
 
     def start(
         self,
@@ -56,8 +56,8 @@ class Cadence:
         self.stop()
         tick_hz = 1.0 / loop.tick_period_s if loop is not None else None
         if loop is not None and tick_hz is not None and rate_hz >= tick_hz * (1.0 - _SLACK):
-            self._loop, self._watch = loop, lambda state: callback()
-            loop.watchers.append(self._watch)
+            self._loop, self._report = loop, callback
+            loop.reporters.append(callback)
             return tick_hz
         self._job = (pacer, pacer.every(1.0 / rate_hz, callback, name))
         return rate_hz
@@ -68,10 +68,10 @@ class Cadence:
             pacer, job = self._job
             self._job = None
             pacer.cancel(job)
-        loop, watch = self._loop, self._watch
-        if loop is not None and watch is not None and watch in loop.watchers:
-            loop.watchers.remove(watch)
-        self._loop = self._watch = None
+        loop, report = self._loop, self._report
+        if loop is not None and report is not None and report in loop.reporters:
+            loop.reporters.remove(report)
+        self._loop = self._report = None
 
 
 class PacedPublishers:

@@ -22,6 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
 from openral_core.models import TrajectoryRules
 from openral_mujoco.command_limits import CommandLimits
@@ -142,6 +143,18 @@ class TrajectoryFollower:
         if dropped is not None:
             self._ended(dropped, f"replaced by {path.source} before it started")
         return path
+
+    def reference(
+        self, time_s: float
+    ) -> tuple[npt.NDArray[np.intp], FloatArray, FloatArray] | None:
+        """(slots, positions, velocities) the running path asks for at ``time_s`` [s] (None:
+        no path runs)."""
+        with self._lock:
+            running = self._running
+        if running is None:
+            return None
+        positions, velocities = running.sample(time_s)
+        return running.slots, positions, velocities
 
     def cancel(self, reason: str = "cancelled", path: JointPath | None = None) -> bool:
         """End the running and the waiting path (only ``path``, when given); True when one

@@ -154,13 +154,17 @@ class Tickable(RobotHal, Protocol):
 
 @runtime_checkable
 class StateParted(Protocol):
-    """A tickable HAL whose :meth:`Tickable.tick` advances one of ``state_parts`` equal parts
-    of a control period (a native scene at its ``state_rate_hz``): an action starts a new
-    period; a tick with None steps the next part of the period in force."""
+    """A tickable HAL that can also step a control period in ``state_parts`` equal parts
+    (a native scene at its ``state_rate_hz``): :meth:`tick_part` with an action starts a
+    new period; with None it steps the next part of the period in force."""
 
     @property
     def state_parts(self) -> int:
-        """Ticks per control period (1: a tick is a whole period)."""
+        """Parts per control period (1: a part is a whole period)."""
+        ...
+
+    def tick_part(self, action: object | None, *, glide: bool = False) -> bool:
+        """One part of a control period (see the class doc); False while E-stopped."""
         ...
 
 

@@ -213,11 +213,8 @@ class SimAttachedHAL(AttachedSensors, EStopLatch):
         return before
 
     def last_observation(self) -> Observation:
-        """The scene's latest observation (its frames: those due at that step).
-
-        Raises:
-            NotConnected: Before connect.
-        """
+        """The scene's latest observation (its frames: those due at that step); raises
+        NotConnected before connect."""
         return self._require_obs()
 
     # -- commands --------------------------------------------------------------------------
@@ -248,11 +245,8 @@ class SimAttachedHAL(AttachedSensors, EStopLatch):
         self._command(action, glide=False)
 
     def merge(self, action: FloatArray) -> FloatArray:
-        """The scene action to step, from a validated ``action`` and ``_last_env_action``.
-
-        Here the action already is the whole scene action; a HAL that commands only some
-        slots of a wider action overrides this to keep the others from the last one.
-        """
+        """The scene action to step from a validated ``action`` (here the whole of it; a HAL
+        commanding some slots of a wider action keeps the others from the last one)."""
         return np.array(action, dtype=np.float64)
 
     @property
@@ -262,29 +256,36 @@ class SimAttachedHAL(AttachedSensors, EStopLatch):
 
     @property
     def state_parts(self) -> int:
-        """Parts of a control period one :meth:`tick` steps (a native scene's state rate;
+        """Parts of a control period :meth:`tick_part` steps (a native scene's state rate;
         1 for another backend)."""
         return self._scene.parts if self._scene is not None else 1
 
     def tick(self, action: object | None, *, glide: bool = False) -> bool:
-        """One of :attr:`state_parts` parts of a scene step: ``action`` starts a new step
-        with it (see :meth:`send_action`; ``glide`` as :meth:`Tickable.tick
-        <openral_hal.protocol.Tickable.tick>` says, on a native scene); None steps the next
-        part, or starts a step with :meth:`hold_action` (the targets in force on a
-        position-controlled scene, the backend's hold on a delta controller). Returns True
-        when the scene stepped, False (nothing done) while E-stopped.
+        """One scene step: with ``action`` (see :meth:`send_action`; ``glide`` as
+        :meth:`Tickable.tick <openral_hal.protocol.Tickable.tick>` says, on a native scene),
+        or with :meth:`hold_action` when None (the targets in force on a position-controlled
+        scene, the backend's hold on a delta controller); the commanded action is kept.
+        Returns True when the scene stepped, False (nothing done) while E-stopped.
 
         Raises:
             ActionRejected: ``action`` is malformed; nothing is changed.
         """
+        return self._tick(action, glide, part=False)
+
+    def tick_part(self, action: object | None, *, glide: bool = False) -> bool:
+        """One of :attr:`state_parts` parts of a scene step, as :meth:`tick` but: ``action``
+        starts a new step with it; None steps the next part (or starts a step holding)."""
+        return self._tick(action, glide, part=True)
+
+    def _tick(self, action: object | None, glide: bool, part: bool) -> bool:
         self._require_obs()
         if self._estopped:
             return False
         if action is not None:
-            self._command(action, glide=glide, part=True)
+            self._command(action, glide=glide, part=part)
             return True
         self._reset_if_done()
-        if self._scene is not None:
+        if part and self._scene is not None:
             self._stepped(self._scene.step_part(None))
         else:
             self._step(self.hold_action())

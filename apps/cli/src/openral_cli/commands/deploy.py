@@ -31,6 +31,7 @@ from openral_core.errors import OpenralError
 from openral_cli.browser_view import DEFAULT_VIEW_PORT, View, ViewPort
 from openral_cli.commands.recording import start_recording, stop_recording
 from openral_cli.console import out
+from openral_cli.deploy_interfaces import print_interfaces
 from openral_cli.help_text import command_group
 from openral_cli.ros_available import require_ros
 
@@ -55,6 +56,20 @@ NoTf = Annotated[
     typer.Option(
         "--no-tf",
         help="Publish no /tf or /tf_static (another node, e.g. robot_state_publisher, does).",
+    ),
+]
+NoStaticTf = Annotated[
+    bool,
+    typer.Option(
+        "--no-static-tf",
+        help="With --no-tf, also leave out the frames no URDF holds (world, odom, scene cameras).",
+    ),
+]
+Namespace = Annotated[
+    str,
+    typer.Option(
+        "--namespace",
+        help="Put the whole graph under this ROS namespace (/arm: /arm/joint_states, ...).",
     ),
 ]
 Duration = Annotated[
@@ -101,6 +116,8 @@ def sim(
         ),
     ] = 100.0,
     no_tf: NoTf = False,
+    no_static_tf: NoStaticTf = False,
+    namespace: Namespace = "",
     duration: Duration = None,
     domain_id: DomainId = None,
     record: Record = None,
@@ -110,7 +127,7 @@ def sim(
 ) -> None:
     """Bring SCENE's robot up as a ROS 2 graph: joint states, cameras, actions, E-stop."""
     parameters = _node_parameters(config, manifest, not no_viewer, camera_rate, joint_state_rate)
-    parameters["publish_tf"] = not no_tf
+    parameters.update(_tf_parameters(no_tf, no_static_tf))
     parameters["view_port"] = view_port if view else 0
     require_ros()
     from openral_nodes.runtime import ros_session
@@ -120,7 +137,7 @@ def sim(
         recorder = None if record is None else start_recording(record, overwrite, domain)
         try:
             title = f"deploy sim: {{robot}} in {config.name}"
-            reason, elapsed_s = _run_graph(context, parameters, title, duration)
+            reason, elapsed_s = _run_graph(context, parameters, title, duration, namespace)
         finally:
             if recorder is not None:
                 stop_recording(recorder)
@@ -154,6 +171,8 @@ def real(
         ),
     ] = None,
     no_tf: NoTf = False,
+    no_static_tf: NoStaticTf = False,
+    namespace: Namespace = "",
     duration: Duration = None,
     domain_id: DomainId = None,
     record: Record = None,
@@ -163,7 +182,7 @@ def real(
     if (robot is None) == (manifest is None):
         raise typer.BadParameter("give the robot: --robot ID or --manifest FILE (one of them)")
     parameters = _real_parameters(robot, manifest, transport, arm_id, calibration, camera)
-    parameters["publish_tf"] = not no_tf
+    parameters.update(_tf_parameters(no_tf, no_static_tf))
     require_ros()
     from openral_nodes.runtime import ros_session
 
@@ -173,7 +192,7 @@ def real(
             recorder = start_recording(record, overwrite, context.get_domain_id())
         try:
             title = f"deploy real: {{robot}} on {transport}"  # {robot}: the node's, once loaded
-            reason, elapsed_s = _run_graph(context, parameters, title, duration)
+            reason, elapsed_s = _run_graph(context, parameters, title, duration, namespace)
         finally:
             if recorder is not None:
                 stop_recording(recorder)
@@ -205,8 +224,19 @@ def _real_parameters(
     }
 
 
+def _tf_parameters(no_tf: bool, no_static_tf: bool) -> dict[str, Any]:
+    """``publish_tf`` and ``publish_static_tf`` of ``--no-tf`` and ``--no-static-tf``."""
+    if no_static_tf and not no_tf:
+        raise typer.BadParameter("--no-static-tf goes with --no-tf (it narrows what --no-tf keeps)")
+    return {"publish_tf": not no_tf, "publish_static_tf": not no_static_tf}
+
+
 def _run_graph(
-    context: Context, parameters: dict[str, Any], title: str, duration: float | None
+    context: Context,
+    parameters: dict[str, Any],
+    title: str,
+    duration: float | None,
+    namespace: str = "",
 ) -> tuple[str, float]:
     """Bring the node up, serve until a signal, ``duration`` or a shutdown transition, then
     take it down; why it stopped and how long it ran [s]."""
@@ -214,7 +244,7 @@ def _run_graph(
     from rclpy.executors import SingleThreadedExecutor
 
     stop = threading.Event()
-    node = _make_node(context, parameters, stop)
+    node = _make_node(context, parameters, stop, namespace)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
     previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in STOP_SIGNALS}
@@ -222,7 +252,7 @@ def _run_graph(
     try:
         _transition(node, "configure")
         _transition(node, "activate")
-        _print_interfaces(node, title)
+        print_interfaces(node, title)
         spin_until(executor, stop, timeout_s=duration)
     finally:
         reason = _shut_down(node, stop)
@@ -264,15 +294,22 @@ def _require_file(
 
 
 def _make_node(
-    context: Context, parameters: dict[str, Any], stop: threading.Event
+    context: Context, parameters: dict[str, Any], stop: threading.Event, namespace: str = ""
 ) -> ManifestLifecycleNode:
     """The manifest node as deploy runs it: boot errors reported by the caller, ``stop``
-    set by a shutdown transition (also one requested over ROS)."""
+    set by a shutdown transition (also one requested over ROS), in ``namespace``."""
     from openral_nodes.manifest_node import ManifestLifecycleNode
 
-    node = ManifestLifecycleNode(
-        context=context, parameter_overrides=parameters, log_boot_errors=False, shutdown_event=stop
-    )
+    try:
+        node = ManifestLifecycleNode(
+            context=context,
+            namespace=namespace,
+            parameter_overrides=parameters,
+            log_boot_errors=False,
+            shutdown_event=stop,
+        )
+    except Exception as error:  # rclpy's InvalidNamespaceException and kin
+        raise OpenralError(f"--namespace {namespace!r}: {error}".splitlines()[0]) from None
     node.heap.enabled = True  # short garbage collections while active (heap_freeze)
     return node
 
@@ -302,58 +339,3 @@ def _shut_down(node: ManifestLifecycleNode, stop: threading.Event) -> str:
     if state == "inactive":
         node.trigger_cleanup()  # type: ignore[no-untyped-call]
     return "signal" if stop.is_set() else "--duration"
-
-
-def _print_interfaces(node: ManifestLifecycleNode, title: str) -> None:
-    """What the graph offers: published topics in a table (fits 80 columns), then inputs."""
-    from openral_bridge.topics import (
-        CMD_VEL,
-        EE_TARGET,
-        ESTOP,
-        FOLLOW_JOINT_TRAJECTORY,
-        JOINT_TRAJECTORY,
-        RELEASE_ESTOP,
-        RESET,
-        SAFE_ACTION,
-    )
-    from rich import box
-    from rich.table import Table
-
-    names, _ = node.action_layout()
-    robot = node.description.name if node.description is not None else "?"
-    table = Table(
-        title=title.format(robot=robot),
-        box=box.SIMPLE_HEAD,
-        pad_edge=False,
-    )
-    for column in ("published topic", "type", "rate"):
-        table.add_column(column, overflow="fold")
-    for topic in node.topics():
-        rate = f"{topic.rate_hz:g} Hz {topic.when}" if topic.rate_hz else topic.when or "latched"
-        table.add_row(topic.name, topic.type, rate.strip())
-    out.print(table, soft_wrap=False)
-    out.print(
-        f"actions:  {SAFE_ACTION} (std_msgs/msg/Float64MultiArray, {len(names)} values: "
-        f"{', '.join(names)})",
-        soft_wrap=False,
-    )
-    if node.commands is not None and node.commands.follows_trajectories:
-        kind = "trajectory_msgs/msg/JointTrajectory, joints by manifest name"
-        out.print(f"          {JOINT_TRAJECTORY} ({kind})", soft_wrap=False)
-        kind = "control_msgs/action/FollowJointTrajectory"
-        out.print(f"          {FOLLOW_JOINT_TRAJECTORY} ({kind})", soft_wrap=False)
-    if node.bridge is not None and node.bridge.ee is not None:
-        frame = node.bridge.ee.follower.base_frame
-        kind = f"geometry_msgs/msg/PoseStamped, the TCP in {frame}"
-        out.print(f"          {EE_TARGET} ({kind})", soft_wrap=False)
-    if node.bridge is not None and node.bridge.base is not None:
-        out.print(f"base:     {CMD_VEL} (geometry_msgs/msg/Twist, base frame)", soft_wrap=False)
-    out.print(f"E-stop:   {ESTOP}, {RELEASE_ESTOP} (std_srvs/srv/Trigger)", soft_wrap=False)
-    if node.loop is not None and node.hal is not None and not node.hal.is_real:
-        out.print(f"reset:    {RESET} (std_srvs/srv/Trigger)", soft_wrap=False)
-    view = node.bridge.view if node.bridge is not None else None
-    if view is not None:
-        out.print(f"view:     {view.feed.view.ports.url}", soft_wrap=True, markup=False)
-    out.print(
-        "running; stop with Ctrl-C. In a second terminal: openral ros topics", soft_wrap=False
-    )

@@ -39,8 +39,8 @@ def services(
 
 @app.command("actions")
 def actions(wait: DiscoveryWait = 2.0, domain_id: DomainId = None) -> None:
-    """Table of the actions in the graph: name and type(s), found from their hidden
-    `<name>/_action/feedback` topics."""
+    """Table of the actions in the graph: name and type(s), found from the hidden
+    feedback topic (NAME/_action/feedback) each action server publishes."""
     require_ros()
     listing, domain, waited = _listing(wait, domain_id, include_hidden=False)
     _print_interfaces("action", listing.actions, domain, waited)
