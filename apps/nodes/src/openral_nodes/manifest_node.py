@@ -326,16 +326,9 @@ class ManifestLifecycleNode(NamespacedEntities, LifecycleNode):
         spec_msg.header.stamp = sim_stamp(self, sim_time_s)
         spec.publish(spec_msg)
         rate_hz = float(self._param("joint_state_rate_hz"))
-        self.states = RobotStateStreams(
-            self,
-            hal,
-            self.hal_lock,
-            self.loop,
-            rate_hz,
-            self._loaded,
-            bool(self._param("publish_tf")),
-            self._texts,
-        )
+        tf = (bool(self._param("publish_tf")), bool(self._param("publish_static_tf")))
+        loop, loaded, texts = self.loop, self._loaded, self._texts
+        self.states = RobotStateStreams(self, hal, self.hal_lock, loop, rate_hz, loaded, tf, texts)
         self.states.start(pacer)
         rules = self.description.trajectory if self.description is not None else None
         self.commands = CommandInterfaces(

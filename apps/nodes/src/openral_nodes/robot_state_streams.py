@@ -39,7 +39,11 @@ from openral_core.loaded import LoadedRobot
 from openral_hal.errors import HalError
 from openral_hal.protocol import FramesHal, MobileBaseHal, RobotHal
 from openral_sim.frame_tree import FrameTree
-from openral_sim.robot_description import scene_robot_description, scene_semantic_description
+from openral_sim.robot_description import (
+    scene_robot_description,
+    scene_semantic_description,
+    urdf_transforms,
+)
 
 if TYPE_CHECKING:
     from rclpy.node import Node
@@ -56,7 +60,7 @@ class RobotStateStreams:
         loop: ControlLoop | None,
         rate_hz: float,
         robot: LoadedRobot | None,
-        publish_tf: bool = True,
+        tf: tuple[bool, bool] = (True, True),
         texts: tuple[str, str] | None = None,
     ) -> None:
         """Lay out the frames (nothing is published until :meth:`start`).
@@ -68,8 +72,12 @@ class RobotStateStreams:
             loop: The control loop of a simulated HAL (None for a real one).
             rate_hz: The joint-state rate, also the highest ``/tf`` rate [Hz].
             robot: The loaded robot (for its URDF).
-            publish_tf: False leaves ``/tf`` and ``/tf_static`` to another node (a
-                robot_state_publisher fed by our ``/joint_states`` and ``/robot_description``).
+            tf: (publish_tf, publish_static_tf). publish_tf False leaves the URDF's
+                transforms to another node (a robot_state_publisher fed by our
+                ``/joint_states`` and ``/robot_description``): only the frames no URDF
+                holds are sent (the world, the odometry frame and the base on it, scene
+                cameras); publish_static_tf False then leaves out the static ones of those
+                too (a mobile base's moving transform is still sent).
             texts: The URDF and SRDF made beforehand (:func:`descriptions_before_connect`);
                 None: made on threads after start.
         """
@@ -84,8 +92,12 @@ class RobotStateStreams:
             rate_hz = 1.0 / loop.tick_period_s
         self.states = JointStatePublisher(node, rate_hz, source)
         self.tf = None
-        if publish_tf and tree is not None and data is not None:
-            self.tf = TfPublisher(node, tree, data, rate_hz)
+        publish_tf, publish_static_tf = tf
+        if (publish_tf or publish_static_tf) and tree is not None and data is not None:
+            leave_out = frozenset() if publish_tf else urdf_transforms(tree)
+            self.tf = TfPublisher(node, tree, data, rate_hz, leave_out)
+            if not publish_tf and not publish_static_tf:
+                self.tf.static = self.tf.static[:0]
         self.description = self.semantic = None
         if tree is not None and robot is not None:
             name, loaded = robot.name, robot

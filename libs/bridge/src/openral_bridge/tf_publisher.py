@@ -44,7 +44,14 @@ TF_STATIC_QOS = ros_messages.LATCHED
 class TfPublisher:
     """The frames of one scene on ``/tf`` and ``/tf_static`` (see the module doc)."""
 
-    def __init__(self, node: Node, tree: FrameTree, data: mujoco.MjData, rate_hz: float) -> None:
+    def __init__(
+        self,
+        node: Node,
+        tree: FrameTree,
+        data: mujoco.MjData,
+        rate_hz: float,
+        leave_out: frozenset[str] = frozenset(),
+    ) -> None:
         """Nothing is created until :meth:`start`.
 
         Args:
@@ -52,16 +59,25 @@ class TfPublisher:
             tree: The scene's frame tree.
             data: The scene's live data (read only by :meth:`capture`).
             rate_hz: Highest ``/tf`` rate [Hz] (the joint-state rate).
+            leave_out: Frames whose transform another node publishes (``--no-tf``: those a
+                robot_state_publisher takes from the URDF).
         """
         self.node, self.tree, self.data, self.rate_hz = node, tree, data, float(rate_hz)
+        names = tree.frames
+        self.static = np.array([r for r in tree.static if names[r].name not in leave_out], np.intp)
+        """Rows of the static transforms sent."""
+        self.dynamic = np.array(
+            [r for r in tree.dynamic if names[r].name not in leave_out], np.intp
+        )
+        """Rows of the dynamic transforms sent."""
         self.published = 0
         """``/tf`` messages sent since :meth:`start`."""
         self._latest: FrameSample | None = None
         self._sent: FrameSample | None = None
         self._out = PacedPublishers(node)
         self._tick_hz = self.rate_hz
-        self._dynamic = _message(tree, tree.dynamic)
-        self._static = _message(tree, tree.static)
+        self._dynamic = _message(tree, self.dynamic)
+        self._static = _message(tree, self.static)
 
     def capture(self) -> None:
         """Copy every frame's world pose (the control loop calls it holding the HAL's lock)."""
@@ -91,9 +107,9 @@ class TfPublisher:
     def publish(self) -> None:
         """Send the dynamic transforms of the newest capture, unless already sent."""
         sample, publishers = self._latest, self._out.publishers
-        if sample is None or not publishers or sample is self._sent or not len(self.tree.dynamic):
+        if sample is None or not publishers or sample is self._sent or not len(self.dynamic):
             return
-        _fill(self._dynamic, sample, self.tree, self.tree.dynamic)
+        _fill(self._dynamic, sample, self.tree, self.dynamic)
         publishers[0].publish(self._dynamic)
         self._sent = sample
         self.published += 1
@@ -102,7 +118,7 @@ class TfPublisher:
         """Send every static transform of the newest capture (after start and each reset)."""
         sample, publishers = self._latest, self._out.publishers
         if sample is not None and publishers:
-            _fill(self._static, sample, self.tree, self.tree.static)
+            _fill(self._static, sample, self.tree, self.static)
             publishers[1].publish(self._static)
 
     def topics(self) -> list[TopicInfo]:

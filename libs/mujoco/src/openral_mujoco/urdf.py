@@ -24,6 +24,8 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 from collections import Counter
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
@@ -45,8 +47,22 @@ ORIGIN_DECIMALS = 12
 """Decimals of an origin's numbers [m, rad]."""
 
 
+@dataclass(frozen=True)
+class FixedFrame:
+    """A frame fixed on a link of the tree (a sensor's): no geometry, a fixed joint."""
+
+    name: str
+    parent: str
+    position: Vector
+    quat: Quaternion
+
+
 def urdf_text(
-    tree: RobotTree, model: mujoco.MjModel, name: str, meshes: MeshExporter | None = None
+    tree: RobotTree,
+    model: mujoco.MjModel,
+    name: str,
+    meshes: MeshExporter | None = None,
+    frames: Sequence[FixedFrame] = (),
 ) -> str:
     """The URDF of ``tree`` (read from ``model``) as a ``<robot name=name>`` document.
 
@@ -55,6 +71,8 @@ def urdf_text(
         model: The compiled model the tree was read from (geoms, inertias, meshes).
         name: The robot's name.
         meshes: Writes the mesh files; default a :class:`MeshExporter` of ``model``.
+        frames: Frames to add as empty links on fixed joints ``<frame>_joint``, parents
+            first (a sensor's frames, :mod:`openral_sim.robot_description`).
 
     Raises:
         TreeUnsupported: Two links or two joints would share a name.
@@ -67,6 +85,9 @@ def urdf_text(
         if link.parent is not None:
             _add_joints(robot, link)
         robot.append(_link(model, link, exporter))
+    for frame in frames:
+        _fixed(robot, frame.parent, frame.name, frame.position, frame.quat, f"{frame.name}_joint")
+        ET.SubElement(robot, "link", name=frame.name)
     ET.indent(robot, space="  ")
     return '<?xml version="1.0"?>\n' + ET.tostring(robot, encoding="unicode") + "\n"
 

@@ -41,6 +41,10 @@ from openral_sim.base_drive import BaseDrive
 IntArray = npt.NDArray[np.intp]
 OPTICAL = np.array([0.0, 1.0, 0.0, 0.0])
 """Half a turn about x (w, x, y, z): a MuJoCo camera frame → its REP 103 optical frame."""
+CAMERA_LINK = np.array([0.5, -0.5, 0.5, 0.5])
+"""A MuJoCo camera frame → its camera link (x forward = -z, y left = -x, z up = y)."""
+OPTICAL_SUFFIX = "_optical_frame"
+"""A camera frame_id ending so gets a camera link named with ``_link`` instead."""
 
 
 class FrameTreeError(HalError):
@@ -54,6 +58,10 @@ class SensorFrame:
     frame_id: str
     camera: int = -1
     site: int = -1
+    parent: str = ""
+    """The frame it hangs from ("": the link of its body, or the world)."""
+    body_axes: bool = False
+    """A camera's link (REP 103 body axes: x forward, z up) instead of its optical frame."""
 
 
 @dataclass(frozen=True)
@@ -138,6 +146,11 @@ class FrameTree:
         self.dynamic = np.array([i for i, f in enumerate(frames) if not f.static], np.intp)
 
     @property
+    def sensor_rows(self) -> tuple[int, ...]:
+        """The rows of the sensors' frames in :attr:`frames`, in order."""
+        return tuple(row for row, _ in self._sensors)
+
+    @property
     def names_of_frames(self) -> tuple[str, ...]:
         """Every frame's name, the world first."""
         return tuple(frame.name for frame in self.frames)
@@ -194,7 +207,7 @@ class FrameTree:
             fixed_mount = True
         else:
             raise FrameTreeError(f"frame {sensor.frame_id!r} has neither a camera nor a site")
-        parent = link_of.get(body, self.names.world)
+        parent = sensor.parent or link_of.get(body, self.names.world)
         on_world = body == 0 or int(model.body_weldid[body]) == 0
         static = fixed_mount and (body in link_of or on_world)
         return Frame(sensor.frame_id, parent, static)
@@ -225,16 +238,28 @@ def scene_frame_tree(
         HalError: See :class:`FrameTree` and :func:`~openral_mujoco.robot_tree.robot_tree`.
     """
     tree = robot_tree(model, robot.description, robot.tables, addresses)
+    taken = {link.name for link in tree.links} | {s.frame_id for s in robot.description.sensors}
     sensors = []
     for sensor in robot.description.sensors:
         if sensor.name in cameras:
             camera = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, cameras[sensor.name])
-            sensors.append(SensorFrame(sensor.frame_id, camera=camera))
+            link = camera_link(sensor.frame_id)
+            if link is not None and link not in taken:  # camera link, then its optical frame
+                taken.add(link)
+                sensors.append(SensorFrame(link, camera=camera, body_axes=True))
+            sensors.append(SensorFrame(sensor.frame_id, camera=camera, parent=link or ""))
         elif isinstance(sensor, SiteSensor):
             site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, sensor.site)
             if site >= 0:
                 sensors.append(SensorFrame(sensor.frame_id, site=site))
     return FrameTree(model, robot.tables.frames, tree, sensors, base)
+
+
+def camera_link(frame_id: str) -> str | None:
+    """The camera link of an optical frame ``<name>_optical_frame``: ``<name>_link``."""
+    if not frame_id.endswith(OPTICAL_SUFFIX) or frame_id == OPTICAL_SUFFIX:
+        return None
+    return frame_id[: -len(OPTICAL_SUFFIX)] + "_link"
 
 
 # -- poses -----------------------------------------------------------------------------------
@@ -259,9 +284,9 @@ def _sensor_pose(data: mujoco.MjData, sensor: SensorFrame) -> tuple[FloatArray, 
     quat = np.empty(4)
     if sensor.camera >= 0:
         mujoco.mju_mat2Quat(quat, data.cam_xmat[sensor.camera])
-        optical = np.empty(4)
-        mujoco.mju_mulQuat(optical, quat, OPTICAL)
-        return np.array(data.cam_xpos[sensor.camera]), optical
+        turned = np.empty(4)
+        mujoco.mju_mulQuat(turned, quat, CAMERA_LINK if sensor.body_axes else OPTICAL)
+        return np.array(data.cam_xpos[sensor.camera]), turned
     mujoco.mju_mat2Quat(quat, data.site_xmat[sensor.site])
     return np.array(data.site_xpos[sensor.site]), quat
 

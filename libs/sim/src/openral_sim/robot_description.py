@@ -16,10 +16,13 @@ Example::
 
 from __future__ import annotations
 
+import mujoco
+import numpy as np
 from openral_core.loaded import LoadedRobot
 from openral_mujoco.robot_tree import robot_tree
 from openral_mujoco.srdf import srdf_text
-from openral_mujoco.urdf import urdf_text
+from openral_mujoco.state import FloatArray
+from openral_mujoco.urdf import FixedFrame, urdf_text
 
 from openral_sim.frame_tree import FrameTree
 from openral_sim.scene_base import robot_alone
@@ -59,7 +62,45 @@ def scene_robot_description(frames: FrameTree, name: str) -> str:
         TreeUnsupported: Two links or two joints would share a name.
         MeshExportFailed: A mesh file could not be written.
     """
-    return urdf_text(frames.tree, frames.model, name)
+    return urdf_text(frames.tree, frames.model, name, frames=sensor_frames(frames))
+
+
+def sensor_frames(frames: FrameTree) -> list[FixedFrame]:
+    """The sensors' frames fixed on the robot (a camera's link and optical frame, an F-T,
+    lidar or IMU site), each posed in its parent, parents first: what robot_state_publisher
+    needs to place them from the URDF alone. A sensor on a moving mount or off the robot
+    (a scene camera) is not the robot's: it stays on ``/tf``."""
+    data = mujoco.MjData(frames.model)
+    mujoco.mj_forward(frames.model, data)
+    sample = frames.sample(data)
+    on_robot = {link.name for link in frames.tree.links}
+    rows = []
+    for row in frames.sensor_rows:
+        frame = frames.frames[row]
+        if frame.static and frame.parent in on_robot:
+            on_robot.add(frame.name)
+            rows.append(row)
+    positions, quats = sample.relative(frames, np.array(rows, dtype=np.intp))
+    return [
+        FixedFrame(frames.frames[row].name, frames.frames[row].parent, _vec(p), _quat(q))
+        for row, p, q in zip(rows, positions, quats, strict=True)
+    ]
+
+
+def urdf_transforms(frames: FrameTree) -> frozenset[str]:
+    """The frames whose transform the scene's URDF holds (a robot_state_publisher sends
+    them): the robot's links below its root and :func:`sensor_frames`. The root's own
+    transform (world or odometry → base) is no URDF's."""
+    links = {link.name for link in frames.tree.links} - {frames.tree.base}
+    return frozenset(links | {frame.name for frame in sensor_frames(frames)})
+
+
+def _vec(values: FloatArray) -> tuple[float, float, float]:
+    return float(values[0]), float(values[1]), float(values[2])
+
+
+def _quat(values: FloatArray) -> tuple[float, float, float, float]:
+    return float(values[0]), float(values[1]), float(values[2]), float(values[3])
 
 
 def scene_semantic_description(frames: FrameTree, robot: LoadedRobot) -> str:
