@@ -643,6 +643,24 @@ A TF frame id: starts with a letter; letters, digits, `_` and `/` (never a leadi
 """
 
 
+class JointLimits(OpenralModel):
+    """
+    A joint's velocity and effort limits.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    velocity_limit: Annotated[StrictFloat, Field(gt=0.0, le=1000.0)]
+    """
+    Largest speed [rad/s or m/s].
+    """
+    effort_limit: Annotated[StrictFloat, Field(gt=0.0, le=1000000.0)]
+    """
+    Largest effort [N·m or N].
+    """
+
+
 class ExtraLink(OpenralModel):
     """
     A link rigidly fixed to another, with no body in the model.
@@ -864,6 +882,18 @@ class Frames(OpenralModel):
     ] = {}
     """
     Names of the joints the manifest does not list: an MJCF joint's name (a finger that mimics another) or a link's name (as `links` names it) for the fixed joint into that link → joint name. Default: the MJCF name; the fixed joint into link L is `L_fixed`. Manifest joints keep the manifest's names.
+    """
+    joint_limits: Annotated[
+        dict[MjcfName, JointLimits],
+        Field(
+            examples=[
+                {"joint_torso_height": {"velocity_limit": 0.1, "effort_limit": 1000.0}}
+            ],
+            validate_default=True,
+        ),
+    ] = {}
+    """
+    Velocity and effort limits of joints the manifest does not list (a passive or held joint, such as a mobile base's torso slide), by MJCF joint name, for the URDF. Default: no velocity limit (0, which MoveIt reads as a joint that cannot move) and the effort of the actuator driving the joint. A mimic joint takes its leader's limits.
     """
     extra_links: Annotated[list[ExtraLink], Field(validate_default=True)] = []
     """

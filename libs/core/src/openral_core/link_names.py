@@ -44,6 +44,8 @@ class LinkNaming:
     joints: dict[str, str] = field(default_factory=dict)
     """MJCF joint name, or a link's name for the fixed joint into it → joint name."""
     extra_links: tuple[ExtraLinkWiring, ...] = ()
+    limits: dict[str, tuple[float, float]] = field(default_factory=dict)
+    """MJCF joint name → (velocity [rad/s or m/s], effort [N·m or N]) of an unlisted joint."""
 
     def link(self, body: str) -> str:
         """The link name of the MJCF body ``body``."""
@@ -71,7 +73,8 @@ class LinkNaming:
             )
             for e in data.get("extra_links", ())
         )
-        return cls(dict(data.get("links", {})), dict(data.get("joints", {})), extras)
+        limits = {k: (float(v[0]), float(v[1])) for k, v in data.get("limits", {}).items()}
+        return cls(dict(data.get("links", {})), dict(data.get("joints", {})), extras, limits)
 
 
 def link_naming(robot: RobotDescription) -> LinkNaming:
@@ -88,7 +91,11 @@ def link_naming(robot: RobotDescription) -> LinkNaming:
         )
         for extra in frames.extra_links
     )
-    return LinkNaming(dict(frames.links), dict(frames.joints), extras)
+    limits = {
+        name: (float(limit.velocity_limit), float(limit.effort_limit))
+        for name, limit in frames.joint_limits.items()
+    }
+    return LinkNaming(dict(frames.links), dict(frames.joints), extras, limits)
 
 
 def _vector(values: Any) -> Vector:

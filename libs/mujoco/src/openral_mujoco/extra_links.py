@@ -100,6 +100,13 @@ def check_renames(naming: LinkNaming, bodies: set[str], links: list[TreeLink]) -
         )
     joints = {link.joint.mjcf_name for link in links if link.joint and not link.joint.manifest}
     named = joints | {link.name for link in links}
+    unlisted = sorted(set(naming.limits) - joints)
+    if unlisted:
+        raise TreeUnsupported(
+            f"frames.joint_limits: {unlisted[0]!r} is no joint of the robot's model that the "
+            f"manifest does not list (the manifest's own have its limits; joints: "
+            f"{', '.join(sorted(joints)) or 'none'})"
+        )
     unknown = sorted(set(naming.joints) - named)
     if unknown:
         raise TreeUnsupported(

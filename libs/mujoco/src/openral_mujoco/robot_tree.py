@@ -309,6 +309,7 @@ class _JointReader:
         if slide and not limited:
             lower, upper, limited = -UNLIMITED_SLIDE_M, UNLIMITED_SLIDE_M, True
         kind = "prismatic" if slide else ("revolute" if limited else "continuous")
+        listed = self.naming.limits.get(mjcf) or (0.0, effort_limit(model, joint))
         return TreeJoint(
             name=declared.name if declared is not None else self.naming.joint(mjcf),
             mjcf_name=mjcf,
@@ -317,10 +318,8 @@ class _JointReader:
             anchor=_vector(model.jnt_pos[joint]),
             lower=lower,
             upper=upper,
-            velocity=float(declared.velocity_limit) if declared is not None else 0.0,
-            effort=float(declared.effort_limit)
-            if declared is not None
-            else effort_limit(model, joint),
+            velocity=float(declared.velocity_limit) if declared is not None else listed[0],
+            effort=float(declared.effort_limit) if declared is not None else listed[1],
             qpos=int(model.jnt_qposadr[joint]),
             dof=int(model.jnt_dofadr[joint]),
             manifest=declared is not None,
