@@ -47,5 +47,5 @@ def test_an_unknown_joint_limits_key_is_refused(tmp_path: Path) -> None:
     assert typo != text
     (folder / "robot.yaml").write_text(typo)
     robot = open_robot(folder / "robot.yaml")
-    with pytest.raises(TreeUnsupported, match="frames.joint_limits: 'joint_torso_heigth' is no"):
+    with pytest.raises(TreeUnsupported, match=r"frames\.joint_limits: 'joint_torso_heigth' is no"):
         robot_description(robot)
