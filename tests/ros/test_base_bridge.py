@@ -8,6 +8,7 @@ import threading
 from collections.abc import Iterator
 from typing import Any
 
+import numpy as np
 import pytest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
@@ -94,6 +95,11 @@ def test_cmd_vel_0_3_m_s_for_2_s_moves_the_base_0_6_m_in_odom(rig: Rig) -> None:
     wait_until(lambda: bool(rig.odometry), what="/odom after the drive")
     odom = rig.odometry[-1]
     assert odom.header.frame_id == "odom" and odom.child_frame_id == "base_link"
+    for covariance in (odom.pose.covariance, odom.twist.covariance):  # the planar drive's
+        matrix = np.reshape(covariance, (6, 6))
+        assert np.all(np.diag(matrix) > 0) and not np.any(matrix - np.diag(np.diag(matrix)))
+        planar, fixed = np.diag(matrix)[[0, 1, 5]], np.diag(matrix)[[2, 3, 4]]
+        assert planar.min() > fixed.max()  # x, y, yaw move; z, roll, pitch cannot
     assert odom.pose.pose.position.x == pytest.approx(0.6, abs=0.05)
     assert abs(odom.pose.pose.position.y) < 0.01
     assert abs(odom.twist.twist.linear.x) < 0.01  # stopped

@@ -49,3 +49,15 @@ def test_an_unknown_joint_limits_key_is_refused(tmp_path: Path) -> None:
     robot = open_robot(folder / "robot.yaml")
     with pytest.raises(TreeUnsupported, match=r"frames\.joint_limits: 'joint_torso_heigth' is no"):
         robot_description(robot)
+
+
+def test_relative_mesh_paths_compile_in_mujoco(tmp_path: Path) -> None:
+    """``--mesh-uri relative``'s form: meshes beside the URDF, named by relative path, which
+    MuJoCo's own URDF compiler loads (it cannot open ``file://`` URIs)."""
+    import mujoco
+
+    text = robot_description(open_robot_by_id("franka_panda"), beside=tmp_path)
+    assert "file://" not in text and 'filename="meshes/' in text
+    (tmp_path / "panda.urdf").write_text(text)
+    model = mujoco.MjModel.from_xml_path(str(tmp_path / "panda.urdf"))
+    assert model.nmesh > 0 and model.njnt == 9

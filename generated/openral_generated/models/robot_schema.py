@@ -643,6 +643,15 @@ A TF frame id: starts with a letter; letters, digits, `_` and `/` (never a leadi
 """
 
 
+UrdfJointName = TypeAliasType(
+    "UrdfJointName",
+    Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/-]{0,126}$")],
+)
+"""
+A URDF joint name: starts with a letter; letters, digits, `_`, `/` and `-` (vendors write such names, e.g. ur_description's `base_link-base_link_inertia`).
+"""
+
+
 class JointLimits(OpenralModel):
     """
     A joint's velocity and effort limits.
@@ -677,7 +686,7 @@ class ExtraLink(OpenralModel):
     """
     The link it is fixed to (as `links` names it), or the base frame.
     """
-    joint: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/]{0,126}$")]
+    joint: Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/-]{0,126}$")]
     """
     The name of the fixed joint from `parent` to it.
     """
@@ -870,7 +879,7 @@ class Frames(OpenralModel):
     Link names for bodies of the robot: MJCF body name → link name. A body not listed keeps its MJCF name. TF, the URDF, the SRDF and every frame_id (sensors mounted on a body, the TCP's parent) follow.
     """
     joints: Annotated[
-        dict[FrameName, FrameName],
+        dict[FrameName, UrdfJointName],
         Field(
             examples=[
                 {

@@ -12,7 +12,10 @@
   rate, on the node's :class:`~openral_bridge.pacer.Pacer`): header frame ``odom_frame``,
   child frame ``base_frame`` (both from the manifest), pose in the odometry frame (where
   the base frame was at the last reset, REP 105), twist in the base frame, stamped in
-  simulated time. The simulation knows the pose exactly, so the covariances are zero.
+  simulated time. Covariances follow the drive (a holonomic planar base): the simulation
+  knows the pose exactly, so the dims the base moves in (x, y, yaw; vx, vy, wz) carry
+  :data:`PLANAR_VARIANCE` (never zero: a filter fusing it must not meet a singular matrix),
+  and the dims it cannot move in (z, roll, pitch and their rates) :data:`FIXED_VARIANCE`.
 
 Every call into the HAL is made holding ``lock`` (the node's lock around its HAL), so it
 never overlaps a control tick running on the pacer's thread.
@@ -39,6 +42,16 @@ if TYPE_CHECKING:
 
     from openral_bridge.control_loop import ControlLoop
 
+PLANAR_VARIANCE = 1e-6
+"""Variance of x, y [m²], yaw [rad²] and of vx, vy, wz: a 1 mm / 1 mrad floor."""
+FIXED_VARIANCE = 1e-9
+"""Variance of z, roll, pitch and their rates: held by the floor, known exactly."""
+_PLANAR = (0, 7, 35)
+"""Diagonal indices of x, y and yaw (z-rotation) in a 6x6 row-major covariance."""
+COVARIANCE = [
+    (PLANAR_VARIANCE if i in _PLANAR else FIXED_VARIANCE) if i % 7 == 0 else 0.0 for i in range(36)
+]
+"""The pose and twist covariance of every ``/odom`` message (see the module doc)."""
 WARN_EVERY_S = 2.0
 """At most one warning per this many seconds for a stream of refused commands [s]."""
 
@@ -58,6 +71,7 @@ def odometry_msg(odometry: BaseOdometry) -> Any:
     twist = msg.twist.twist
     twist.linear.x, twist.linear.y = odometry.vx_m_s, odometry.vy_m_s
     twist.angular.z = odometry.wz_rad_s
+    msg.pose.covariance = msg.twist.covariance = COVARIANCE
     return msg
 
 

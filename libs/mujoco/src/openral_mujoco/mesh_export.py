@@ -72,6 +72,16 @@ class MeshExporter:
         self._model = model
         self._folder = folder if folder is not None else mesh_folder()
         self._files: dict[tuple[object, ...], Path] = {}
+        self.relative_to: Path | None = None
+        """Name files relative to this folder (:meth:`geom_name`); None: by file:// URI."""
+
+    def geom_name(self, geom: int) -> str:
+        """How a URDF names :meth:`geom_file`: a ``file://`` URI, or a path relative to
+        :attr:`relative_to` (POSIX separators)."""
+        path = self.geom_file(geom)
+        if self.relative_to is None:
+            return path.as_uri()
+        return Path(os.path.relpath(path, self.relative_to.resolve())).as_posix()
 
     def geom_file(self, geom: int) -> Path:
         """The absolute path of the STL file of mesh, capsule or ellipsoid ``geom``, in the

@@ -26,6 +26,7 @@ import xml.etree.ElementTree as ET
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -63,6 +64,7 @@ def urdf_text(
     name: str,
     meshes: MeshExporter | None = None,
     frames: Sequence[FixedFrame] = (),
+    relative_to: Path | None = None,
 ) -> str:
     """The URDF of ``tree`` (read from ``model``) as a ``<robot name=name>`` document.
 
@@ -73,12 +75,15 @@ def urdf_text(
         meshes: Writes the mesh files; default a :class:`MeshExporter` of ``model``.
         frames: Frames to add as empty links on fixed joints ``<frame>_joint``, parents
             first (a sensor's frames, :mod:`openral_sim.robot_description`).
+        relative_to: Name mesh files by their path relative to this folder (the URDF's: the
+            form MuJoCo's URDF compiler reads) instead of by ``file://`` URI (rviz2's).
 
     Raises:
         TreeUnsupported: Two links or two joints would share a name.
         MeshExportFailed: A mesh file could not be written.
     """
     exporter = meshes if meshes is not None else MeshExporter(model)
+    exporter.relative_to = relative_to
     _require_unique_names(tree)
     robot = ET.Element("robot", name=name)
     for link in tree.links:
@@ -241,7 +246,7 @@ def _place(element: ET.Element, model: mujoco.MjModel, geom: int, meshes: MeshEx
     elif kind == mujoco.mjtGeom.mjGEOM_CYLINDER:
         ET.SubElement(geometry, "cylinder", radius=_number(size[0]), length=_number(2 * size[1]))
     elif kind in EXPORTED:
-        ET.SubElement(geometry, "mesh", filename=meshes.geom_file(geom).as_uri())
+        ET.SubElement(geometry, "mesh", filename=meshes.geom_name(geom))
     else:
         raise TreeUnsupported(f"geom {geom} has type {kind}, which a URDF cannot state")
 

@@ -16,9 +16,12 @@ Example::
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import mujoco
 import numpy as np
 from openral_core.loaded import LoadedRobot
+from openral_mujoco.mesh_export import MeshExporter
 from openral_mujoco.robot_tree import robot_tree
 from openral_mujoco.srdf import srdf_text
 from openral_mujoco.state import FloatArray
@@ -28,9 +31,11 @@ from openral_sim.frame_tree import FrameTree
 from openral_sim.scene_base import robot_alone
 
 
-def robot_description(robot: LoadedRobot) -> str:
+def robot_description(robot: LoadedRobot, beside: Path | None = None) -> str:
     """The robot's URDF text; its mesh files are written to the mesh cache
-    (:mod:`openral_mujoco.mesh_export`) when not there yet.
+    (:mod:`openral_mujoco.mesh_export`) when not there yet and named by ``file://`` URI, or,
+    with ``beside`` (the URDF's folder), written to ``beside/meshes`` and named by relative
+    path (what MuJoCo's URDF compiler reads).
 
     Raises:
         ManifestError: The robot's model does not load or disagrees with its manifest.
@@ -39,7 +44,10 @@ def robot_description(robot: LoadedRobot) -> str:
     """
     alone = robot_alone(robot)
     tree = robot_tree(alone.model, robot.description, robot.tables, alone.addresses)
-    return urdf_text(tree, alone.model, robot.name)
+    if beside is None:
+        return urdf_text(tree, alone.model, robot.name)
+    meshes = MeshExporter(alone.model, beside / "meshes")
+    return urdf_text(tree, alone.model, robot.name, meshes, relative_to=beside)
 
 
 def robot_semantic_description(robot: LoadedRobot) -> str:

@@ -4,6 +4,7 @@ publishes them (/robot_description, /robot_description_semantic)."""
 from __future__ import annotations
 
 from collections.abc import Callable
+from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
@@ -16,21 +17,41 @@ from openral_cli.console import err
 from openral_cli.console import error as print_error
 
 
+class MeshUri(StrEnum):
+    """How ``robot urdf`` names mesh files."""
+
+    file = "file"
+    relative = "relative"
+
+
 def urdf(
     target: Annotated[str, typer.Argument(help="Robot id, manifest file or robot folder.")],
     out_file: Annotated[
         Path | None,
         typer.Option("--out", help="File to write the URDF to.", show_default="standard output"),
     ] = None,
+    mesh_uri: Annotated[
+        MeshUri,
+        typer.Option(
+            "--mesh-uri",
+            help="file: meshes named by file:// URI in the model cache (rviz2, ROS tools); "
+            "relative: written to meshes/ beside --out and named by relative path (MuJoCo's "
+            "URDF compiler reads that form).",
+        ),
+    ] = MeshUri.file,
 ) -> None:
     """The robot's URDF, as the ROS graph publishes it on /robot_description.
 
-    Mesh files (STL) are written once to the model cache and named by absolute path.
-    Exits 1 when the robot does not load or its model has no URDF form.
+    Mesh files (STL) are written once to the model cache and named by file:// URI, or with
+    --mesh-uri relative beside the --out file. Exits 1 when the robot does not load or its
+    model has no URDF form.
     """
     from openral_sim.robot_description import robot_description
 
-    name, text = _text_of(target, robot_description, "URDF")
+    if mesh_uri is MeshUri.relative and out_file is None:
+        raise typer.BadParameter("--mesh-uri relative names meshes beside --out FILE; give it")
+    beside = out_file.resolve().parent if mesh_uri is MeshUri.relative and out_file else None
+    name, text = _text_of(target, lambda robot: robot_description(robot, beside), "URDF")
     if out_file is None:
         typer.echo(text, nl=False)
         return
