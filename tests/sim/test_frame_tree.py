@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import math
+import xml.etree.ElementTree as ET
 import zlib
 from pathlib import Path
 
@@ -24,9 +25,13 @@ from openral_core.loader import load_scene
 from openral_core.models import Backend, LimitedJoint, SiteSensor
 from openral_mujoco.errors import HalError
 from openral_mujoco.robot_tree import BaseKind
-from openral_sim.frame_tree import Frame, FrameTree
+from openral_sim.frame_tree import Frame, FrameTree, camera_link
 from openral_sim.native_scene import NativeScene
-from openral_sim.robot_description import robot_description, scene_robot_description
+from openral_sim.robot_description import (
+    robot_description,
+    scene_robot_description,
+    sensor_frames,
+)
 from openral_sim.scene import build_scene, build_sim_env_from_yaml
 from openral_sim.scene_cameras import camera_sensors
 
@@ -42,6 +47,8 @@ TARGET_SPREAD_RAD = 0.3
 """Largest offset of a random target from the held pose [rad or m], inside the limits."""
 OPTICAL = np.diag([1.0, -1.0, -1.0])
 """A MuJoCo camera frame (looks along -z, y up) → its REP 103 optical frame (z forward)."""
+CAMERA_AXES = np.array([[0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]])
+"""A MuJoCo camera frame → its camera link (REP 103 body axes: x forward, y left, z up)."""
 
 
 def _default_scenes() -> dict[str, Path]:
@@ -153,7 +160,11 @@ def test_chained_transforms_land_on_mujocos_poses(robot_id: str) -> None:
     scene = _moved(robot_id)
     tree, data, model = scene.frame_tree, scene.data, scene.model
     world = _world_poses(tree, data)
-    expected: dict[str, np.ndarray] = {}
+    root = _matrix(data.xpos[tree.tree.root], data.xquat[tree.tree.root])
+    offset = np.eye(4)  # the root body in the base frame: a mobile base's is off its axis
+    if tree.tree.kind is BaseKind.MOBILE and scene.base is not None:
+        offset[:3, 3] = scene.base.root_in_base_frame
+    expected: dict[str, np.ndarray] = {tree.names.base: root @ np.linalg.inv(offset)}
     for link in tree.tree.links:
         if link.body >= 0:
             expected[link.name] = _matrix(data.xpos[link.body], data.xquat[link.body])
@@ -168,14 +179,13 @@ def test_chained_transforms_land_on_mujocos_poses(robot_id: str) -> None:
             camera = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, cameras[sensor.name])
             rotation = data.cam_xmat[camera].reshape(3, 3) @ OPTICAL
             expected[sensor.frame_id] = _from_rotation(data.cam_xpos[camera], rotation)
+            link = camera_link(sensor.frame_id)  # x forward (-z of MuJoCo's camera), z up (y)
+            if link is not None and link in tree.names_of_frames:
+                body_axes = data.cam_xmat[camera].reshape(3, 3) @ CAMERA_AXES
+                expected[link] = _from_rotation(data.cam_xpos[camera], body_axes)
         elif isinstance(sensor, SiteSensor):
             site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, sensor.site)
             expected[sensor.frame_id] = _from_rotation(data.site_xpos[site], data.site_xmat[site])
-    root = _matrix(data.xpos[tree.tree.root], data.xquat[tree.tree.root])
-    offset = np.eye(4)  # the root body in the base frame: a mobile base's is off its axis
-    if tree.tree.kind is BaseKind.MOBILE and scene.base is not None:
-        offset[:3, 3] = scene.base.root_in_base_frame
-    expected[tree.names.base] = root @ np.linalg.inv(offset)
     wrong = {}
     for name, pose in expected.items():
         distance, angle = _errors(world[name], pose)
@@ -262,8 +272,9 @@ def test_a_mobile_base_hangs_from_an_odometry_frame_fixed_at_the_reset() -> None
 def test_a_base_frame_named_after_a_body_of_the_model_is_refused(
     write_manifest: ManifestWriter,
 ) -> None:
-    manifest = write_manifest(
-        ("frames: {base: base}", "frames: {base: base_link}"),
+    manifest = write_manifest(  # the model's non-root body base_link, not renamed
+        ("  links: {base: base_link, base_link: base_link_inertia}\n", ""),
+        ("  joints: {base_link_inertia: base_link-base_link_inertia}\n", ""),
         base=ROBOTS / "ur10e" / "robot.yaml",
         folder="ur10e",
     )
@@ -283,7 +294,14 @@ def test_a_base_frame_named_after_a_body_of_the_model_is_refused(
 
 @pytest.mark.parametrize("robot_id", sorted(SCENES))
 def test_a_scene_publishes_the_urdf_of_the_robot_alone(robot_id: str) -> None:
-    """What the graph reads from its scene's model is what ``openral robot urdf`` writes."""
+    """What the graph reads from its scene's model is what ``openral robot urdf`` writes, and
+    then the sensors' frames fixed on the robot, as empty links on fixed joints."""
     scene = _scene(robot_id)
     published = scene_robot_description(scene.frame_tree, scene.robot.name)
-    assert published == robot_description(scene.robot)
+    alone = robot_description(scene.robot)
+    closing = "</robot>\n"
+    assert published.startswith(alone[: -len(closing)]) and published.endswith(closing)
+    added = ET.fromstring(f"<robot>{published[len(alone) - len(closing) : -len(closing)]}</robot>")
+    frames = {f.name for f in sensor_frames(scene.frame_tree)}
+    assert {link.get("name") for link in added.iter("link")} == frames
+    assert {joint.get("type") for joint in added.iter("joint")} <= {"fixed"}

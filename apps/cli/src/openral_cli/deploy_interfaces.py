@@ -54,6 +54,10 @@ def _inputs(node: ManifestLifecycleNode) -> list[tuple[str, str]]:
         rows.append(("", f"{name(t.JOINT_TRAJECTORY)}, {name(t.JTC_JOINT_TRAJECTORY)} ({kind})"))
         kind = "control_msgs/action/FollowJointTrajectory"
         rows.append(("", f"{name(t.FOLLOW_JOINT_TRAJECTORY)} ({kind})"))
+    bridge = node.bridge
+    if bridge is not None and bridge.ee is not None:
+        kind = f"geometry_msgs/msg/PoseStamped, the TCP in {bridge.ee.follower.base_frame}"
+        rows.append(("", f"{name(t.EE_TARGET)} ({kind})"))
     if commands is not None and commands.surface.gripper is not None:
         axis = commands.surface.gripper.axis
         kind = f"control_msgs/action/GripperCommand, {axis.joint} {list(axis.limits)}"
@@ -63,10 +67,6 @@ def _inputs(node: ManifestLifecycleNode) -> list[tuple[str, str]]:
         services = "list_controllers, list_hardware_interfaces, switch_controller"
         rows.append(("control:", f"{name(t.CONTROLLER_MANAGER)}/{{{services}}}"))
         rows.append(("", f"controllers: {', '.join(manager.controllers)}"))
-    bridge = node.bridge
-    if bridge is not None and bridge.ee is not None:
-        kind = f"geometry_msgs/msg/PoseStamped, the TCP in {bridge.ee.follower.base_frame}"
-        rows.append(("", f"{name(t.EE_TARGET)} ({kind})"))
     if bridge is not None and bridge.base is not None:
         rows.append(("base:", f"{name(t.CMD_VEL)} (geometry_msgs/msg/Twist, base frame)"))
     rows.append(("E-stop:", f"{name(t.ESTOP)}, {name(t.RELEASE_ESTOP)} (std_srvs/srv/Trigger)"))

@@ -251,7 +251,7 @@ class ManifestLifecycleNode(NamespacedEntities, LifecycleNode):
         rows = [TopicInfo(ACTION_SPEC, "sensor_msgs/msg/JointState", None)]
         rows = (self.states.topics() if self.states else []) + rows
         if self.loop is not None and self.hal is not None and can_tick(self.hal):
-            rows.insert(0, TopicInfo(CLOCK, "rosgraph_msgs/msg/Clock", 1.0 / self.loop.period_s))
+            rows.insert(0, TopicInfo(CLOCK, "rosgraph_msgs/msg/Clock", 1 / self.loop.tick_period_s))
         rows += self.commands.topics() if self.commands is not None else []
         rows += self.bridge.topics() if self.bridge else []
         return [replace(row, name=graph_name(self, row.name)) for row in rows]

@@ -30,6 +30,7 @@ from openral_bridge.joint_state_publisher import (
 from openral_bridge.pacer import Pacer
 from openral_bridge.tf_publisher import TfPublisher
 from openral_bridge.topics import (
+    DYNAMIC_JOINT_STATES,
     JOINT_STATES,
     MANIFEST_JOINT_STATES,
     ROBOT_DESCRIPTION_SEMANTIC,
@@ -139,6 +140,7 @@ class RobotStateStreams:
         """What these publish, with their nominal rates."""
         kind, rate = "sensor_msgs/msg/JointState", self.states.rate_hz
         rows = [TopicInfo(JOINT_STATES, kind, rate), TopicInfo(MANIFEST_JOINT_STATES, kind, rate)]
+        rows.append(TopicInfo(DYNAMIC_JOINT_STATES, "control_msgs/msg/DynamicJointState", rate))
         rows += self.tf.topics() if self.tf is not None else []
         for description in (self.description, self.semantic):
             rows += description.topics() if description is not None else []

@@ -91,15 +91,19 @@ def check_scene_cameras(scene: DeployScene, robot: RobotDescription) -> None:
 def state_parts_per_control(scene: DeployScene, substeps: int, timestep_s: float) -> int:
     """In how many equal parts a control period of ``substeps`` physics steps of
     ``timestep_s`` [s] is stepped, so the state advances at about ``options.state_rate_hz``:
-    the divisor of ``substeps`` nearest the asked rate (ties: the faster).
+    the divisor of ``substeps`` nearest the asked rate (ties: the faster); 1 when the rate
+    is left at its default and the control rate is faster.
 
     Raises:
         ManifestError: At ``scene.options.state_rate_hz`` when it is slower than the control
             rate (rule 7 of the scene schema).
     """
     options = scene.scene.options
+    given = options is not None and "state_rate_hz" in options.model_fields_set
     state_hz = options.state_rate_hz if options else 100.0
     control_hz = 1.0 / (substeps * timestep_s)
+    if not given and state_hz < control_hz:  # the default never slows a faster control rate
+        return 1
     if state_hz < control_hz * (1.0 - 1e-9):
         message = (
             f"{state_hz:g} Hz is slower than the control rate ({control_hz:g} Hz); the state "
