@@ -35,10 +35,10 @@ from tests.ros.test_tf_live import (
     START_WAIT_S,
     Graph,
     Recorder,
-    _chain,
     _named_frames,
     _subscribe_to_headers,
     _transforms,
+    unresolved,
 )
 
 pytestmark = pytest.mark.exclusive  # rates of wall time: run alone
@@ -140,12 +140,7 @@ def test_no_tf_leaves_the_urdf_to_a_robot_state_publisher(live: Live) -> None:
     tree = {**_transforms(*sent), **rsp}
     world = live.robot.tables.frames.world
     named = _named_frames(live.graph)
-    lost = {}
-    for frame, topic in named.items():
-        try:
-            _chain(tree, frame, world)
-        except AssertionError as error:
-            lost[frame] = f"(on {topic}) {error}"
+    lost = unresolved(tree, named, world)
     assert not lost, "frames the URDF and the graph do not resolve:\n" + "\n".join(lost.values())
     sensors = {s.frame_id for s in live.robot.description.sensors} & set(rsp)
     resolved = f"{len(named)} frames resolved; sensors in the URDF: {sorted(sensors)}"

@@ -221,6 +221,20 @@ def _chain(tree: dict[str, tuple[str, np.ndarray]], frame: str, top: str) -> np.
     return pose
 
 
+def unresolved(
+    tree: dict[str, tuple[str, np.ndarray]], named: dict[str, str], top: str
+) -> dict[str, str]:
+    """Frame → why, for each frame of ``named`` (frame → topic naming it) that ``tree`` does
+    not chain to ``top``."""
+    lost = {}
+    for frame, topic in named.items():
+        try:
+            _chain(tree, frame, top)
+        except AssertionError as error:
+            lost[frame] = f"(on {topic}) {error}"
+    return lost
+
+
 def _with_tf(recorder: Recorder, messages: list[Any], what: str) -> tuple[Any, Any]:
     """(the newest of ``messages`` whose stamp a /tf message carries too, that /tf message),
     waiting for more of both. /tf is sent from a pacer job at most once per control tick, so
@@ -268,12 +282,7 @@ def test_every_frame_named_resolves_to_the_world(graph: Graph) -> None:
     assert not twice, f"frames with two parents: {twice}"
     tree = _transforms(*transforms)
     named = _named_frames(graph)
-    lost = {}
-    for frame, topic in named.items():
-        try:
-            _chain(tree, frame, world)
-        except AssertionError as error:
-            lost[frame] = f"(on {topic}) {error}"
+    lost = unresolved(tree, named, world)
     assert not lost, "frames with no chain to the world:\n" + "\n".join(lost.values())
     print(f"{graph.robot.name}: {len(named)} frames named on {len(recorder.messages)} topics")
 

@@ -10,11 +10,11 @@ frame_id take their names from the tree.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
 from openral_core.models import Frames, RobotDescription
+from openral_core.tcp_wiring import unit_quaternion
 
 Vector = tuple[float, float, float]
 Quaternion = tuple[float, float, float, float]
@@ -109,6 +109,4 @@ def _quaternion(values: Any) -> Quaternion:
 
 
 def _unit(values: Any) -> Quaternion:
-    w, x, y, z = (float(v) for v in values)
-    norm = math.sqrt(w * w + x * x + y * y + z * z) or 1.0  # rule 27 refuses a zero one
-    return w / norm, x / norm, y / norm, z / norm
+    return unit_quaternion([float(v) for v in values])  # rule 27 refuses a zero one

@@ -27,14 +27,15 @@ def tcp_wiring(tcp: ToolCentrePoint | None) -> TcpWiring | None:
     if tcp is None:
         return None
     frame, kind = (tcp.body, "body") if tcp.body is not None else (tcp.site or "", "site")
-    return TcpWiring(frame, kind, _triple(tcp.offset_m), _unit_quat(tcp.quat_wxyz))
+    return TcpWiring(frame, kind, _triple(tcp.offset_m), unit_quaternion(tcp.quat_wxyz))
 
 
-def _unit_quat(values: list[float] | None) -> tuple[float, float, float, float]:
-    """``values`` normalised (rule 18 bounds how far from unit they may be), else identity."""
-    if values is None:
+def unit_quaternion(values: list[float] | None) -> tuple[float, float, float, float]:
+    """``values`` (w, x, y, z) normalised, else identity (None, or all zero): the manifest's
+    rules bound how far from unit a stored quaternion may be (rules 18 and 27)."""
+    norm = math.hypot(*values) if values is not None else 0.0
+    if values is None or norm == 0.0:
         return (1.0, 0.0, 0.0, 0.0)
-    norm = math.hypot(*values)
     w, x, y, z = (v / norm for v in values)
     return (w, x, y, z)
 

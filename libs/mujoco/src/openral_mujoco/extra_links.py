@@ -100,17 +100,13 @@ def check_renames(naming: LinkNaming, bodies: set[str], links: list[TreeLink]) -
         )
     joints = {link.joint.mjcf_name for link in links if link.joint and not link.joint.manifest}
     named = joints | {link.name for link in links}
-    unlisted = sorted(set(naming.limits) - joints)
-    if unlisted:
-        raise TreeUnsupported(
-            f"frames.joint_limits: {unlisted[0]!r} is no joint of the robot's model that the "
-            f"manifest does not list (the manifest's own have its limits; joints: "
-            f"{', '.join(sorted(joints)) or 'none'})"
-        )
-    unknown = sorted(set(naming.joints) - named)
-    if unknown:
-        raise TreeUnsupported(
-            f"frames.joints: {unknown[0]!r} is neither a joint of the robot's model that the "
-            f"manifest does not list (those keep the manifest's names) nor a link (joints: "
-            f"{', '.join(sorted(joints)) or 'none'})"
-        )
+    listing = f"joints: {', '.join(sorted(joints)) or 'none'}"
+    for field, keys, allowed, what in (
+        ("joint_limits", naming.limits, joints, "is no joint of the robot's model that the "
+         f"manifest does not list (the manifest's own have its limits; {listing})"),
+        ("joints", naming.joints, named, "is neither a joint of the robot's model that the "
+         f"manifest does not list (those keep the manifest's names) nor a link ({listing})"),
+    ):  # fmt: skip
+        unknown = sorted(set(keys) - allowed)
+        if unknown:
+            raise TreeUnsupported(f"frames.{field}: {unknown[0]!r} {what}")
