@@ -110,11 +110,16 @@ def test_twenty_lifecycle_cycles_leak_no_threads_fds_or_ros_entities(
         node.destroy_node()
 
 
-@pytest.mark.parametrize("publish_tf", [True, False])
+@pytest.mark.parametrize(
+    ("publish_tf", "publish_static_tf"), [(True, True), (False, True), (False, False)]
+)
 def test_publish_tf_false_leaves_tf_to_another_node_and_keeps_the_description(
-    ros_context: Context, spinner: Spinner, publish_tf: bool
+    ros_context: Context, spinner: Spinner, publish_tf: bool, publish_static_tf: bool
 ) -> None:
-    node = make_node(ros_context, publish_tf=publish_tf)
+    """--no-tf leaves the URDF's transforms to a robot_state_publisher and keeps sending what
+    no URDF holds (world → base_link, the scene's cameras); --no-static-tf leaves out those
+    too (the fixed Panda then sends no transform at all)."""
+    node = make_node(ros_context, publish_tf=publish_tf, publish_static_tf=publish_static_tf)
     spinner.add_node(node)
     try:
         assert spinner.call(node.trigger_configure) == SUCCESS
@@ -124,8 +129,14 @@ def test_publish_tf_false_leaves_tf_to_another_node_and_keeps_the_description(
             return {p.topic_name for p in node.publishers}
 
         published = spinner.call(topics)
-        assert ({"/tf", "/tf_static"} <= published) is publish_tf
-        assert not ({"/tf", "/tf_static"} & published) or publish_tf
+        assert ({"/tf", "/tf_static"} <= published) is publish_static_tf
+        assert not ({"/tf", "/tf_static"} & published) or publish_static_tf
+        tf = node.states.tf if node.states is not None else None
+        if tf is not None:
+            sent = {tf.tree.frames[int(r)].name for r in [*tf.static, *tf.dynamic]}
+            urdf = {link.name for link in tf.tree.tree.links} - {tf.tree.tree.base}
+            assert bool(sent & urdf) is publish_tf, sent & urdf
+            assert ("agentview_optical_frame" in sent) is publish_static_tf
         assert {"/joint_states", "/robot_description"} <= published
         assert spinner.call(node.trigger_deactivate) == SUCCESS
         assert spinner.call(node.trigger_cleanup) == SUCCESS

@@ -94,11 +94,12 @@ class RobotStateStreams:
         self.states = JointStatePublisher(node, rate_hz, source)
         self.tf = None
         publish_tf, publish_static_tf = tf
-        if (publish_tf or publish_static_tf) and tree is not None and data is not None:
+        if tree is not None and data is not None:
             leave_out = frozenset() if publish_tf else urdf_transforms(tree)
-            self.tf = TfPublisher(node, tree, data, rate_hz, leave_out)
-            if not publish_tf and not publish_static_tf:
-                self.tf.static = self.tf.static[:0]
+            tf_out = TfPublisher(
+                node, tree, data, rate_hz, leave_out, publish_tf or publish_static_tf
+            )
+            self.tf = tf_out if len(tf_out.static) or len(tf_out.dynamic) else None
         self.description = self.semantic = None
         if tree is not None and robot is not None:
             name, loaded = robot.name, robot

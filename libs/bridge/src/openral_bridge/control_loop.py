@@ -88,19 +88,17 @@ class ControlLoop:
             on_tick: Called after every tick that stepped with its simulated time [s]
                 (None for a HAL without one), e.g. to publish ``/clock``.
             lock: The HAL's lock, held while a tick steps and reads it (default: own).
-            follower: The joint trajectories to follow (None: this loop follows none).
-            on_sample: Called with the desired point after each tick that followed a
-                trajectory.
-            on_reset: Called on the loop's thread right after a reset's tick. The HAL lock
-                is not held during these three.
+            follower: The joint trajectories to follow (None: none).
+            on_sample: Called with the desired point of each period that followed one.
+            on_reset: Called on the loop's thread right after a reset's tick (the HAL lock
+                is not held during these three).
         """
         self.node, self.hal, self.on_tick = node, hal, on_tick
         self.lock = lock if lock is not None else threading.Lock()
         self.period_s = float(hal.control_period_s)
         """The control period: actions, trajectory samples and ee steps at its start [s]."""
         parted = hal if isinstance(hal, StateParted) else None
-        self.parts = parted.state_parts if parted is not None else 1
-        self._step = parted.tick_part if parted is not None else hal.tick
+        self.parts, self._step = (parted.state_parts, parted.tick_part) if parted else (1, hal.tick)
         self.tick_period_s = self.period_s / self.parts
         """Simulated time one tick advances: the state period [s]."""
         self._phase = 0  # ticks of the current control period stepped, modulo parts
@@ -108,8 +106,7 @@ class ControlLoop:
         """Ticks that stepped; actions applied; superseded (see above); ticks that raised."""
         self.watch = RealTimeWatch()
         self.state: JointStateSample | None = None
-        """The HAL's state right after the last tick that stepped (read holding the lock);
-        None before one, or after a failed tick."""
+        """The HAL's state after the last tick that stepped (None: none yet, or it failed)."""
         self.follower, self.on_sample, self.on_reset = follower, on_sample, on_reset
         self.followed = 0
         """Ticks that glided along a trajectory or towards an end-effector target."""
@@ -127,7 +124,7 @@ class ControlLoop:
         (and a reset's tick): each copies what it publishes from the live scene, so nothing
         reads the scene in the middle of a step and the copies all show the same state."""
         self._pending: FloatArray | None = None
-        self._slots: dict[int, float] = {}
+        self._slots: dict[int, float] = {}  # command_slots' values for the next period
         self._reset: ResetRequest | None = None
         self._pending_lock = threading.Lock()
         self._job: tuple[Pacer, PacedJob] | None = None

@@ -51,6 +51,7 @@ class TfPublisher:
         data: mujoco.MjData,
         rate_hz: float,
         leave_out: frozenset[str] = frozenset(),
+        static: bool = True,
     ) -> None:
         """Nothing is created until :meth:`start`.
 
@@ -61,10 +62,12 @@ class TfPublisher:
             rate_hz: Highest ``/tf`` rate [Hz] (the joint-state rate).
             leave_out: Frames whose transform another node publishes (``--no-tf``: those a
                 robot_state_publisher takes from the URDF).
+            static: False sends no static transform at all (``--no-static-tf``).
         """
         self.node, self.tree, self.data, self.rate_hz = node, tree, data, float(rate_hz)
         names = tree.frames
-        self.static = np.array([r for r in tree.static if names[r].name not in leave_out], np.intp)
+        kept = tree.static if static else ()
+        self.static = np.array([r for r in kept if names[r].name not in leave_out], np.intp)
         """Rows of the static transforms sent."""
         self.dynamic = np.array(
             [r for r in tree.dynamic if names[r].name not in leave_out], np.intp

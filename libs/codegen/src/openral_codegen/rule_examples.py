@@ -267,6 +267,14 @@ RULE_BREAKS = (
         "control_freq_hz: 1000.0",
         "openral_sim.scene_checks.physics_steps_per_control",
     ),
+    RuleBreak(
+        SchemaName.SCENE,
+        7,
+        SCENE_FILE,
+        "control_freq_hz: 20.0",
+        "control_freq_hz: 20.0\n    state_rate_hz: 10.0",
+        "openral_sim.scene_checks.state_parts_per_control",
+    ),
 )
 """Every rule break the reference pages show, in page order."""
 

@@ -34,7 +34,7 @@ def urdf(
         MeshUri,
         typer.Option(
             "--mesh-uri",
-            help="file: meshes named by file:// URI in the model cache (rviz2, ROS tools); "
+            help="file: meshes named by file URI in the model cache (rviz2, ROS tools); "
             "relative: written to meshes/ beside --out and named by relative path (MuJoCo's "
             "URDF compiler reads that form).",
         ),
@@ -42,7 +42,7 @@ def urdf(
 ) -> None:
     """The robot's URDF, as the ROS graph publishes it on /robot_description.
 
-    Mesh files (STL) are written once to the model cache and named by file:// URI, or with
+    Mesh files (STL) are written once to the model cache and named by file URI, or with
     --mesh-uri relative beside the --out file. Exits 1 when the robot does not load or its
     model has no URDF form.
     """
