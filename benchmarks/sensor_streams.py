@@ -25,8 +25,8 @@ from openral_sim.sensor_schedule import sensor_rates
 
 from benchmarks.deploy_launch import camera_topic
 
-JOINT_STATE_RATE_HZ = 50.0
-"""deploy sim's default /joint_states (and /odom) rate [Hz]."""
+JOINT_STATE_RATE_HZ = 100.0
+"""deploy sim's default /joint_states (and /odom) rate [Hz]: the state rate."""
 
 
 @dataclass(frozen=True)

@@ -133,11 +133,11 @@ class ControlSurface:
             self.gripper.stop_goal(reason)
 
     def topics(self) -> list[TopicInfo]:
-        """The controller state topic (after every tick)."""
+        """The controller state topic (once per control period)."""
         if self.state is None or self.loop is None:
             return []
         kind = "control_msgs/msg/JointTrajectoryControllerState"
-        return [TopicInfo(JTC_STATE, kind, 1.0 / self.loop.tick_period_s)]
+        return [TopicInfo(JTC_STATE, kind, 1.0 / self.loop.period_s)]
 
     def _broadcaster(
         self, states: JointStatePublisher | None, names: tuple[str, ...]

@@ -1,10 +1,11 @@
 """``/joint_trajectory_controller/controller_state``: what the trajectory controller tracks.
 
-A ``control_msgs/JointTrajectoryControllerState`` after every tick, stamped in simulated
-time, for the controller's joints (manifest names, the URDF's): ``reference`` is the running
-trajectory's point at that instant (the targets in force when none runs), ``feedback`` the
-measured positions and velocities, ``error`` their difference, ``output`` what is commanded
-(the reference: a position-controlled robot) and ``speed_scaling_factor`` 1.
+A ``control_msgs/JointTrajectoryControllerState`` once per control period (the controller's
+update: when a period's last part has stepped), stamped in simulated time, for the
+controller's joints (manifest names, the URDF's): ``reference`` is the running trajectory's
+point at that instant (the targets in force when none runs), ``feedback`` the measured
+positions and velocities, ``error`` their difference, ``output`` what is commanded (the
+reference: a position-controlled robot) and ``speed_scaling_factor`` 1.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ if TYPE_CHECKING:
 
 
 class ControllerStatePublisher:
-    """Publishes the trajectory controller's state after every tick of ``loop``."""
+    """Publishes the trajectory controller's state once per control period of ``loop``."""
 
     def __init__(
         self,
@@ -57,7 +58,7 @@ class ControllerStatePublisher:
 
     def publish(self, state: JointStateSample) -> None:
         """One message for the state after a tick (the control loop's thread)."""
-        if state.sim_time_s is None or self._pub is None:
+        if state.sim_time_s is None or self._pub is None or not self.loop.period_ended:
             return
         with self.lock:
             reference = np.asarray(self.hal.hold_action(), dtype=np.float64)

@@ -114,11 +114,9 @@ class ControlLoop:
         """The end-effector target (:mod:`openral_bridge.ee_bridge`), to :attr:`on_ee_sample`."""
         self.on_ee_sample: Callable[[DesiredPoint], None] | None = None
         self.watchers: list[Callable[[JointStateSample], None]] = []
-        """Called in order with the state after every tick that stepped the scene (the HAL
-        lock not held), e.g. to judge a trajectory goal against its path."""
+        """Called with the state after every tick that stepped (the HAL lock not held)."""
         self.reporters: list[Callable[[], None]] = []
-        """Called after every tick that did not fail, stepped or E-stopped (the HAL lock not
-        held): what publishes the state (a frozen scene's too, with its frozen stamp)."""
+        """Called after every tick that did not fail, also E-stopped (the state publishers)."""
         self.readers: list[Callable[[], None]] = []
         """Called in order, holding the HAL lock, right after every tick that stepped the scene
         (and a reset's tick): each copies what it publishes from the live scene, so nothing
@@ -129,6 +127,11 @@ class ControlLoop:
         self._pending_lock = threading.Lock()
         self._job: tuple[Pacer, PacedJob] | None = None
         self._driven: Drive | None = None
+
+    @property
+    def period_ended(self) -> bool:
+        """True right after the tick that ended a control period (every tick when unparted)."""
+        return self._phase == 0
 
     @property
     def running(self) -> bool:

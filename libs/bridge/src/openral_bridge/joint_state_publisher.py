@@ -159,6 +159,7 @@ class JointStatePublisher:
         """False while the joint state broadcaster is deactivated: nothing is published."""
         self._out = PacedPublishers(node)
         self._messages: tuple[StateReading, Any, Any] | None = None
+        self._dynamic: Any = None
 
     def start(self, pacer: Pacer, loop: ControlLoop | None = None) -> None:
         """Create the publishers, publish once, then at :attr:`rate_hz` on ``pacer``, or after
@@ -191,7 +192,8 @@ class JointStatePublisher:
         joints, manifest = self._messages_of(self.source.reading())
         publishers[0].publish(joints)
         publishers[1].publish(manifest)
-        publishers[2].publish(dynamic_joint_state(joints))
+        self._dynamic = dynamic_joint_state(joints, self._dynamic)
+        publishers[2].publish(self._dynamic)
         self.published += 1
 
     def _messages_of(self, reading: StateReading) -> tuple[Any, Any]:
@@ -211,17 +213,21 @@ class JointStatePublisher:
         )
 
 
-def dynamic_joint_state(joints: Any) -> Any:
+def dynamic_joint_state(joints: Any, reuse: Any = None) -> Any:
     """``control_msgs/DynamicJointState`` of a ``JointState``: each joint's position,
-    velocity and effort interfaces (joint_state_broadcaster's ``/dynamic_joint_states``)."""
-    return DynamicJointState(
-        header=joints.header,
-        joint_names=joints.name,
-        interface_values=[
-            InterfaceValue(interface_names=list(INTERFACES), values=[q, v, e])
-            for q, v, e in zip(joints.position, joints.velocity, joints.effort, strict=True)
-        ],
-    )
+    velocity and effort interfaces (joint_state_broadcaster's ``/dynamic_joint_states``);
+    ``reuse`` (the last one, same joints) is filled in place instead of building anew."""
+    names = joints.name
+    if reuse is None or list(reuse.joint_names) != list(names):
+        reuse = DynamicJointState(
+            joint_names=names,
+            interface_values=[InterfaceValue(interface_names=list(INTERFACES)) for _ in names],
+        )
+    reuse.header = joints.header
+    rows = zip(reuse.interface_values, joints.position, joints.velocity, joints.effort, strict=True)
+    for value, q, v, e in rows:
+        value.values = [q, v, e]
+    return reuse
 
 
 def _joined(first: JointStateSample, second: JointStateSample) -> JointStateSample:
