@@ -174,9 +174,17 @@ def test_reset_restores_the_start_state_and_the_first_frame(client: Client) -> N
         assert bytes(first.data) == bytes(frame.data)
 
 
-def _settle(client: Client) -> None:
-    """Let an earlier test's motion die down."""
+def _settle(client: Client, still_rad_s: float = 1e-3, timeout_s: float = 10.0) -> None:
+    """Let an earlier test's motion die down: wait until both joints move slower than
+    ``still_rad_s`` on /joint_states (at least 0.5 s)."""
     time.sleep(0.5)
+
+    def still() -> bool:
+        msg = client.probe.latest(JOINT_STATES)
+        speeds = [abs(msg.velocity[list(msg.name).index(j)]) for j in JOINTS]
+        return max(speeds) < still_rad_s
+
+    client.probe.wait(still, timeout_s, "the joints at rest")
 
 
 def _back(client: Client, q0: np.ndarray) -> None:
