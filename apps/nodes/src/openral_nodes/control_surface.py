@@ -35,7 +35,7 @@ from openral_hal.protocol import RobotHal
 from openral_nodes.controller_manager import Controller, ControllerManager
 from openral_nodes.controller_state import ControllerStatePublisher
 from openral_nodes.gripper_action import GripperAction
-from openral_nodes.gripper_wiring import gripper_axis
+from openral_nodes.gripper_wiring import GripperAxis, gripper_axis
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -76,9 +76,9 @@ class ControlSurface:
         controllers = [self._broadcaster(states, names)]
         entities: list[Entity] = []
         arm = names
-        axis = gripper_axis(self.robot, names) if self.robot is not None else "no manifest"
+        axis = gripper_axis(self.robot, names) if self.robot is not None else None
         loop = self.loop
-        if loop is not None and action is not None and not isinstance(axis, str):
+        if loop is not None and action is not None and isinstance(axis, GripperAxis):
             self.gripper = GripperAction(self.node, self.hal, loop, axis, self.on_refused)
             self.gripper.create()
             arm = tuple(n for n in names if n != axis.joint)
@@ -91,7 +91,7 @@ class ControlSurface:
                     self.gripper.switch,
                 )
             )
-        elif isinstance(axis, str) and "no gripper" not in axis and action is not None:
+        elif isinstance(axis, str) and action is not None:
             self._log().info(f"no {GRIPPER_NAME}: {axis}")
         if loop is not None and action is not None and loop.follower is not None:
             self.action = action

@@ -50,11 +50,12 @@ class GripperAxis:
         return float(state.efforts[self.slot])
 
 
-def gripper_axis(robot: LoadedRobot, action_names: tuple[str, ...]) -> GripperAxis | str:
-    """The first gripper of ``robot`` as an axis, or why it cannot have a gripper action."""
+def gripper_axis(robot: LoadedRobot, action_names: tuple[str, ...]) -> GripperAxis | str | None:
+    """The first gripper of ``robot`` as an axis, why it cannot have a gripper action, or
+    None for a robot without a gripper."""
     wiring = robot.tables.hal_wiring
     if wiring is None or not wiring.grippers:
-        return "the robot has no gripper"
+        return None
     gripper = wiring.grippers[0]
     if gripper.joint not in action_names:
         return f"the gripper {gripper.joint} is no slot of this scene's action"
