@@ -17,6 +17,8 @@ from openral_hal.factory import RealOptions
 from openral_real import arm_calibration
 from openral_real.calibration import MotorCalibration, read_calibration, write_calibration
 from openral_real.emulator.emulated_bus import EmulatedBus
+from openral_real.errors import BusFault
+from openral_real.feetech_bus import ServoReading
 from openral_real.feetech_hal import FeetechHal
 
 from tests.real.conftest import Rig, open_bus
@@ -41,6 +43,43 @@ def _sweep(bus: EmulatedBus, robot: LoadedRobot, pause_s: float) -> None:
             time.sleep(pause_s)
 
 
+def _enter(process: subprocess.Popen[str]) -> None:
+    """The user presses ENTER; a process that already ended says why."""
+    assert process.stdin is not None
+    try:
+        process.stdin.write("\n")
+        process.stdin.flush()
+    except BrokenPipeError:
+        _, err = process.communicate(timeout=30)
+        pytest.fail(f"calibrate ended early (exit {process.returncode}): {err}")
+
+
+class _FlakyBus:
+    """Two motors whose present block is lost on the reads numbered in ``lost``."""
+
+    ids = (1, 2)
+
+    def __init__(self, lost: set[int]) -> None:
+        self.lost, self.reads = lost, 0
+
+    def read_present(self) -> list[ServoReading]:
+        self.reads += 1
+        if self.reads in self.lost:
+            raise BusFault("shoulder_lift stopped answering (no reply within 50 ms)")
+        position = 2000 + 10 * self.reads
+        return [ServoReading(position, 0, 0, 12.0, 30, 0, False) for _ in self.ids]
+
+
+def test_range_recording_reads_again_after_a_lost_reply_and_ends_after_three_in_a_row() -> None:
+    bus = _FlakyBus(lost={2, 3})
+    ranges = arm_calibration.record_ranges(bus, lambda: bus.reads >= 5)  # type: ignore[arg-type]
+    assert ranges == {1: (2010, 2050), 2: (2010, 2050)}  # reads 1, 4 and 5 counted
+    bus = _FlakyBus(lost={2, 3, 4})
+    with pytest.raises(BusFault, match="stopped answering"):
+        arm_calibration.record_ranges(bus, lambda: False)  # type: ignore[arg-type]
+    assert bus.reads == 4
+
+
 def test_interactive_calibration_records_the_ranges_the_hand_moved_through(
     so101: LoadedRobot, tmp_path: Path
 ) -> None:
@@ -50,13 +89,10 @@ def test_interactive_calibration_records_the_ranges_the_hand_moved_through(
             "robot", "calibrate", "so101", "--transport", bus.path, "--calibration", str(file),
             stdin=subprocess.PIPE,
         )  # fmt: skip
-        assert process.stdin is not None
-        process.stdin.write("\n")  # the arm is in the middle (EmulatedBus put it there)
-        process.stdin.flush()
+        _enter(process)  # the arm is in the middle (EmulatedBus put it there)
         time.sleep(1.5)
         _sweep(bus, so101, pause_s=0.1)
-        process.stdin.write("\n")
-        process.stdin.flush()
+        _enter(process)
         out, err = process.communicate(timeout=60)
         assert process.returncode == 0, err
         servo_limits = {

@@ -119,3 +119,31 @@ def test_a_process_forked_after_opening_gl_refuses_to_render_instead_of_hanging(
         assert queue.get(timeout=60) == "rendered"
     finally:
         child.join(5)
+
+
+def test_a_scene_rendered_on_one_thread_renders_on_another() -> None:
+    """A bus emulator's scene is reset (and rendered) on the thread that built it, then
+    stepped by the emulator's own thread: measured without the release, the second
+    thread's render failed with EGL_BAD_ACCESS (the context was still current on the
+    first)."""
+    scene = NativeScene(load_scene(FRANKA_SCENE), open_robot_by_id("franka_panda"))
+    try:
+        scene.reset(0)
+        camera = next(iter(scene.sensors.cameras))
+        here = scene.sensors.render(scene.data, [camera])[camera]
+        there: list[object] = []
+
+        def render_elsewhere() -> None:
+            try:
+                there.append(scene.sensors.render(scene.data, [camera])[camera])
+            except Exception as error:
+                there.append(error)
+
+        thread = threading.Thread(target=render_elsewhere)
+        thread.start()
+        thread.join(30)
+        again = scene.sensors.render(scene.data, [camera])[camera]
+    finally:
+        scene.close()
+    assert len(there) == 1 and not isinstance(there[0], Exception), there
+    assert (there[0] == here).all() and (again == here).all()  # type: ignore[union-attr]

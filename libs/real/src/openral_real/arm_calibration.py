@@ -24,10 +24,15 @@ from openral_core.models import LimitedJoint, RobotDescription
 from openral_core.real_wiring import FeetechWiring
 
 from openral_real.calibration import HALF_TURN, MotorCalibration
+from openral_real.errors import BusFault
 from openral_real.feetech_bus import FeetechBus
 
 RANGE_POLL_S = 0.02
 """How often the range recording reads the arm [s]."""
+MISSED_READS = 3
+"""Reads in a row that may fail while the ranges are recorded before the recording ends
+with the bus's error: a reply lost once (noise on the wire, a busy host) must not throw
+away the minute the user spent moving the arm."""
 
 
 def release(bus: FeetechBus) -> None:
@@ -67,12 +72,25 @@ def record_ranges(
         bus: The arm's bus (homed).
         done: Polled between reads; True ends the recording.
         seen: Called after each read with id → (present, lowest, highest).
+
+    Raises:
+        BusFault: :data:`MISSED_READS` reads in a row failed (the last one's error).
     """
     low: dict[int, int] = {}
     high: dict[int, int] = {}
+    missed = 0
     while True:
+        try:
+            readings = bus.read_present()
+        except BusFault:
+            missed += 1
+            if missed >= MISSED_READS:
+                raise
+            time.sleep(RANGE_POLL_S)
+            continue
+        missed = 0
         now = {}
-        for servo_id, reading in zip(bus.ids, bus.read_present(), strict=True):
+        for servo_id, reading in zip(bus.ids, readings, strict=True):
             low[servo_id] = min(low.get(servo_id, reading.position), reading.position)
             high[servo_id] = max(high.get(servo_id, reading.position), reading.position)
             now[servo_id] = (reading.position, low[servo_id], high[servo_id])

@@ -34,7 +34,7 @@ import numpy as np
 import numpy.typing as npt
 from openral_core.models import DepthSensor
 
-from openral_sim.gl_guard import GL_LOCK
+from openral_sim.gl_guard import gl_turn
 
 SELF_MARGIN_M = 0.01
 """Points closer than this to the robot's own visible surface leave the cloud [m]."""
@@ -105,7 +105,7 @@ class DepthCamera:
     ) -> tuple[Depth, npt.NDArray[np.int32]]:
         """Depth [m] (raw, before the range) and the geom id seen at each pixel (-1: none),
         from a renderer of this sensor's size; ``data`` is only read."""
-        with GL_LOCK:
+        with gl_turn():
             renderer.update_scene(data, camera=self.camera_id)
             renderer.enable_depth_rendering()
             try:

@@ -16,6 +16,12 @@ first env was built in the parent). :func:`open_renderer` (and :func:`claim_gl`,
 library's own renderer is announced with) refuses that in one line naming the way out, a
 process started afresh (``forkserver`` or ``spawn``).
 
+A context may be current on one thread only (EGL answers ``EGL_BAD_ACCESS`` otherwise),
+and a scene's renderer is used by whichever thread steps it: a bus emulator built on the
+main thread steps on its own, a camera capture developed on another. :func:`gl_turn` (the
+lock plus a release of the calling thread's context on the way out) therefore leaves no
+context current outside a render, so any thread may render with any renderer next.
+
 Cost: llvmpipe already spreads one render over every core, so two renders at once only
 share the cores two ways; serialized, a frame waits at most for one other frame, which the
 frame renderers' retry (:mod:`openral_bridge.frame_renderer`) absorbs. Checked by the
@@ -27,11 +33,20 @@ from __future__ import annotations
 
 import os
 import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import mujoco
 from openral_mujoco.errors import HalError
 
-__all__ = ["GL_LOCK", "InheritedGlError", "claim_gl", "close_renderer", "open_renderer"]
+__all__ = [
+    "GL_LOCK",
+    "InheritedGlError",
+    "claim_gl",
+    "close_renderer",
+    "gl_turn",
+    "open_renderer",
+]
 
 GL_LOCK = threading.Lock()
 """Held around every OpenGL call this package makes (never while waiting on anything
@@ -64,19 +79,50 @@ def claim_gl() -> None:
     _opened_in = os.getpid()
 
 
+@contextmanager
+def gl_turn() -> Iterator[None]:
+    """This thread's turn at OpenGL: holds :data:`GL_LOCK`, and on the way out makes no
+    context current on this thread, so the next render may come from any thread."""
+    with GL_LOCK:
+        try:
+            yield
+        finally:
+            _release_current()
+
+
+def _release_current() -> None:
+    """Make no context current on the calling thread (MuJoCo's offscreen back-ends; a
+    GLFW window's context stays with its thread)."""
+    backend = os.environ.get("MUJOCO_GL", "").lower()
+    if backend == "egl":
+        from mujoco import egl
+
+        if egl.EGL_DISPLAY is not None:
+            egl.EGL.eglMakeCurrent(
+                egl.EGL_DISPLAY,
+                egl.EGL.EGL_NO_SURFACE,
+                egl.EGL.EGL_NO_SURFACE,
+                egl.EGL.EGL_NO_CONTEXT,
+            )
+    elif backend == "osmesa":
+        from OpenGL import GL, osmesa  # type: ignore[import-untyped]
+
+        osmesa.OSMesaMakeCurrent(None, None, GL.GL_FLOAT, 0, 0)
+
+
 def open_renderer(model: mujoco.MjModel, height: int, width: int) -> mujoco.Renderer:
-    """A ``mujoco.Renderer`` of ``model`` at ``height`` x ``width`` [px], made holding
-    :data:`GL_LOCK` (its context belongs to the calling thread).
+    """A ``mujoco.Renderer`` of ``model`` at ``height`` x ``width`` [px], made in
+    :func:`gl_turn` (no thread holds its context afterwards).
 
     Raises:
         InheritedGlError: This process was forked after its parent had opened a context.
     """
     claim_gl()
-    with GL_LOCK:
+    with gl_turn():
         return mujoco.Renderer(model, height, width)
 
 
 def close_renderer(renderer: mujoco.Renderer) -> None:
     """Free ``renderer``'s context holding :data:`GL_LOCK` (idempotent)."""
-    with GL_LOCK:
+    with gl_turn():
         renderer.close()

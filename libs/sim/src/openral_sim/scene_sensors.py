@@ -18,7 +18,7 @@ from openral_core.models import RgbSensor, RobotDescription
 from openral_core.tables import FrameNames
 
 from openral_sim.depth_cloud import DepthFrame
-from openral_sim.gl_guard import GL_LOCK, close_renderer, open_renderer
+from openral_sim.gl_guard import close_renderer, gl_turn, open_renderer
 from openral_sim.mujoco_capture import MujocoCapture
 from openral_sim.observation import ImageArray, LidarScan
 from openral_sim.range_sensors import RangeSensors
@@ -92,7 +92,7 @@ class SceneSensors:
         cameras, buffers = self.cameras, dict(out or {})
 
         def render(renderer: mujoco.Renderer, data: mujoco.MjData, sensor: str) -> ImageArray:
-            with GL_LOCK:
+            with gl_turn():
                 renderer.update_scene(data, camera=cameras[sensor])
                 return renderer.render(out=buffers.get(sensor))
 
@@ -121,7 +121,7 @@ class SceneSensors:
         images: dict[str, ImageArray] = {}
         for name in names:
             assert renderer is not None
-            with GL_LOCK:
+            with gl_turn():
                 renderer.update_scene(data, camera=self.cameras[name])
                 images[name] = renderer.render().copy()
         return images

@@ -25,8 +25,10 @@ import typer
 
 from openral_cli.console import out
 
-CALIBRATION_REPLY_S = 0.05
-"""How long calibration waits for a servo's reply [s]: it keeps no control loop's pace."""
+CALIBRATION_REPLY_S = 0.2
+"""How long calibration waits for a servo's reply [s]: it keeps no control loop's pace, so
+a wait far beyond a servo's sub-millisecond answer costs nothing and rides out a busy host
+(a calibration on the emulator once ended early under a loaded test run)."""
 
 if TYPE_CHECKING:
     from openral_core import LoadedRobot
