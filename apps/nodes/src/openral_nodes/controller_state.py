@@ -58,7 +58,7 @@ class ControllerStatePublisher:
 
     def publish(self, state: JointStateSample) -> None:
         """One message for the state after a tick (the control loop's thread)."""
-        if state.sim_time_s is None or self._pub is None or not self.loop.period_ended:
+        if state.sim_time_s is None or self._pub is None or self.loop.ticks_left:
             return
         with self.lock:
             reference = np.asarray(self.hal.hold_action(), dtype=np.float64)

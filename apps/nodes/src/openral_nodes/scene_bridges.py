@@ -15,9 +15,10 @@
 
 Every sensor's rate comes from one rule (:func:`~openral_sim.sensor_schedule.sensor_rates`):
 its manifest rate, the ``camera_rate_hz`` override applied to RGB, depth and lidar alike,
-capped at the control rate of a ticked HAL. All their periodic work runs on the node's
-pacer and every call into the HAL or the live scene holds the node's HAL lock. A sensor
-none of them serves is reported once at setup.
+capped at the control rate of a ticked HAL; cameras, depth and lidars take the scene at
+a control period's end (:mod:`openral_bridge.snapshot_gate`). All their periodic work
+runs on the node's pacer and every call into the HAL or the live scene holds the node's
+HAL lock. A sensor none of them serves is reported once at setup.
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from openral_bridge.ee_bridge import EeBridge
 from openral_bridge.pacer import Pacer
 from openral_bridge.range_bridge import RangeBridge
 from openral_bridge.sim_sensor_bridge import SimSensorBridge
+from openral_bridge.snapshot_gate import period_end_gate
 from openral_bridge.state_sensor_bridge import StateSensorBridge
 from openral_bridge.topics import TopicInfo
 from openral_bridge.view_bridge import ViewBridge
@@ -94,6 +96,8 @@ class SceneBridges:
             camera_rates_hz=rates,
             served_elsewhere=served,
         )
+        if loop is not None:  # imaging sensors show period-end states, as `sim run` does
+            self.range.gate = self.sensors.gate = period_end_gate(loop)
         self.pacer = pacer
         self.view_port = view_port
         self.view: ViewBridge | None = None

@@ -129,9 +129,9 @@ class ControlLoop:
         self._driven: Drive | None = None
 
     @property
-    def period_ended(self) -> bool:
-        """True right after the tick that ended a control period (every tick when unparted)."""
-        return self._phase == 0
+    def ticks_left(self) -> int:
+        """Ticks still to step in this control period (0 right after the one that ended it)."""
+        return (self.parts - self._phase) % self.parts
 
     @property
     def running(self) -> bool:

@@ -41,12 +41,16 @@ from openral_sim.sensor_sources import FrameCapture, FrameDeveloper
 
 from openral_bridge.os_thread import name_os_thread
 
-__all__ = ["FrameRenderer", "ImageArray"]
+__all__ = ["FrameRenderer", "ImageArray", "SnapshotGate"]
 
 FrameT = TypeVar("FrameT")
 """What one render makes: an RGB image, a depth frame with its cloud."""
 PublishFn = Callable[[str, FrameT, float], None]
 """Publish one sensor's frame with the snapshot's simulated time [s] (render thread)."""
+
+SnapshotGate = Callable[[], float]
+"""Asked holding the HAL's lock before a paced snapshot: 0 when the live state may be
+taken now, else how long until it may [s] (:mod:`openral_bridge.snapshot_gate`)."""
 
 RETRY_S = 0.01
 """How soon a sensor's job asks again for a frame refused because the previous one is
@@ -163,15 +167,24 @@ class FrameRenderer(Generic[FrameT]):
         return True
 
     def request_or_retry(
-        self, sensor: str, lock: AbstractContextManager[object], *, wait_s: float = 0.0
+        self,
+        sensor: str,
+        lock: AbstractContextManager[object],
+        *,
+        wait_s: float = 0.0,
+        gate: SnapshotGate | None = None,
     ) -> float | None:
-        """A sensor's paced job: :meth:`request` a frame holding ``lock`` (the HAL's).
+        """A sensor's paced job: :meth:`request` a frame holding ``lock`` (the HAL's),
+        once ``gate`` (when given) lets the live state be taken.
 
         Returns:
-            :data:`RETRY_S` when the previous frame of ``sensor`` is still in flight (the
-            pacer asks again that much later), else None (queued, or the renderer failed).
+            The gate's delay, or :data:`RETRY_S` when the previous frame of ``sensor`` is
+            still in flight (the pacer asks again that much later), else None (queued, or
+            the renderer failed).
         """
         with lock:
+            if gate is not None and (delay_s := gate()) > 0.0:
+                return delay_s
             queued = self.request(sensor, wait_s=wait_s)
         return None if queued or self.error is not None else RETRY_S
 

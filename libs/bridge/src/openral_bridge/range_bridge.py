@@ -33,7 +33,7 @@ from openral_sim.depth_cloud import DepthFrame
 from openral_sim.sensor_sources import DepthSource, LidarSource
 
 from openral_bridge import ros_messages
-from openral_bridge.frame_renderer import FrameRenderer
+from openral_bridge.frame_renderer import FrameRenderer, SnapshotGate
 from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.sim_sensor_bridge import NOW_WAIT_S
 from openral_bridge.topics import TopicInfo, camera_info, depth_image, depth_points, scan
@@ -83,6 +83,8 @@ class RangeBridge:
         self.rates_hz = dict(rates_hz)
         self._streams: dict[str, _Stream] = {}
         self._pacer: Pacer | None = None
+        self.gate: SnapshotGate | None = None
+        """When a paced snapshot or scan may be taken (None: whenever it is due)."""
 
     def topics(self) -> list[TopicInfo]:
         """What the bridge publishes now."""
@@ -176,11 +178,14 @@ class RangeBridge:
         stream.topics = [TopicInfo(topic, "sensor_msgs/msg/LaserScan", rate)]
         return stream
 
-    def _publish_scan(self, name: str) -> None:
-        """Cast and publish one scan of the live state (pacer thread)."""
+    def _publish_scan(self, name: str, gate: SnapshotGate | None) -> float | None:
+        """Cast and publish one scan of the live state (pacer thread) once ``gate`` lets it
+        (returns the gate's delay [s] instead)."""
         stream, spec = self._streams[name], self.lidars[name]
         assert self._lidar_source is not None
         with self.lock:
+            if gate is not None and (delay_s := gate()) > 0.0:
+                return delay_s
             reading = self._lidar_source.scan(name)
         msg = ros_messages.laser_scan_msg(
             reading.ranges,
@@ -192,17 +197,18 @@ class RangeBridge:
         )
         stream.publishers["scan"].publish(msg)
         stream.published += 1
+        return None
 
     # -- both --------------------------------------------------------------------------------
 
     def _due(self, name: str, wait_s: float = 0.0) -> float | None:
         """A sensor's job: request a depth frame, or cast and publish a scan; returns
         :data:`~openral_bridge.frame_renderer.RETRY_S` when the previous depth frame is
-        still in flight (the pacer asks again shortly), else None."""
-        frames = self._streams[name].frames
+        still in flight, or the :attr:`gate`'s delay (the pacer asks again that much
+        later), else None."""
+        frames, gate = self._streams[name].frames, self.gate if wait_s == 0.0 else None
         if frames is None:
-            self._publish_scan(name)
-            return None
+            return self._publish_scan(name, gate)
         if frames.error is not None:  # as a camera does: said once, its job ends
             stream = self._streams[name]
             if self._pacer is not None and stream.job is not None:
@@ -213,7 +219,7 @@ class RangeBridge:
                 f"{frames.error}); the robot keeps running without its depth"
             )
             return None
-        return frames.request_or_retry(name, self.lock, wait_s=wait_s)
+        return frames.request_or_retry(name, self.lock, wait_s=wait_s, gate=gate)
 
     def _rate(self, name: str, manifest_hz: float) -> float:
         return float(self.rates_hz.get(name, manifest_hz))

@@ -13,14 +13,14 @@ can do:
   view).
 
 A HAL that is a :class:`~openral_sim.sensor_sources.CameraSource` (a native scene's, or
-any driver's) has a camera rendered only when its frame is due, off the control path: the
-sensor's job (on the pacer's thread, holding the HAL's lock, so never during a control
-tick) takes a snapshot and a :class:`~openral_bridge.frame_renderer.FrameRenderer` thread
-develops and publishes it; a camera still busy with its previous frame is skipped and
-counted (:attr:`SimSensorBridge.frames_skipped`). While the bridge serves its cameras the
-scene's ``reset``/``step`` render nothing. A backend that renders inside its own step
-(robosuite) publishes the last observation's frames (``read_images()``) instead, on the
-pacer's thread.
+any driver's) has a camera rendered only when its frame is due, off the control path: its
+job (pacer thread, HAL lock held, never mid-tick; with a :attr:`~SimSensorBridge.gate`,
+only at a control period's end) takes a snapshot and a
+:class:`~openral_bridge.frame_renderer.FrameRenderer` thread develops and publishes it; a
+camera still busy with its previous frame is skipped and counted
+(:attr:`SimSensorBridge.frames_skipped`). While the bridge serves its cameras the scene's
+``reset``/``step`` render nothing. A backend that renders inside its own step (robosuite)
+publishes the last observation's frames (``read_images()``) instead, on the pacer's thread.
 
 Header stamps are simulation time (MuJoCo ``data.time``; the node publishes ``/clock``):
 a rendered frame carries its snapshot's time, so the stamp says which physics state it
@@ -47,7 +47,7 @@ from openral_sim.sensor_sources import CameraSource, ObservationFrames
 
 from openral_bridge import ros_messages
 from openral_bridge.camera_messages import CameraMessages
-from openral_bridge.frame_renderer import FrameRenderer, ImageArray
+from openral_bridge.frame_renderer import FrameRenderer, ImageArray, SnapshotGate
 from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.topics import TopicInfo, camera_image, camera_info
 
@@ -133,6 +133,8 @@ class SimSensorBridge:
         self._viewer_job: PacedJob | None = None
         self.on_frame: Callable[[str, ImageArray, float], None] | None = None
         """Called with (camera, frame, stamp [s]) after each frame is published."""
+        self.gate: SnapshotGate | None = None
+        """When a paced snapshot may be taken (None: whenever it is due)."""
 
     # -- lifecycle -------------------------------------------------------------------------
 
@@ -270,7 +272,8 @@ class SimSensorBridge:
             if frames.error is not None:
                 self._camera_failed(frames.error)
                 return None
-            return frames.request_or_retry(name, self.lock, wait_s=wait_s)
+            gate = self.gate if wait_s == 0.0 else None
+            return frames.request_or_retry(name, self.lock, wait_s=wait_s, gate=gate)
         camera_hal = self._camera_hal
         if camera_hal is None:
             return None
