@@ -98,9 +98,10 @@ def mutated(draw: st.DrawFn, name: SchemaName) -> tuple[str, Any]:
     objects = [(p, n) for p, n in nodes if isinstance(n, dict)]
     if kind == "extra_key":
         path, node = draw(st.sampled_from(objects))
-        # A string value is wrong for every map of the contract too (all map to numbers),
-        # so the extra key is invalid whether the object is a model or a map.
-        return kind, _replace(document, path, {**node, "zz_unknown_field": "x"})
+        # A null value is wrong for every map of the contract too (they map to numbers,
+        # names or objects, never null), so the extra key is invalid whether the object is
+        # a model or a map (a string was not, once maps of link and joint names came).
+        return kind, _replace(document, path, {**node, "zz_unknown_field": None})
     if kind == "drop_key":
         candidates = [(p, n) for p, n in objects if n]
         if not candidates:

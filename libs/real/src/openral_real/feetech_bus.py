@@ -58,7 +58,10 @@ latches the E-stop) instead of holding the driver's loop."""
 STALL_MS = 2.0
 """A reply wait this much longer than its timeout was this thread held up [ms]."""
 CONNECT_TIMEOUT_MS = 50.0
-"""Reply timeout of the pings and register reads at connect [ms]."""
+"""Reply timeout of the pings and single-register reads and writes [ms]; each is asked up
+to :data:`CONNECT_TRIES` times before the motor counts as silent (idempotent requests; a
+busy host once missed one 50 ms wait on the emulator)."""
+CONNECT_TRIES = 3
 
 
 class _ExclusivePort(scs.PortHandler):  # type: ignore[misc]
@@ -196,8 +199,7 @@ class FeetechBus:
         """
         problems = []
         for servo_id in self.ids:
-            self._port.setPacketTimeoutMillis(CONNECT_TIMEOUT_MS)
-            model, result, _ = self._call(self._packets.ping, self._port, servo_id)
+            model, result, _ = self._asked(self._packets.ping, self._port, servo_id)
             if result != scs.COMM_SUCCESS:
                 problems.append(f"{self.names[servo_id]} does not answer")
             elif model != self.wiring.model_number:
@@ -220,8 +222,7 @@ class FeetechBus:
             BusFault: No reply, a corrupt one, or the port failed.
         """
         address, size = self.wiring.registers[name]
-        self._port.setPacketTimeoutMillis(CONNECT_TIMEOUT_MS)
-        data, result, error = self._call(
+        data, result, error = self._asked(
             self._packets.readTxRx, self._port, servo_id, address, size
         )
         self._check(servo_id, result, error, f"reading {name}")
@@ -235,8 +236,7 @@ class FeetechBus:
         """
         address, size = self.wiring.registers[name]
         data = list(self._encode(name, value).to_bytes(size, "little"))
-        self._port.setPacketTimeoutMillis(CONNECT_TIMEOUT_MS)
-        result, error = self._call(
+        result, error = self._asked(
             self._packets.writeTxRx, self._port, servo_id, address, size, data
         )
         self._check(servo_id, result, error, f"writing {name}")
@@ -333,6 +333,17 @@ class FeetechBus:
     def _reply_ms(self, length: int) -> float:
         """Wire time of one status packet of ``length`` data bytes plus the reply timeout."""
         return (6 + length) * self._byte_ms + self.reply_timeout_s * 1000.0
+
+    def _asked(self, function: Any, *args: Any) -> Any:
+        """A request with a reply (the SDK's ``(..., result, error)``), sent again while it
+        times out, up to :data:`CONNECT_TRIES` times; a late reply is flushed first."""
+        for _ in range(CONNECT_TRIES):
+            self._port.setPacketTimeoutMillis(CONNECT_TIMEOUT_MS)
+            reply = self._call(function, *args)
+            if reply[-2] != scs.COMM_RX_TIMEOUT:
+                break
+            self._call(self._port.ser.reset_input_buffer)
+        return reply
 
     def _call(self, function: Any, *args: Any) -> Any:
         """An SDK call; a port that failed (unplugged) becomes a :class:`BusFault`."""

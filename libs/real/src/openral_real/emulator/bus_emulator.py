@@ -77,6 +77,9 @@ class BusEmulator:
         self.faults: dict[int, set[Fault]] = {servo_id: set() for servo_id in self.servos}
         self.corrupt_share = 0.0
         """Share of replies sent with a wrong checksum (0 to 1)."""
+        self.lost: dict[int, int] = {}
+        """Servo id → how many of its next replies are lost on the wire (noise); the
+        request itself is obeyed."""
         self._draw = random.Random(seed)
         self._registered: dict[int, tuple[int, bytes]] = {}
         self._names = {address: name for name, (address, _) in model.registers.items()}
@@ -120,6 +123,9 @@ class BusEmulator:
         clock = request_bytes * self.byte_s
         replies = []
         for servo_id, params in answers:
+            if self.lost.get(servo_id, 0) > 0:
+                self.lost[servo_id] -= 1
+                continue
             clock += self.servos[servo_id].get("Return_Delay_Time") * DELAY_UNIT_S
             data = self._status(servo_id, params)
             clock += len(data) * self.byte_s
