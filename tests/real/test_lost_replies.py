@@ -6,8 +6,10 @@ from __future__ import annotations
 
 import pytest
 from openral_hal.errors import ConfigurationError
+from openral_real.errors import BusFault
+from openral_real.feetech_bus import FeetechBus
 
-from tests.real.conftest import Rig
+from tests.real.conftest import Rig, open_bus
 
 
 def test_two_lost_replies_of_one_motor_at_connect_are_asked_again(rig: Rig) -> None:
@@ -25,3 +27,31 @@ def test_three_lost_replies_make_the_motor_silent(rig: Rig) -> None:
     rig.bus.emulator.lost[4] = 3
     with pytest.raises(ConfigurationError, match=r"motor 4 \(wrist_flex\) does not answer"):
         rig.hal().connect()
+
+
+def _out_of_turn(bus: FeetechBus, times: int) -> list[int]:
+    """The SDK's ping reads a late reply of another request as its own ``times`` times
+    (it then indexes past the data: IndexError, as seen under load); counts the calls."""
+    ping, calls = bus._packets.ping, []
+
+    def crossed(*args: object) -> object:
+        calls.append(1)
+        if len(calls) <= times:
+            raise IndexError("list index out of range")
+        return ping(*args)
+
+    bus._packets.ping = crossed
+    return calls
+
+
+def test_a_late_reply_taken_for_another_is_a_failed_try_not_a_crash(rig: Rig) -> None:
+    bus = open_bus(rig.robot, rig.path)
+    try:
+        calls = _out_of_turn(bus, 2)
+        bus.check_motors()
+        assert len(calls) == 2 + 6  # two crossed tries of motor 1, then each motor once
+        _out_of_turn(bus, 99)
+        with pytest.raises(BusFault, match=r"motor 1 \(shoulder_pan\) answered out of turn 3"):
+            bus.check_motors()
+    finally:
+        bus.close()

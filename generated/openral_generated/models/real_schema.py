@@ -14,14 +14,16 @@ from pydantic import (
 )
 from typing import Annotated
 from openral_base import OpenralModel
+from typing_extensions import TypeAliasType
 
 
 class Driver(StrEnum):
     """
-    Which driver reaches the hardware. `feetech`: a bus of Feetech STS serial servos, one per joint, through feetech-servo-sdk (LeRobot's SO-100 and SO-101 arms); its wiring is `feetech`. More kinds (`ros2_control`) come with their drivers.
+    Which driver reaches the hardware. `feetech`: a bus of Feetech STS serial servos, one per joint, through feetech-servo-sdk (LeRobot's SO-100 and SO-101 arms); its wiring is `feetech`. `ros2_control`: the robot's own ROS 2 driver (franka_ros2, ur_robot_driver, xarm_ros2, ...) with a joint_state_broadcaster and a joint_trajectory_controller, reached over ROS 2 in the namespace given on the command line (`--transport ros2_control:<namespace>`); its names are `ros2_control`.
     """
 
     feetech = "feetech"
+    ros2_control = "ros2_control"
 
 
 class Estop(StrEnum):
@@ -127,6 +129,21 @@ class FeetechSettings(OpenralModel):
     """
 
 
+class CommandInterface(StrEnum):
+    """
+    How actions reach the controller: `topic` streams one-point trajectories (trajectory_msgs/JointTrajectory, `time_from_start` one control period) at the control rate, each replacing the last, as teleoperation does; `action` sends each as a FollowJointTrajectory goal (one goal in flight; a new one pre-empts it).
+    """
+
+    topic = "topic"
+    action = "action"
+
+
+JointNamesAdditionalProperty = TypeAliasType(
+    "JointNamesAdditionalProperty",
+    Annotated[StrictStr, Field(pattern="^[A-Za-z][A-Za-z0-9_/-]{0,126}$")],
+)
+
+
 class FeetechBus(OpenralModel):
     """
     A half-duplex serial bus of Feetech STS servos, one servo per manifest joint, in position mode. The port is not a fact about the robot and is given on the command line (`--transport /dev/ttyACM0`).
@@ -178,6 +195,63 @@ class FeetechBus(OpenralModel):
     """
 
 
+class Ros2ControlDriver(OpenralModel):
+    """
+    Where a ros2_control robot driver takes commands and gives its state, relative to its namespace (the namespace is not a fact about the robot: `--transport ros2_control:<namespace>`). The defaults are ros2_control's own names, which franka_ros2 and ur_robot_driver keep.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    joint_state_topic: Annotated[
+        StrictStr,
+        Field(
+            max_length=200,
+            pattern="^[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*){0,7}$",
+            title="RosRelativeName",
+        ),
+    ] = "joint_states"
+    """
+    The joint_state_broadcaster's topic (sensor_msgs/JointState). Its stamps must be fresh: a stream that stops for two control periods latches the E-stop.
+    """
+    controller: Annotated[
+        StrictStr,
+        Field(
+            max_length=200,
+            pattern="^[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*){0,7}$",
+            title="RosRelativeName",
+        ),
+    ] = "joint_trajectory_controller"
+    """
+    The joint_trajectory_controller over the manifest's arm joints: commands go to `<controller>/joint_trajectory` (topic) or `<controller>/follow_joint_trajectory` (action).
+    """
+    command_interface: CommandInterface = CommandInterface.topic
+    """
+    How actions reach the controller: `topic` streams one-point trajectories (trajectory_msgs/JointTrajectory, `time_from_start` one control period) at the control rate, each replacing the last, as teleoperation does; `action` sends each as a FollowJointTrajectory goal (one goal in flight; a new one pre-empts it).
+    """
+    gripper_action: Annotated[
+        StrictStr | None,
+        Field(
+            examples=["gripper_controller/gripper_cmd"],
+            max_length=200,
+            pattern="^[A-Za-z][A-Za-z0-9_]*(/[A-Za-z][A-Za-z0-9_]*){0,7}$",
+            title="RosRelativeName",
+        ),
+    ] = None
+    """
+    The gripper's control_msgs/GripperCommand action (a parallel_gripper_action_controller or gripper_action_controller). Absent: the robot's gripper joints, if any, go through the trajectory controller with the arm.
+    """
+    joint_names: dict[
+        Annotated[
+            str, StringConstraints(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,62}$", strict=True)
+        ],
+        JointNamesAdditionalProperty,
+    ] = {}
+    """
+    The driver's joint names where they differ from the manifest's: manifest joint → driver joint. A joint not listed keeps its manifest name.
+    """
+
+
 class RealDescription(OpenralModel):
     """
     How the physical robot is driven: by `openral deploy real`, `openral robot calibrate` and `build_hal(mode="real")`. The safety envelope is the manifest's own (joint limits, velocity limits, E-stop); this section says which driver reaches the hardware, how often it reads and writes it, and what the E-stop and a shutdown do to it. Absent: the robot has no real driver.
@@ -188,7 +262,7 @@ class RealDescription(OpenralModel):
     )
     driver: Driver
     """
-    Which driver reaches the hardware. `feetech`: a bus of Feetech STS serial servos, one per joint, through feetech-servo-sdk (LeRobot's SO-100 and SO-101 arms); its wiring is `feetech`. More kinds (`ros2_control`) come with their drivers.
+    Which driver reaches the hardware. `feetech`: a bus of Feetech STS serial servos, one per joint, through feetech-servo-sdk (LeRobot's SO-100 and SO-101 arms); its wiring is `feetech`. `ros2_control`: the robot's own ROS 2 driver (franka_ros2, ur_robot_driver, xarm_ros2, ...) with a joint_state_broadcaster and a joint_trajectory_controller, reached over ROS 2 in the namespace given on the command line (`--transport ros2_control:<namespace>`); its names are `ros2_control`.
     """
     control_rate_hz: Annotated[StrictFloat, Field(ge=1.0, le=1000.0)] = 100.0
     """
@@ -213,4 +287,8 @@ class RealDescription(OpenralModel):
     feetech: FeetechBus | None = None
     """
     The Feetech bus (with `driver: feetech`); see FeetechBus.
+    """
+    ros2_control: Ros2ControlDriver | None = None
+    """
+    The robot driver's controllers (with `driver: ros2_control`); see Ros2ControlDriver. Absent: every default.
     """

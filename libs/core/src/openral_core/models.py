@@ -12,6 +12,7 @@ from openral_generated.models.real_schema import (
     FeetechMotor,
     FeetechSettings,
     RealDescription,
+    Ros2ControlDriver,
 )
 from openral_generated.models.robot_schema import (
     Base,
@@ -103,6 +104,7 @@ __all__ = [
     "RealDescription",
     "RgbSensor",
     "RobotDescription",
+    "Ros2ControlDriver",
     "SceneObject",
     "SceneOptions",
     "SceneSpec",

@@ -1,4 +1,5 @@
-"""Cross-field rules of a manifest's ``real`` section (rules 20 to 26 of robot.schema.json).
+"""Cross-field rules of a manifest's ``real`` section (rules 20 to 26, 28 and 29 of
+robot.schema.json).
 
 They keep the wiring a real driver reads sound before anything touches a bus: the feetech
 driver has its bus, every joint has exactly one motor, no two motors share an id, a joint a
@@ -28,8 +29,43 @@ def real_findings(robot: RobotDescription) -> Iterator[Finding]:
             ("real", "driver"),
             ("the feetech driver needs its bus: add a `feetech` section (servo_model, motors)"),
         )
+    for section in ("feetech", "ros2_control"):  # rule 28
+        if getattr(real, section) is not None and real.driver.value != section:
+            yield (
+                ("real", section),
+                f"a `{section}` section belongs to `driver: {section}`; this robot's driver "
+                f"is {real.driver.value!r}",
+            )
+    if real.driver.value == "ros2_control":  # rule 28
+        for key in ("estop", "shutdown"):
+            if getattr(real, key).value != "hold":
+                yield (
+                    ("real", key),
+                    f"a ros2_control driver's {key} is `hold` (its controllers hold the arm; "
+                    "cutting torque is the robot driver's own business)",
+                )
     if real.feetech is not None:
         yield from _feetech_findings(robot, real.feetech)
+    if real.ros2_control is not None:
+        yield from _driver_name_findings(robot, real.ros2_control.joint_names or {})
+
+
+def _driver_name_findings(robot: RobotDescription, renamed: dict[str, str]) -> Iterator[Finding]:
+    """Rule 29: joint_names keys are joints; the driver names they give are distinct."""
+    base: PathKey = ("real", "ros2_control", "joint_names")
+    taken: dict[str, str] = {}
+    for joint in robot.joints:
+        driver = renamed.get(joint.name, joint.name)
+        if driver in taken:
+            yield (
+                (*base, joint.name) if joint.name in renamed else base,
+                f"joints {taken[driver]!r} and {joint.name!r} both take the driver name "
+                f"{driver!r}; each joint needs its own",
+            )
+        taken.setdefault(driver, joint.name)
+    for name in renamed:
+        if name not in {joint.name for joint in robot.joints}:
+            yield (*base, name), _not_a_joint(name, robot)
 
 
 def _feetech_findings(robot: RobotDescription, bus: FeetechBus) -> Iterator[Finding]:

@@ -4,7 +4,8 @@ What a real driver consumes (``generated/openral_generated/tables/<id>.json``, k
 ``real``): the driver kind, its control rate, the E-stop and shutdown behaviour, and for a
 Feetech bus one row per motor in manifest joint order (joint, bus id, the registers written
 at connect) plus the servo model's identity and control table, so the driver needs nothing
-but this table and its calibration file.
+but this table and its calibration file; for a ros2_control driver, its topic, controller
+and action names and the driver's name of every manifest joint.
 """
 
 from __future__ import annotations
@@ -12,7 +13,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from openral_core.models import FeetechBus, FeetechSettings, RealDescription, RobotDescription
+from openral_core.models import (
+    FeetechBus,
+    FeetechSettings,
+    RealDescription,
+    RobotDescription,
+    Ros2ControlDriver,
+)
 from openral_core.servo_models import SERVO_MODELS
 
 
@@ -68,6 +75,26 @@ class FeetechWiring:
 
 
 @dataclass(frozen=True)
+class Ros2ControlWiring:
+    """A ros2_control robot driver with every default filled in (names relative to its
+    namespace)."""
+
+    joint_state_topic: str
+    controller: str
+    command_interface: str
+    """``topic`` or ``action``."""
+    gripper_action: str | None
+    """The GripperCommand action (None: grippers go with the arm's trajectory)."""
+    driver_joints: tuple[str, ...]
+    """The driver's name of each manifest joint, in manifest order."""
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Ros2ControlWiring:
+        """Inverse of ``dataclasses.asdict``."""
+        return cls(**{**data, "driver_joints": tuple(data["driver_joints"])})
+
+
+@dataclass(frozen=True)
 class RealWiring:
     """A robot's real driver with every default filled in (see RealDescription)."""
 
@@ -80,6 +107,7 @@ class RealWiring:
     first_motion_speed_scale: float
     refuse_zero_action: bool
     feetech: FeetechWiring | None
+    ros2_control: Ros2ControlWiring | None
 
     @property
     def control_period_s(self) -> float:
@@ -89,8 +117,14 @@ class RealWiring:
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> RealWiring:
         """Inverse of ``dataclasses.asdict`` (the ``real`` of a tables JSON file)."""
-        bus = data.get("feetech")
-        return cls(**{**data, "feetech": None if bus is None else FeetechWiring.from_dict(bus)})
+        bus, ros = data.get("feetech"), data.get("ros2_control")
+        return cls(
+            **{
+                **data,
+                "feetech": None if bus is None else FeetechWiring.from_dict(bus),
+                "ros2_control": None if ros is None else Ros2ControlWiring.from_dict(ros),
+            }
+        )
 
 
 def real_wiring(robot: RobotDescription) -> RealWiring | None:
@@ -107,6 +141,22 @@ def real_wiring(robot: RobotDescription) -> RealWiring | None:
         first_motion_speed_scale=float(real.first_motion_speed_scale),
         refuse_zero_action=real.refuse_zero_action,
         feetech=_feetech(robot, real.feetech) if real.feetech is not None else None,
+        ros2_control=(
+            _ros2_control(robot, real.ros2_control or Ros2ControlDriver())
+            if real.driver.value == "ros2_control"
+            else None
+        ),
+    )
+
+
+def _ros2_control(robot: RobotDescription, driver: Ros2ControlDriver) -> Ros2ControlWiring:
+    renamed = driver.joint_names or {}
+    return Ros2ControlWiring(
+        joint_state_topic=str(driver.joint_state_topic),
+        controller=str(driver.controller),
+        command_interface=driver.command_interface.value,
+        gripper_action=None if driver.gripper_action is None else str(driver.gripper_action),
+        driver_joints=tuple(renamed.get(joint.name, joint.name) for joint in robot.joints),
     )
 
 

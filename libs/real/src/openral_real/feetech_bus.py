@@ -26,15 +26,14 @@ Where the SDK falls short, and what is done here instead (with its own calls):
 - it drains the port's output before every packet (``tcdrain``) and writes without a time
   limit: on a busy machine a write held the driver's loop for a third of a second; here a
   packet is written as it comes, and only a port that takes nothing for
-  :data:`WRITE_TIMEOUT_S` is a timeout (pyserial's write times out too when the bytes went
-  through but the thread got Python's lock back late).
+  :data:`~openral_real.feetech_port.WRITE_TIMEOUT_S` is a timeout (pyserial's write times
+  out too when the bytes went through but the thread got Python's lock back late).
+  The port is :class:`~openral_real.feetech_port.ExclusivePort`.
 """
 
 from __future__ import annotations
 
 import contextlib
-import os
-import select
 import termios
 import time
 from collections.abc import Sequence
@@ -47,14 +46,10 @@ from openral_core.real_wiring import FeetechWiring
 from openral_core.servo_models import fault_text
 
 from openral_real.errors import BusError, BusFault
+from openral_real.feetech_port import ExclusivePort
 
 PRESENT_FIRST = "Present_Position"
 PRESENT_LAST = "Moving"
-SERIAL_READ_TIMEOUT_S = 0.001
-"""How long one read of the port waits for bytes before the SDK looks at its timeout [s]."""
-WRITE_TIMEOUT_S = 0.02
-"""Longest a packet may take to be handed to the port [s]: a wedged adapter raises (and
-latches the E-stop) instead of holding the driver's loop."""
 STALL_MS = 2.0
 """A reply wait this much longer than its timeout was this thread held up [ms]."""
 CONNECT_TIMEOUT_MS = 50.0
@@ -62,51 +57,6 @@ CONNECT_TIMEOUT_MS = 50.0
 to :data:`CONNECT_TRIES` times before the motor counts as silent (idempotent requests; a
 busy host once missed one 50 ms wait on the emulator)."""
 CONNECT_TRIES = 3
-
-
-class _ExclusivePort(scs.PortHandler):  # type: ignore[misc]
-    """The SDK's port, opened exclusively with a short blocking read (see the module doc)."""
-
-    def setupPort(self, cflag_baud: int) -> bool:  # noqa: N802 (the SDK's name)
-        if getattr(self, "is_open", False):
-            self.closePort()
-        self.ser = serial.Serial(
-            port=self.port_name,
-            baudrate=self.baudrate,
-            bytesize=serial.EIGHTBITS,
-            timeout=SERIAL_READ_TIMEOUT_S,
-            write_timeout=WRITE_TIMEOUT_S,
-            exclusive=True,
-        )
-        self.is_open = True
-        self.ser.reset_input_buffer()
-        self.tx_time_per_byte = (1000.0 / self.baudrate) * 10.0
-        return True
-
-    def clearPort(self) -> None:  # noqa: N802 (the SDK's name)
-        """Nothing: the SDK drains the port's output before every packet (``tcdrain``),
-        which waits for the operating system to pass the last packet on (a third of a
-        second, seen on a busy machine); packets written to one port leave in order
-        anyway."""
-
-    def writePort(self, packet: Sequence[int]) -> int:  # noqa: N802 (the SDK's name)
-        """Hand ``packet`` to the port; a timeout only when the port takes nothing for
-        :data:`WRITE_TIMEOUT_S` (a wedged adapter). pyserial's own write also times out
-        when the bytes went through but this thread got Python's lock back late."""
-        data, fd = bytes(packet), self.ser.fd
-        deadline, sent = time.monotonic() + WRITE_TIMEOUT_S, 0
-        while sent < len(data):
-            with contextlib.suppress(BlockingIOError):  # the port is non-blocking
-                sent += os.write(fd, data[sent:])
-                continue
-            left = deadline - time.monotonic()
-            if left <= 0 or not select.select([], [fd], [], left)[1]:
-                raise serial.SerialTimeoutException("Write timeout")
-        return sent
-
-    def getCurrentTime(self) -> float:  # noqa: N802 (the SDK's name)
-        """Now [ms] on the monotonic clock (the SDK's wall clock can step under a timeout)."""
-        return time.monotonic() * 1000.0
 
 
 @dataclass(frozen=True)
@@ -172,7 +122,7 @@ class FeetechBus:
         Raises:
             BusError: No such port, no permission, or another program holds it.
         """
-        port = _ExclusivePort(self.port_name)
+        port = ExclusivePort(self.port_name)
         port.baudrate = self.wiring.baud_rate
         try:
             port.setBaudRate(self.wiring.baud_rate)
@@ -335,14 +285,24 @@ class FeetechBus:
         return (6 + length) * self._byte_ms + self.reply_timeout_s * 1000.0
 
     def _asked(self, function: Any, *args: Any) -> Any:
-        """A request with a reply (the SDK's ``(..., result, error)``), sent again while it
-        times out, up to :data:`CONNECT_TRIES` times; a late reply is flushed first."""
+        """A request to motor ``args[1]`` with a reply (the SDK's ``(..., result, error)``),
+        sent again while it times out, up to :data:`CONNECT_TRIES` times. Before a retry a
+        late reply gets one more timeout to arrive and is flushed; one the SDK still takes
+        for another request's (it then indexes past its data) counts as a failed try."""
+        reply: Any = None
         for _ in range(CONNECT_TRIES):
             self._port.setPacketTimeoutMillis(CONNECT_TIMEOUT_MS)
-            reply = self._call(function, *args)
-            if reply[-2] != scs.COMM_RX_TIMEOUT:
-                break
+            try:
+                reply = self._call(function, *args)
+            except IndexError:  # the SDK read a late reply of another shape as this one's
+                reply = None
+            if reply is not None and reply[-2] != scs.COMM_RX_TIMEOUT:
+                return reply
+            time.sleep(CONNECT_TIMEOUT_MS / 1000.0)
             self._call(self._port.ser.reset_input_buffer)
+        if reply is None:
+            who = self.names.get(args[1], "the bus")
+            raise BusFault(f"{who} answered out of turn {CONNECT_TRIES} times (late replies)")
         return reply
 
     def _call(self, function: Any, *args: Any) -> Any:

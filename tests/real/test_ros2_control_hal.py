@@ -1,0 +1,107 @@
+"""Ros2ControlHal against deploy sim as the robot: deploy sim runs the Panda in namespace
+``robot`` (its ros2_control surface: /robot/joint_states, the trajectory controller's topic,
+the gripper action) and the HAL drives it as it would drive franka_ros2 on the arm. Killing
+the robot latches the HAL's E-stop within two control periods with one line."""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+from openral_core import open_robot_by_id
+from openral_hal.errors import ConfigurationError, EStopLatched
+from openral_hal.factory import RealOptions, build_hal
+from openral_nodes.runtime import claim_domain_id
+from openral_real.ros2_control_hal import Ros2ControlHal
+from openral_real.ros2_control_link import driver_namespace
+
+from tests.conftest import ROBOTS
+from tests.ros.lifecycle_client import deploy_output, deploy_sim
+from tests.ros.ros_helpers import wait_until
+
+SCENE = ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml"
+PERIOD_S = 0.01
+"""The Panda's real.control_rate_hz is 100."""
+
+
+@pytest.fixture(scope="module")
+def robot_driver(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[object, Path]]:
+    """deploy sim as the robot, in namespace /robot, on a domain of its own."""
+    logs = tmp_path_factory.mktemp("robot")
+    domain = claim_domain_id()
+    before = os.environ.get("ROS_DOMAIN_ID")
+    os.environ["ROS_DOMAIN_ID"] = str(domain)
+    try:
+        with deploy_sim(SCENE, domain, logs, ("--namespace", "robot")) as process:
+            yield process, logs
+    finally:
+        if before is None:
+            os.environ.pop("ROS_DOMAIN_ID", None)
+        else:
+            os.environ["ROS_DOMAIN_ID"] = before
+
+
+@pytest.fixture
+def hal(robot_driver: tuple[object, Path]) -> Iterator[Ros2ControlHal]:
+    robot = open_robot_by_id("franka_panda")
+    options = RealOptions()
+    built = build_hal(robot, mode="real", transport="ros2_control:robot", real_options=options)
+    assert isinstance(built, Ros2ControlHal)
+    built.connect()
+    try:
+        yield built
+    finally:
+        built.disconnect()
+
+
+def test_a_transport_that_is_no_namespace_is_one_line() -> None:
+    assert driver_namespace("ros2_control:/panda/") == "/panda"
+    assert driver_namespace("ros2_control:") == ""
+    for bad in (None, "/dev/ttyACM0", "ros2_control:9lives", "ros2_control:a b"):
+        with pytest.raises(ConfigurationError) as raised:
+            driver_namespace(bad)
+        assert "ros2_control:" in str(raised.value) and "\n" not in str(raised.value)
+
+
+def test_it_reads_the_robot_and_holds_it_where_it_is(hal: Ros2ControlHal) -> None:
+    state = hal.read_state()
+    assert not state.stale and state.names[0] == "panda_joint1"
+    start = np.array([0.0, -0.785398, 0.0, -2.356194, 0.0, 1.570796, 0.785398])
+    np.testing.assert_allclose(state.positions[:7], start, atol=0.02)
+    np.testing.assert_allclose(hal.hold_action(), state.positions, atol=0.01)
+    with pytest.raises(Exception, match="all-zero action"):
+        hal.send_action(np.zeros(8))
+
+
+def test_an_action_moves_the_robots_arm_and_gripper(hal: Ros2ControlHal) -> None:
+    target = hal.hold_action()
+    target[0] += 0.3
+    gripper_open = target[7]
+    target[7] = 0.2 * gripper_open  # most of the way shut
+    hal.send_action(target)
+    wait_until(lambda: abs(hal.read_state().positions[0] - target[0]) < 0.01, 10.0, "joint 1")
+    wait_until(lambda: hal.read_state().positions[7] < 0.5 * gripper_open, 10.0, "the gripper")
+    assert hal.sent > 50
+
+
+def test_killing_the_robot_latches_the_estop_within_two_periods(
+    robot_driver: tuple[object, Path], hal: Ros2ControlHal
+) -> None:
+    process, logs = robot_driver
+    faults: list[tuple[float, str]] = []
+    hal.on_fault = lambda line: faults.append((time.monotonic(), line))
+    assert process.poll() is None, deploy_output(logs)  # type: ignore[attr-defined]
+    process.kill()  # type: ignore[attr-defined]
+    process.wait(10)  # type: ignore[attr-defined]
+    wait_until(lambda: bool(faults), 5.0, "the E-stop")
+    sent = hal.sent
+    assert hal.estopped and len(faults) == 1
+    assert "joint_states stopped" in faults[0][1] and "\n" not in faults[0][1]
+    time.sleep(0.2)
+    assert hal.sent == sent  # nothing sent after the latch
+    with pytest.raises(EStopLatched):
+        hal.release_estop()
