@@ -117,5 +117,5 @@ def test_the_motor_table_follows_manifest_order_and_merges_settings() -> None:
 
 
 def test_a_robot_without_a_real_section_has_no_real_table() -> None:
-    tables = robot_tables(load_robot(REPO / "robots" / "franka_panda" / "robot.yaml"))
+    tables = robot_tables(load_robot(REPO / "robots" / "ur5e" / "robot.yaml"))
     assert tables.real is None

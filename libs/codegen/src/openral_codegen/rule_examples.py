@@ -220,6 +220,17 @@ RULE_BREAKS = (
         SchemaName.ROBOT, 26, SO101_FILE, "    baud_rate: 1000000\n", "    baud_rate: 230400\n"
     ),
     RuleBreak(
+        SchemaName.ROBOT, 28, ROBOT_FILE, "  shutdown: hold  #", "  shutdown: torque_off  #"
+    ),
+    RuleBreak(
+        SchemaName.ROBOT,
+        29,
+        ROBOT_FILE,
+        "    gripper_action: gripper_controller/gripper_cmd\n",
+        "    gripper_action: gripper_controller/gripper_cmd\n"
+        "    joint_names: {panda_joint2: panda_joint1}\n",
+    ),
+    RuleBreak(
         SchemaName.SCENE,
         1,
         SCENE_FILE,

@@ -56,7 +56,7 @@ def _driver_name_findings(robot: RobotDescription, renamed: dict[str, str]) -> I
     taken: dict[str, str] = {}
     for joint in robot.joints:
         driver = renamed.get(joint.name, joint.name)
-        if driver in taken:
+        if driver in taken and taken[driver] != joint.name:  # a repeated name is rule 2's
             yield (
                 (*base, joint.name) if joint.name in renamed else base,
                 f"joints {taken[driver]!r} and {joint.name!r} both take the driver name "
