@@ -219,9 +219,7 @@ RULE_BREAKS = (
     RuleBreak(
         SchemaName.ROBOT, 26, SO101_FILE, "    baud_rate: 1000000\n", "    baud_rate: 230400\n"
     ),
-    RuleBreak(
-        SchemaName.ROBOT, 28, ROBOT_FILE, "  shutdown: hold  #", "  shutdown: torque_off  #"
-    ),
+    RuleBreak(SchemaName.ROBOT, 28, ROBOT_FILE, "  shutdown: hold  #", "  shutdown: torque_off  #"),
     RuleBreak(
         SchemaName.ROBOT,
         29,
