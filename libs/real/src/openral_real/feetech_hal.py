@@ -33,11 +33,10 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
-from openral_core.models import LimitedJoint, RgbSensor, RobotDescription
+from openral_core.models import LimitedJoint, RgbSensor
 from openral_core.real_wiring import FeetechWiring, RealWiring
-from openral_hal.errors import ActionRejected, ConfigurationError, NotConnected
+from openral_hal.errors import ConfigurationError, NotConnected
 from openral_hal.factory import RealOptions
-from openral_hal.protocol import EStopLatch
 from openral_mujoco.action import validated_action
 from openral_mujoco.state import FloatArray, JointStateSample
 from openral_sim.frame_tree import FrameTree
@@ -52,6 +51,7 @@ from openral_real.calibration import (
 from openral_real.errors import BusError, BusFault
 from openral_real.feetech_bus import FeetechBus, ServoReading
 from openral_real.kinematic_twin import KinematicTwin
+from openral_real.manifest_arm import ManifestArm
 from openral_real.motion_envelope import MotionEnvelope
 from openral_real.opencv_cameras import Cameras, camera_devices
 from openral_real.servo_units import ServoUnits
@@ -86,7 +86,7 @@ def feetech_hal(robot: LoadedRobot, transport: str | None, options: RealOptions)
     return FeetechHal(robot, transport, options)
 
 
-class FeetechHal(EStopLatch):
+class FeetechHal(ManifestArm):
     """A Feetech servo arm, driven through the manifest (see the module doc)."""
 
     is_real = True
@@ -120,26 +120,6 @@ class FeetechHal(EStopLatch):
         self._froze = False
 
     # -- what the HAL is ---------------------------------------------------------------------
-
-    @property
-    def description(self) -> RobotDescription:
-        """The manifest this HAL drives."""
-        return self.robot.description
-
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        """Canonical joint names in manifest order."""
-        return tuple(joint.name for joint in self.robot.description.joints)
-
-    @property
-    def action_names(self) -> tuple[str, ...]:
-        """One action slot per manifest joint (a gripper in its write mode)."""
-        return self.joint_names
-
-    @property
-    def control_period_s(self) -> float:
-        """One read-and-write cycle of the bus [s]."""
-        return self.real.control_period_s
 
     @property
     def connected(self) -> bool:
@@ -246,21 +226,6 @@ class FeetechHal(EStopLatch):
         values = validated_action(np.asarray(action, dtype=np.float64), self.action_names)
         self.screen_action(values)
         session.envelope.aim(session.units.action_angles(values))
-
-    def screen_action(self, values: FloatArray) -> None:
-        """Refuse an all-zero action (unless the manifest allows it) and any action while
-        the E-stop is latched; ``values`` already has the right width and is finite.
-
-        Raises:
-            ActionRejected: All zeros. EStopLatched: The E-stop is latched.
-        """
-        if self.real.refuse_zero_action and not np.any(values):
-            raise ActionRejected(
-                "an all-zero action commands every joint to 0 and the gripper shut on an "
-                "absolute-position arm; zero is not hold on a real robot: send the hold "
-                "action (/openral/action_spec) or the measured positions"
-            )
-        self._refuse_when_estopped()
 
     @property
     def clamped(self) -> npt.NDArray[np.int64]:

@@ -35,13 +35,13 @@ import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
 from openral_core.models import LimitedJoint, RobotDescription
 from openral_core.real_wiring import RealWiring, Ros2ControlWiring
-from openral_hal.errors import ActionRejected, ConfigurationError, NotConnected
+from openral_hal.errors import ConfigurationError, NotConnected
 from openral_hal.factory import RealOptions
-from openral_hal.protocol import EStopLatch
 from openral_mujoco.action import validated_action
 from openral_mujoco.gripper import reading_map
 from openral_mujoco.state import FloatArray, JointStateSample
 
+from openral_real.manifest_arm import ManifestArm
 from openral_real.motion_envelope import MotionEnvelope
 from openral_real.ros2_control_link import JointReading, Ros2ControlLink, driver_namespace
 
@@ -62,7 +62,7 @@ def ros2_control_hal(
     return Ros2ControlHal(robot, driver_namespace(transport))
 
 
-class Ros2ControlHal(EStopLatch):
+class Ros2ControlHal(ManifestArm):
     """A ros2_control robot driver as a real HAL (see the module doc)."""
 
     is_real = True
@@ -98,26 +98,6 @@ class Ros2ControlHal(EStopLatch):
         self._watchdog: threading.Thread | None = None
 
     # -- what the HAL is ---------------------------------------------------------------------
-
-    @property
-    def description(self) -> RobotDescription:
-        """The manifest this HAL drives."""
-        return self.robot.description
-
-    @property
-    def joint_names(self) -> tuple[str, ...]:
-        """Canonical joint names in manifest order."""
-        return tuple(joint.name for joint in self.robot.description.joints)
-
-    @property
-    def action_names(self) -> tuple[str, ...]:
-        """One action slot per manifest joint (a gripper in its write mode)."""
-        return self.joint_names
-
-    @property
-    def control_period_s(self) -> float:
-        """The period the robot driver is commanded at [s]."""
-        return self.real.control_period_s
 
     @property
     def connected(self) -> bool:
@@ -203,19 +183,6 @@ class Ros2ControlHal(EStopLatch):
         values = validated_action(np.asarray(action, dtype=np.float64), self.action_names)
         self.screen_action(values)
         self._envelope.aim(self._joint_values(values))
-
-    def screen_action(self, values: FloatArray) -> None:
-        """Refuse an all-zero action (unless allowed) and any action while E-stopped.
-
-        Raises:
-            ActionRejected: All zeros. EStopLatched: The E-stop is latched.
-        """
-        if self.real.refuse_zero_action and not np.any(values):
-            raise ActionRejected(
-                "an all-zero action commands every joint to 0; zero is not hold on a real "
-                "robot: send the hold action (/openral/action_spec) or the measured positions"
-            )
-        self._refuse_when_estopped()
 
     @property
     def clamped(self) -> npt.NDArray[np.int64]:

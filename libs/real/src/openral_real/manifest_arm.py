@@ -1,0 +1,57 @@
+"""What every real arm HAL of the manifest shares: its names, its period, and the rule that
+refuses an all-zero action (one place for both drivers, Feetech and ros2_control)."""
+
+from __future__ import annotations
+
+import numpy as np
+from openral_core.loaded import LoadedRobot
+from openral_core.models import RobotDescription
+from openral_core.real_wiring import RealWiring
+from openral_hal.errors import ActionRejected
+from openral_hal.protocol import EStopLatch
+from openral_mujoco.state import FloatArray
+
+__all__ = ["ManifestArm"]
+
+
+class ManifestArm(EStopLatch):
+    """A real arm driven through the manifest: one action slot per joint (a mixin; the HAL
+    sets :attr:`robot` and :attr:`real`)."""
+
+    robot: LoadedRobot
+    real: RealWiring
+
+    @property
+    def description(self) -> RobotDescription:
+        """The manifest this HAL drives."""
+        return self.robot.description
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Canonical joint names in manifest order."""
+        return tuple(joint.name for joint in self.robot.description.joints)
+
+    @property
+    def action_names(self) -> tuple[str, ...]:
+        """One action slot per manifest joint (a gripper in its write mode)."""
+        return self.joint_names
+
+    @property
+    def control_period_s(self) -> float:
+        """One read-and-write cycle of the driver [s]."""
+        return self.real.control_period_s
+
+    def screen_action(self, values: FloatArray) -> None:
+        """Refuse an all-zero action (unless the manifest allows it) and any action while
+        the E-stop is latched; ``values`` already has the right width and is finite.
+
+        Raises:
+            ActionRejected: All zeros. EStopLatched: The E-stop is latched.
+        """
+        if self.real.refuse_zero_action and not np.any(values):
+            raise ActionRejected(
+                "an all-zero action commands every joint to 0 and the gripper shut on an "
+                "absolute-position arm; zero is not hold on a real robot: send the hold "
+                "action (/openral/action_spec) or the measured positions"
+            )
+        self._refuse_when_estopped()
