@@ -198,6 +198,7 @@ def test_the_servos_holding_another_calibration_are_refused_untouched(
     assert gc.get_freeze_count() == 0  # the heap frozen for the loop is given back
 
 
+@pytest.mark.exclusive  # torque off within one 10 ms period: a real-time measurement
 def test_an_estop_that_cuts_torque_and_a_release_that_holds_again(
     so101: LoadedRobot, tmp_path: Path
 ) -> None:
