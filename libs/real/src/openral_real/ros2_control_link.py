@@ -4,7 +4,8 @@ goals out, on a ROS 2 context of the link's own.
 The link knows ROS and names, nothing of the robot's safety: what to send and when is
 :class:`~openral_real.ros2_control_hal.Ros2ControlHal`'s. It runs one executor thread of
 its own, so the driver's readings arrive whatever the caller's graph is doing, and it is
-isolated from the caller's nodes (its own ``rclpy`` context, on the same ``ROS_DOMAIN_ID``).
+isolated from the caller's nodes (its own ``rclpy`` context, on the process's
+``ROS_DOMAIN_ID``, which ``deploy real --domain-id`` sets).
 
 Names are the driver's, under its namespace: ``/<ns>/<joint_state_topic>``,
 ``/<ns>/<controller>/joint_trajectory`` (or ``follow_joint_trajectory``) and

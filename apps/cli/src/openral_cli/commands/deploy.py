@@ -19,6 +19,7 @@ is held where it is at bring-up, and at the end it holds, then takes the manifes
 
 from __future__ import annotations
 
+import os
 import signal
 import threading
 import time
@@ -186,6 +187,8 @@ def real(
     require_ros()
     from openral_nodes.runtime import ros_session
 
+    if domain_id is not None:  # a driver's own ROS link (ros2_control) joins the same domain
+        os.environ["ROS_DOMAIN_ID"] = str(domain_id)
     with ros_session(domain_id=domain_id) as context:
         recorder = None
         if record is not None:
