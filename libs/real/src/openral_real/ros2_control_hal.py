@@ -35,7 +35,7 @@ import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
 from openral_core.models import LimitedJoint, RobotDescription
 from openral_core.real_wiring import RealWiring, Ros2ControlWiring
-from openral_hal.errors import ConfigurationError, NotConnected
+from openral_hal.errors import ConfigurationError, EStopLatched, NotConnected
 from openral_hal.factory import RealOptions
 from openral_mujoco.action import validated_action
 from openral_mujoco.gripper import reading_map
@@ -210,8 +210,6 @@ class Ros2ControlHal(ManifestArm):
     def _on_release(self) -> None:
         """Start again from the measured pose, slowly (a stale stream stays latched)."""
         if self._link is not None and self.read_state().stale:
-            from openral_hal.errors import EStopLatched
-
             raise EStopLatched("the robot driver's readings are stale; release refused")
         self._envelope.start(self._measured())
         self._gripper_sent, self.estop_reason = None, None
@@ -283,15 +281,12 @@ class Ros2ControlHal(ManifestArm):
 
     def _measured(self) -> FloatArray:
         """The newest reading in joint units (the gripper's slot back in its joint's)."""
-        sample = self._newest()
-        joints = sample.positions.copy()
-        if self._gripper is not None:
-            slot, offset, gain = self._gripper
-            joints[slot] = (joints[slot] - offset) / gain
-        return joints
+        return self._joint_values(self._newest().positions)
 
-    def _joint_values(self, action: FloatArray) -> FloatArray:
-        joints = np.asarray(action, dtype=np.float64).copy()
+    def _joint_values(self, slots: FloatArray) -> FloatArray:
+        """Action-slot values (or a reading's positions) in joint units: the gripper's slot
+        through the inverse of its reading map."""
+        joints = np.asarray(slots, dtype=np.float64).copy()
         if self._gripper is not None:
             slot, offset, gain = self._gripper
             joints[slot] = (joints[slot] - offset) / gain
