@@ -185,6 +185,7 @@ def real(
     parameters = _real_parameters(robot, manifest, transport, arm_id, calibration, camera)
     parameters.update(_tf_parameters(no_tf, no_static_tf))
     require_ros()
+    from openral_hal.realtime import ahead_of_other_programs
     from openral_nodes.runtime import ros_session
 
     if domain_id is not None:  # a driver's own ROS link (ros2_control) joins the same domain
@@ -195,7 +196,8 @@ def real(
             recorder = start_recording(record, overwrite, context.get_domain_id())
         try:
             title = f"deploy real: {{robot}} on {transport}"  # {robot}: the node's, once loaded
-            reason, elapsed_s = _run_graph(context, parameters, title, duration, namespace)
+            with ahead_of_other_programs():  # the recorder (started above) stays ordinary
+                reason, elapsed_s = _run_graph(context, parameters, title, duration, namespace)
         finally:
             if recorder is not None:
                 stop_recording(recorder)

@@ -53,6 +53,7 @@ def bus(
     """Serve ROBOT_ID's servo bus on a pseudo-terminal; print its path first."""
     from openral_core import open_robot_by_id
     from openral_core.loader import load_scene
+    from openral_hal.realtime import ahead_of_other_programs
     from openral_real.emulator.emulated_bus import EmulatedBus
 
     robot = open_robot_by_id(robot_id)
@@ -63,7 +64,8 @@ def bus(
     log_file = log.open("w", encoding="utf-8") if log is not None else None
     try:
         emulated = EmulatedBus(robot, scene=loaded_scene, seed=seed, log=log_file, link=link)
-        _serve(emulated)
+        with ahead_of_other_programs():  # servos answer whatever else runs
+            _serve(emulated)
     finally:
         if log_file is not None:
             log_file.close()
