@@ -41,3 +41,18 @@ class NamespacedEntities:
 
     def create_service(self, srv_type: Any, srv_name: str, callback: Any, **kwargs: Any) -> Any:
         return super().create_service(srv_type, self._graph_name(srv_name), callback, **kwargs)  # type: ignore[misc]
+
+
+def namespaced_node(name: str, namespace: str, **kwargs: Any) -> Any:
+    """A plain rclpy node named ``name`` whose absolute names land under ``namespace``
+    (a client of a namespaced graph: :class:`NamespacedEntities`).
+
+    Raises:
+        rclpy's InvalidNamespaceException (and kin): A namespace ROS refuses.
+    """
+    from rclpy.node import Node
+
+    class ClientNode(NamespacedEntities, Node):
+        pass
+
+    return ClientNode(name, namespace=namespace, **kwargs)

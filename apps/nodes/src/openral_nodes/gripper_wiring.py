@@ -14,11 +14,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from openral_core.loaded import LoadedRobot
-from openral_core.models import GripperReadMode, GripperWriteMode, LimitedJoint
-from openral_mujoco.gripper import reading_map
+from openral_core.models import LimitedJoint
+from openral_mujoco.gripper import SlotMap, slot_map, units_mismatch
 from openral_mujoco.state import JointStateSample
-
-NORMALISED_READINGS = (GripperReadMode.sum_over_scale, GripperReadMode.affine_low_high)
 
 
 @dataclass(frozen=True)
@@ -29,21 +27,20 @@ class GripperAxis:
     slot: int
     limits: tuple[float, float]
     """The manifest's position limits of the joint (URDF units)."""
-    offset: float
-    gain: float
-    """Reading = ``offset + gain * q`` with every finger at ``q``."""
+    map: SlotMap
+    """The slot against the joint position (every finger at it)."""
 
     def command(self, position: float) -> float:
         """The action slot's value that sends the gripper to ``position``."""
-        return self.offset + self.gain * position
+        return self.map.slot(position)
 
     def position(self, state: JointStateSample) -> float:
         """The joint position of a HAL reading."""
-        return (float(state.positions[self.slot]) - self.offset) / self.gain
+        return self.map.joint(float(state.positions[self.slot]))
 
     def speed(self, state: JointStateSample) -> float:
         """The joint speed of a HAL reading [unit/s]."""
-        return float(state.velocities[self.slot]) / self.gain
+        return float(state.velocities[self.slot]) / self.map.gain
 
     def effort(self, state: JointStateSample) -> float:
         """The gripper's effort in a HAL reading (N or N·m)."""
@@ -59,15 +56,9 @@ def gripper_axis(robot: LoadedRobot, action_names: tuple[str, ...]) -> GripperAx
     gripper = wiring.grippers[0]
     if gripper.joint not in action_names:
         return f"the gripper {gripper.joint} is no slot of this scene's action"
-    normalised_in = gripper.read_mode in NORMALISED_READINGS
-    normalised_out = gripper.write_mode == GripperWriteMode.normalised
-    if normalised_in != normalised_out:
-        return (
-            f"its read mode {gripper.read_mode} and write mode {gripper.write_mode} do not "
-            "share units"
-        )
-    fingers = len(gripper.qpos_addrs)
-    read = reading_map(gripper.read_mode, fingers, gripper.ctrl_range, gripper.qpos_scale)
+    mismatch = units_mismatch(gripper.read_mode, gripper.write_mode)
+    if mismatch is not None:
+        return mismatch
     joint = next(j for j in robot.description.joints if j.name == gripper.joint)
     if not isinstance(joint, LimitedJoint):
         return f"the gripper {gripper.joint} is continuous: a GripperCommand needs limits"
@@ -76,6 +67,7 @@ def gripper_axis(robot: LoadedRobot, action_names: tuple[str, ...]) -> GripperAx
         joint=gripper.joint,
         slot=action_names.index(gripper.joint),
         limits=(float(low), float(high)),
-        offset=read.offset,
-        gain=sum(read.weights),
+        map=slot_map(
+            gripper.read_mode, len(gripper.qpos_addrs), gripper.ctrl_range, gripper.qpos_scale
+        ),
     )

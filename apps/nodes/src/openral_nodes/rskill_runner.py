@@ -38,6 +38,7 @@ from rclpy.qos import (
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float64MultiArray
 
+from openral_nodes.graph_names import NamespacedEntities
 from openral_nodes.topic_codec import image_to_rgb
 
 T = TypeVar("T")
@@ -132,7 +133,7 @@ def _refuse_off_graph(policy: PolicyAdapter, name: str) -> None:
         )
 
 
-class RskillRunnerNode(Node):
+class RskillRunnerNode(NamespacedEntities, Node):
     """Runs one policy against the openral topic contract (see the module docstring).
 
     ROS parameters: ``robot_id`` (str), ``policy`` (built-in policy name, default
@@ -148,8 +149,14 @@ class RskillRunnerNode(Node):
         context: Context | None = None,
         parameter_overrides: list[Parameter] | None = None,
         policy: PolicyAdapter | None = None,
+        namespace: str = "",
     ) -> None:
-        super().__init__("rskill_runner", context=context, parameter_overrides=parameter_overrides)
+        super().__init__(
+            "rskill_runner",
+            context=context,
+            parameter_overrides=parameter_overrides,
+            namespace=namespace,
+        )
         robot_id = str(self.declare_parameter("robot_id", "").value)
         policy_name = str(self.declare_parameter("policy", "wave").value)
         params = self.declare_parameter("policy_params", Parameter.Type.STRING_ARRAY).value

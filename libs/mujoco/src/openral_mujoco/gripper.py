@@ -97,3 +97,42 @@ def gripper_command(mode: str, ctrl: float, ctrl_range: tuple[float, float]) -> 
     forward = command_map(mode, ctrl_range)
     low, high = command_range(mode, ctrl_range)
     return min(max((ctrl - forward.offset) / forward.weights[0], low), high)
+
+
+NORMALISED_READINGS = (GripperReadMode.sum_over_scale, GripperReadMode.affine_low_high)
+"""Read modes that give a 0-1 opening (the others give the finger's own units)."""
+
+
+@dataclass(frozen=True)
+class SlotMap:
+    """A gripper's action slot against its URDF joint: with every finger at ``q`` (metres or
+    radians) the slot reads ``offset + gain * q``. A command in a write mode that shares the
+    read mode's units is that same value."""
+
+    offset: float
+    gain: float
+
+    def slot(self, joint: float) -> float:
+        """The slot's value with every finger at ``joint``."""
+        return self.offset + self.gain * joint
+
+    def joint(self, slot: float) -> float:
+        """The finger position a slot value stands for."""
+        return (slot - self.offset) / self.gain
+
+
+def slot_map(
+    read_mode: str, fingers: int, ctrl_range: tuple[float, float], qpos_scale: float
+) -> SlotMap:
+    """The reading map (:func:`reading_map`) of ``fingers`` fingers moving together."""
+    affine = reading_map(read_mode, fingers, ctrl_range, qpos_scale)
+    return SlotMap(float(affine.offset), float(sum(affine.weights)))
+
+
+def units_mismatch(read_mode: str, write_mode: str) -> str | None:
+    """Why a gripper's commands cannot be given in its readings' units (None: they can):
+    a normalised command with a reading in the finger's units, or the reverse."""
+    normalised_in = read_mode in NORMALISED_READINGS
+    if normalised_in == (write_mode == GripperWriteMode.normalised):
+        return None
+    return f"its read mode {read_mode} and write mode {write_mode} do not share units"

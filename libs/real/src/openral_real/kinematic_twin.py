@@ -41,10 +41,13 @@ class KinematicTwin:
         self.data = mujoco.MjData(self.model)
         addresses = locate_robot(wiring, self.model, self.model)
         self._qpos = np.array([wiring.joint_qpos_addr[name] for name in wiring.joint_names])
-        gripper_qpos = {g.joint: g.qpos_addrs[0] for g in wiring.grippers}
+        fingers = {g.joint: g.qpos_addrs for g in wiring.grippers}
+        self._fingers: list[tuple[int, list[int]]] = []
+        """(slot, the other fingers' qpos addresses) of each gripper: they follow the first."""
         for slot, name in enumerate(wiring.joint_names):
-            if name in gripper_qpos:
-                self._qpos[slot] = gripper_qpos[name]
+            if name in fingers:
+                self._qpos[slot] = fingers[name][0]
+                self._fingers.append((slot, list(fingers[name][1:])))
         self._dof = np.array([int(self.model.jnt_dofadr[j]) for j in self._joints_at(self._qpos)])
         self._addresses = addresses
         self._tree: FrameTree | None = None
@@ -52,10 +55,13 @@ class KinematicTwin:
     def pose(
         self, angles: FloatArray, rates: FloatArray, efforts: FloatArray, time_s: float
     ) -> None:
-        """Put every joint at ``angles`` [rad, a gripper's jaw angle], moving at ``rates``
-        [rad/s] and pushing with ``efforts`` [N m], as of ``time_s`` [s, system clock]."""
+        """Put every joint at ``angles`` [rad or m; a gripper's fingers all at its joint's
+        position], moving at ``rates`` [rad/s or m/s] and pushing with ``efforts`` [N m or
+        N], as of ``time_s`` [s, system clock]."""
         data = self.data
         data.qpos[self._qpos] = angles
+        for slot, others in self._fingers:
+            data.qpos[others] = angles[slot]
         data.qvel[self._dof] = rates
         data.qfrc_actuator[self._dof] = efforts
         data.time = time_s

@@ -30,6 +30,7 @@ import threading
 import time
 from collections.abc import Callable
 
+import mujoco
 import numpy as np
 import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
@@ -38,9 +39,11 @@ from openral_core.real_wiring import RealWiring, Ros2ControlWiring
 from openral_hal.errors import ConfigurationError, EStopLatched, NotConnected
 from openral_hal.factory import RealOptions
 from openral_mujoco.action import validated_action
-from openral_mujoco.gripper import reading_map
+from openral_mujoco.gripper import SlotMap, slot_map, units_mismatch
 from openral_mujoco.state import FloatArray, JointStateSample
+from openral_sim.frame_tree import FrameTree
 
+from openral_real.kinematic_twin import KinematicTwin
 from openral_real.manifest_arm import ManifestArm
 from openral_real.motion_envelope import MotionEnvelope
 from openral_real.ros2_control_link import JointReading, Ros2ControlLink, driver_namespace
@@ -85,6 +88,7 @@ class Ros2ControlHal(ManifestArm):
         self.sent = 0
         """Trajectories sent to the driver."""
         self._gripper = _gripper_map(robot, self.wiring)
+        self._twin = KinematicTwin(robot) if robot.tables.hal_wiring is not None else None
         self._link: Ros2ControlLink | None = None
         self._envelope = _envelope(robot.description, real)
         self._speeds = np.array([float(j.velocity_limit) for j in robot.description.joints])
@@ -214,6 +218,28 @@ class Ros2ControlHal(ManifestArm):
         self._envelope.start(self._measured())
         self._gripper_sent, self.estop_reason = None, None
 
+    # -- frames ------------------------------------------------------------------------------
+
+    def frame_tree(self) -> FrameTree | None:
+        """The robot's frames in its own model (None without a sim block)."""
+        return self._twin.frame_tree() if self._twin is not None else None
+
+    def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
+        """The kinematic twin's (model, data), posed by :meth:`pose_twin`."""
+        return (self._twin.model, self._twin.data) if self._twin is not None else None
+
+    def pose_twin(self, sample: JointStateSample) -> None:
+        """Put the twin at ``sample``'s joints (the gripper's fingers at its joint's
+        position), as of its stamp."""
+        if self._twin is None:
+            return
+        rates = sample.velocities.copy()
+        if self._gripper is not None:
+            slot, axis = self._gripper
+            rates[slot] /= axis.gain
+        angles = self._joint_values(sample.positions)
+        self._twin.pose(angles, rates, sample.efforts, sample.stamp_ns / 1e9)
+
     # -- internals ---------------------------------------------------------------------------
 
     def _reading(self, reading: JointReading) -> None:
@@ -242,9 +268,9 @@ class Ros2ControlHal(ManifestArm):
         rows = np.array([values[name] for name in self.wiring.driver_joints], dtype=np.float64)
         positions, velocities = rows[:, 0].copy(), rows[:, 1].copy()
         if self._gripper is not None:
-            slot, offset, gain = self._gripper
-            positions[slot] = offset + gain * positions[slot]
-            velocities[slot] *= gain
+            slot, axis = self._gripper
+            positions[slot] = axis.slot(positions[slot])
+            velocities[slot] *= axis.gain
         efforts = rows[:, 2].copy()
         return JointStateSample(
             self.joint_names, positions, velocities, efforts, round(stamp_s * 1e9), None, False
@@ -288,8 +314,8 @@ class Ros2ControlHal(ManifestArm):
         through the inverse of its reading map."""
         joints = np.asarray(slots, dtype=np.float64).copy()
         if self._gripper is not None:
-            slot, offset, gain = self._gripper
-            joints[slot] = (joints[slot] - offset) / gain
+            slot, axis = self._gripper
+            joints[slot] = axis.joint(joints[slot])
         return joints
 
     def _wait_for_driver(self, link: Ros2ControlLink) -> None:
@@ -344,9 +370,13 @@ def _envelope(description: RobotDescription, real: RealWiring) -> MotionEnvelope
     )
 
 
-def _gripper_map(robot: LoadedRobot, wiring: Ros2ControlWiring) -> tuple[int, float, float] | None:
-    """(slot, offset, gain) of the first gripper: slot value = offset + gain * joint position,
-    the manifest's reading map with every finger at the same position (None: no gripper)."""
+def _gripper_map(robot: LoadedRobot, wiring: Ros2ControlWiring) -> tuple[int, SlotMap] | None:
+    """The first gripper's slot and its map to the driver's joint units (None: no gripper).
+
+    Raises:
+        ConfigurationError: A gripper action for a gripper whose commands do not share its
+            readings' units (no one map converts both).
+    """
     hal = robot.tables.hal_wiring
     if hal is None or not hal.grippers:
         return None
@@ -354,6 +384,9 @@ def _gripper_map(robot: LoadedRobot, wiring: Ros2ControlWiring) -> tuple[int, fl
     names = [joint.name for joint in robot.description.joints]
     if gripper.joint not in names:
         return None
+    mismatch = units_mismatch(gripper.read_mode, gripper.write_mode)
+    if mismatch is not None and wiring.gripper_action is not None:
+        raise ConfigurationError(f"{robot.name}: no gripper_action for {gripper.joint}: {mismatch}")
     fingers = len(gripper.qpos_addrs)
-    affine = reading_map(gripper.read_mode, fingers, gripper.ctrl_range, gripper.qpos_scale)
-    return names.index(gripper.joint), float(affine.offset), float(sum(affine.weights))
+    axis = slot_map(gripper.read_mode, fingers, gripper.ctrl_range, gripper.qpos_scale)
+    return names.index(gripper.joint), axis

@@ -34,6 +34,7 @@ from openral_cli.commands.recording import start_recording, stop_recording
 from openral_cli.console import out
 from openral_cli.deploy_interfaces import print_interfaces
 from openral_cli.help_text import command_group
+from openral_cli.namespace_option import Namespace, bad_namespace
 from openral_cli.ros_available import require_ros
 
 if TYPE_CHECKING:
@@ -64,13 +65,6 @@ NoStaticTf = Annotated[
     typer.Option(
         "--no-static-tf",
         help="With --no-tf, also leave out the frames no URDF holds (world, odom, scene cameras).",
-    ),
-]
-Namespace = Annotated[
-    str,
-    typer.Option(
-        "--namespace",
-        help="Put the whole graph under this ROS namespace (/arm: /arm/joint_states, ...).",
     ),
 ]
 Duration = Annotated[
@@ -314,7 +308,7 @@ def _make_node(
             shutdown_event=stop,
         )
     except Exception as error:  # rclpy's InvalidNamespaceException and kin
-        raise OpenralError(f"--namespace {namespace!r}: {error}".splitlines()[0]) from None
+        raise bad_namespace(namespace, error) from None
     node.heap.enabled = True  # short garbage collections while active (heap_freeze)
     return node
 

@@ -26,6 +26,7 @@ import typer
 
 from openral_cli.console import line, out, progress, status
 from openral_cli.help_text import PARAM_HELP, command_group
+from openral_cli.namespace_option import Namespace, checked
 from openral_cli.ros_available import require_ros
 
 if TYPE_CHECKING:
@@ -59,6 +60,7 @@ def run(
         typer.Option("--frame-timeout", min=0.1, help="Seconds a required input may be missing."),
     ] = 5.0,
     domain_id: DomainId = None,
+    namespace: Namespace = "",
 ) -> None:
     """Run POLICY for ROBOT: camera frames by VLA slot in, /openral/safe_action out."""
     require_ros()
@@ -74,7 +76,9 @@ def run(
     )
     # The node logs an abort too; this command reports it itself, as the one message.
     with ros_session(domain_id, ["--ros-args", "--disable-stdout-logs"]) as context:
-        node = RskillRunnerNode(context=context, parameter_overrides=overrides)
+        node = RskillRunnerNode(
+            context=context, parameter_overrides=overrides, namespace=checked(namespace)
+        )
         try:
             with Spinner(context) as spinner, _sigterm_as_interrupt():
                 spinner.add_node(node)
@@ -158,18 +162,24 @@ def trajectory(
         float, typer.Option("--timeout", min=0.1, help="Seconds to wait for the graph.")
     ] = 10.0,
     domain_id: DomainId = None,
+    namespace: Namespace = "",
 ) -> None:
     """Send one joint trajectory on ``/openral/joint_trajectory`` (from where the joints are
     to the goals in SECONDS), follow it and print how closely the joints tracked it."""
     require_ros()
     from openral_bridge.topics import JOINT_TRAJECTORY
+    from openral_nodes.graph_names import namespaced_node
     from openral_nodes.runtime import Spinner, ros_session
     from openral_nodes.trajectory_sender import TrajectorySender, parse_moves
-    from rclpy.node import Node
 
     moves = parse_moves(move)
     with ros_session(domain_id) as context:
-        node = Node("openral_trajectory_sender", context=context, start_parameter_services=False)
+        node = namespaced_node(
+            "openral_trajectory_sender",
+            checked(namespace),
+            context=context,
+            start_parameter_services=False,
+        )
         try:
             with Spinner(context) as spinner, _sigterm_as_interrupt():
                 spinner.add_node(node)
@@ -189,7 +199,7 @@ def trajectory(
                         on_progress=advance,
                     )
         finally:
-            node.destroy_node()  # type: ignore[no-untyped-call]
+            node.destroy_node()
     _print_report(report, seconds, cubic)
 
 
