@@ -8,7 +8,9 @@ the rule lives in one place.
 
 Each tick (``rate_hz``) the node builds an :class:`~openral_eval.policies.Observation`
 from the latest frames, ``/joint_states`` and the latched ``/openral/action_spec``, calls
-the policy and publishes its action on ``/openral/safe_action``. Until ``frame_timeout_s``
+the policy and publishes its action on ``/openral/safe_action`` (an ``ee_delta_pose``
+policy's action first becomes joint targets: :mod:`openral_nodes.graph_ee_actions`). With a
+namespace, every name lands under it, as deploy's do. Until ``frame_timeout_s``
 after start it waits for missing inputs; after that a missing input (or a camera slot
 whose frames stopped for ``frame_timeout_s``) aborts the runner: ``abort_error`` is set,
 the timer stops, and nothing more is published.
@@ -38,6 +40,7 @@ from rclpy.qos import (
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import Float64MultiArray
 
+from openral_nodes.graph_ee_actions import GraphEeActions
 from openral_nodes.graph_names import NamespacedEntities
 from openral_nodes.topic_codec import image_to_rgb
 
@@ -125,11 +128,10 @@ def _refuse_off_graph(policy: PolicyAdapter, name: str) -> None:
             f"policy {name} reads the simulation itself (privileged state); "
             "it runs in `openral sim sweep`, not on a ROS graph"
         )
-    if action_mode(policy) != "joint_position":
+    if action_mode(policy) not in ("joint_position", "ee_delta_pose"):
         raise RunnerAborted(
-            f"policy {name} acts in {action_mode(policy)}; a ROS graph takes joint targets "
-            "on /openral/safe_action (end-effector targets are not served there yet); run it "
-            "with `openral sim sweep` or `sim run --policy`"
+            f"policy {name} acts in {action_mode(policy)}; on a ROS graph a policy acts in "
+            "joint_position or ee_delta_pose; run it with `openral sim sweep`"
         )
 
 
@@ -182,6 +184,9 @@ class RskillRunnerNode(NamespacedEntities, Node):
                 "; pick another policy or set its required_slots parameter",
             )
         self._joint_names = [joint.name for joint in robot.description.joints]
+        self._ee = None
+        if action_mode(self.policy) == "ee_delta_pose":  # the runner's own IK: module doc
+            self._ee = GraphEeActions(robot, 1.0 / rate_hz)
         self._frames: dict[str, tuple[float, Any]] = {}
         self._joints: dict[str, float] = {}
         self._spec: tuple[tuple[str, ...], npt.NDArray[np.float64]] | None = None
@@ -246,6 +251,10 @@ class RskillRunnerNode(NamespacedEntities, Node):
                 time_s=now - self._first_act,
             )
             action = np.asarray(self.policy.act(obs), dtype=np.float64)
+            if self._ee is not None:
+                if not self._ee.started:
+                    self._ee.start(self._spec[1], self._joints)
+                action = self._ee.joint_action(action, self._joints)
         except OpenralError as error:
             self._abort(error)
             return

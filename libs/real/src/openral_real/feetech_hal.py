@@ -33,7 +33,7 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
-from openral_core.models import LimitedJoint, RgbSensor
+from openral_core.models import RgbSensor
 from openral_core.real_wiring import FeetechWiring, RealWiring
 from openral_hal.errors import ConfigurationError, NotConnected
 from openral_hal.factory import RealOptions
@@ -151,7 +151,7 @@ class FeetechHal(ManifestArm):
         except BaseException:
             self._thaw()
             raise
-        envelope = self._envelope()
+        envelope = self.manifest_envelope()
         envelope.start(units.angles(readings))
         cycle = BusCycle(
             bus, units, envelope, self, self.control_period_s, self.real.estop == "torque_off"
@@ -330,18 +330,6 @@ class FeetechHal(ManifestArm):
         return (
             f"write {self.calibration_file} to them: openral robot calibrate {self.robot.name} "
             f"--transport {self.port} --apply {self.calibration_file}"
-        )
-
-    def _envelope(self) -> MotionEnvelope:
-        joints = self.description.joints
-        low = [j.position_limits[0] if isinstance(j, LimitedJoint) else -np.inf for j in joints]
-        high = [j.position_limits[1] if isinstance(j, LimitedJoint) else np.inf for j in joints]
-        return MotionEnvelope(
-            np.array(low),
-            np.array(high),
-            np.array([j.velocity_limit for j in joints]),
-            self.control_period_s,
-            self.real.first_motion_speed_scale,
         )
 
     def _running(self) -> _Session:

@@ -49,7 +49,8 @@ class KinematicTwin:
                 self._qpos[slot] = fingers[name][0]
                 self._fingers.append((slot, list(fingers[name][1:])))
         self._dof = np.array([int(self.model.jnt_dofadr[j]) for j in self._joints_at(self._qpos)])
-        self._addresses = addresses
+        self.addresses = addresses
+        """Where the robot's joints, bodies and actuators sit in :attr:`model`."""
         self._tree: FrameTree | None = None
 
     def pose(
@@ -79,5 +80,5 @@ class KinematicTwin:
             HalError: The model's layout cannot be stated as a tree.
         """
         if self._tree is None:
-            self._tree = scene_frame_tree(self.model, self.robot, self._addresses, {}, None)
+            self._tree = scene_frame_tree(self.model, self.robot, self.addresses, {}, None)
         return self._tree

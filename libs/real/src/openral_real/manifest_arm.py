@@ -1,15 +1,18 @@
-"""What every real arm HAL of the manifest shares: its names, its period, and the rule that
-refuses an all-zero action (one place for both drivers, Feetech and ros2_control)."""
+"""What every real arm HAL of the manifest shares: its names, its period, its motion
+envelope, and the rule that refuses an all-zero action (one place for both drivers, Feetech
+and ros2_control)."""
 
 from __future__ import annotations
 
 import numpy as np
 from openral_core.loaded import LoadedRobot
-from openral_core.models import RobotDescription
+from openral_core.models import LimitedJoint, RobotDescription
 from openral_core.real_wiring import RealWiring
 from openral_hal.errors import ActionRejected
 from openral_hal.protocol import EStopLatch
 from openral_mujoco.state import FloatArray
+
+from openral_real.motion_envelope import MotionEnvelope
 
 __all__ = ["ManifestArm"]
 
@@ -40,6 +43,20 @@ class ManifestArm(EStopLatch):
     def control_period_s(self) -> float:
         """One read-and-write cycle of the driver [s]."""
         return self.real.control_period_s
+
+    def manifest_envelope(self) -> MotionEnvelope:
+        """A new envelope of the manifest's position and velocity limits at the control
+        period (a continuous joint unbounded), the first motion as slow as ``real`` says."""
+        joints = self.description.joints
+        low = [j.position_limits[0] if isinstance(j, LimitedJoint) else -np.inf for j in joints]
+        high = [j.position_limits[1] if isinstance(j, LimitedJoint) else np.inf for j in joints]
+        return MotionEnvelope(
+            np.array(low, dtype=np.float64),
+            np.array(high, dtype=np.float64),
+            np.array([j.velocity_limit for j in joints], dtype=np.float64),
+            self.control_period_s,
+            self.real.first_motion_speed_scale,
+        )
 
     def screen_action(self, values: FloatArray) -> None:
         """Refuse an all-zero action (unless the manifest allows it) and any action while

@@ -34,8 +34,7 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
-from openral_core.models import LimitedJoint, RobotDescription
-from openral_core.real_wiring import RealWiring, Ros2ControlWiring
+from openral_core.real_wiring import Ros2ControlWiring
 from openral_hal.errors import ConfigurationError, EStopLatched, NotConnected
 from openral_hal.factory import RealOptions
 from openral_mujoco.action import validated_action
@@ -45,7 +44,6 @@ from openral_sim.frame_tree import FrameTree
 
 from openral_real.kinematic_twin import KinematicTwin
 from openral_real.manifest_arm import ManifestArm
-from openral_real.motion_envelope import MotionEnvelope
 from openral_real.ros2_control_link import JointReading, Ros2ControlLink, driver_namespace
 
 CONNECT_TIMEOUT_S = 10.0
@@ -90,7 +88,7 @@ class Ros2ControlHal(ManifestArm):
         self._gripper = _gripper_map(robot, self.wiring)
         self._twin = KinematicTwin(robot) if robot.tables.hal_wiring is not None else None
         self._link: Ros2ControlLink | None = None
-        self._envelope = _envelope(robot.description, real)
+        self._envelope = self.manifest_envelope()
         self._speeds = np.array([float(j.velocity_limit) for j in robot.description.joints])
         self._lock = threading.Lock()
         self._latest: JointStateSample | None = None
@@ -337,13 +335,17 @@ class Ros2ControlHal(ManifestArm):
         )
 
     def _start_watchdog(self) -> None:
+        """A thread that wakes when the newest reading turns :data:`STALE_PERIODS` periods
+        old and, if none came meanwhile, latches the E-stop (then checks once a period)."""
+
         def watch() -> None:
             period = self.control_period_s
             while self._link is not None:
-                time.sleep(period / 2)
                 with self._lock:
                     age_s = time.monotonic() - self._received_s
-                if self._link is not None and age_s > STALE_PERIODS * period:
+                if self._estopped or age_s < STALE_PERIODS * period:
+                    time.sleep(period if self._estopped else STALE_PERIODS * period - age_s)
+                elif self._link is not None:
                     self.latch_fault(
                         f"the robot driver's {self.wiring.joint_state_topic} stopped "
                         f"({age_s * 1000:.0f} ms without a fresh reading, control period "
@@ -353,21 +355,11 @@ class Ros2ControlHal(ManifestArm):
         self._watchdog = threading.Thread(target=watch, name="openral-ros2-watchdog", daemon=True)
         self._watchdog.start()
 
-
-def _envelope(description: RobotDescription, real: RealWiring) -> MotionEnvelope:
-    low, high, speed = [], [], []
-    for joint in description.joints:
-        limits = joint.position_limits if isinstance(joint, LimitedJoint) else (-np.inf, np.inf)
-        low.append(float(limits[0]))
-        high.append(float(limits[1]))
-        speed.append(float(joint.velocity_limit))
-    return MotionEnvelope(
-        np.array(low),
-        np.array(high),
-        np.array(speed),
-        real.control_period_s,
-        real.first_motion_speed_scale,
-    )
+    @property
+    def received_s(self) -> float:
+        """When the newest reading arrived [s, ``time.monotonic()``]."""
+        with self._lock:
+            return self._received_s
 
 
 def _gripper_map(robot: LoadedRobot, wiring: Ros2ControlWiring) -> tuple[int, SlotMap] | None:
