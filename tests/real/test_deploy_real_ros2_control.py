@@ -34,7 +34,7 @@ def _arm(message: JointState) -> list[float]:
 def test_deploy_real_drives_the_robot_through_its_ros2_control_driver(tmp_path: Path) -> None:
     with (
         remote_graph({ROBOT_STATES: JointState}) as remote,
-        deploy_sim(SCENE, remote.domain, tmp_path, ("--namespace", "robot")) as robot,
+        deploy_sim(SCENE, remote.domain, tmp_path, ("--namespace", "robot"), robot=True) as robot,
     ):
         remote.probe.wait_count(ROBOT_STATES, 1, timeout_s=90.0)
         real = openral(

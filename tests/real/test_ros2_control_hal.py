@@ -16,6 +16,7 @@ import pytest
 from openral_core import open_robot_by_id
 from openral_hal.errors import ConfigurationError, EStopLatched
 from openral_hal.factory import RealOptions, build_hal
+from openral_hal.realtime import ahead_of_other_programs
 from openral_nodes.runtime import claim_domain_id
 from openral_real.ros2_control_hal import Ros2ControlHal
 from openral_real.ros2_control_link import driver_namespace
@@ -41,7 +42,7 @@ def robot_driver(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[obj
     before = os.environ.get("ROS_DOMAIN_ID")
     os.environ["ROS_DOMAIN_ID"] = str(domain)
     try:
-        with deploy_sim(SCENE, domain, logs, ("--namespace", "robot")) as process:
+        with deploy_sim(SCENE, domain, logs, ("--namespace", "robot"), robot=True) as process:
             yield process, logs
     finally:
         if before is None:
@@ -56,11 +57,12 @@ def hal(robot_driver: tuple[object, Path]) -> Iterator[Ros2ControlHal]:
     options = RealOptions()
     built = build_hal(robot, mode="real", transport="ros2_control:robot", real_options=options)
     assert isinstance(built, Ros2ControlHal)
-    built.connect()
-    try:
-        yield built
-    finally:
-        built.disconnect()
+    with ahead_of_other_programs():  # as deploy real runs it
+        built.connect()
+        try:
+            yield built
+        finally:
+            built.disconnect()
 
 
 def test_a_transport_that_is_no_namespace_is_one_line() -> None:
@@ -116,7 +118,7 @@ def test_killing_the_robot_latches_the_estop_within_two_periods_and_a_restart_re
     with pytest.raises(EStopLatched):
         hal.release_estop()
     domain = int(os.environ["ROS_DOMAIN_ID"])
-    with deploy_sim(SCENE, domain, tmp_path, ("--namespace", "robot")):
+    with deploy_sim(SCENE, domain, tmp_path, ("--namespace", "robot"), robot=True):
         wait_until(lambda: not hal.read_state().stale, 90.0, "the restarted robot's readings")
         assert hal.estopped and hal.sent == sent  # a robot back is no release
         hal.release_estop()

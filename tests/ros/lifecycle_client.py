@@ -154,16 +154,19 @@ def outside_client(domain_id: int, target: str, name: str) -> Iterator[Lifecycle
 
 @contextmanager
 def deploy_sim(
-    config: Path, domain_id: int, logs: Path, extra: Sequence[str] = ()
+    config: Path, domain_id: int, logs: Path, extra: Sequence[str] = (), *, robot: bool = False
 ) -> Iterator[subprocess.Popen[str]]:
     """``openral deploy sim --config CONFIG --no-viewer [EXTRA…]`` in ``domain_id`` as a
-    subprocess.
+    subprocess; ``robot``: standing in for a robot's driver, ahead of ordinary programs
+    (``nice -n -20``), as a ros2_control driver's loop runs (its 100 Hz stream then keeps
+    time while other programs start beside it).
 
     Its stdout and stderr go to ``logs/deploy.out`` and ``logs/deploy.err`` (files, not
     pipes, so a chatty process never blocks on a full pipe). Still alive on exit, it gets
     SIGTERM, then SIGKILL after :data:`STOP_WAIT_S`.
     """
-    command = [str(OPENRAL), "deploy", "sim", "--config", str(config), "--no-viewer"]
+    command = ["nice", "-n", "-20"] if robot else []
+    command += [str(OPENRAL), "deploy", "sim", "--config", str(config), "--no-viewer"]
     command += ["--domain-id", str(domain_id), *extra]
     with (logs / "deploy.out").open("w") as out, (logs / "deploy.err").open("w") as err:
         process = subprocess.Popen(command, stdout=out, stderr=err, text=True, env=DEPLOY_ENV)

@@ -36,6 +36,7 @@ from openral_bridge.topics import (
     JOINT_TRAJECTORY_STATE,
     JTC_JOINT_TRAJECTORY,
     JTC_NAME,
+    RELEASE_ESTOP,
     RESET,
     SAFE_ACTION,
     TopicInfo,
@@ -259,8 +260,13 @@ class CommandInterfaces:
         return response
 
     def _on_release_estop(self, request: Any, response: Any) -> Any:
-        with self.lock:
-            self.hal.release_estop()
+        try:
+            with self.lock:
+                self.hal.release_estop()
+        except HalError as error:  # the HAL refuses (a real robot's readings are stale)
+            response.success, response.message = False, str(error)
+            self._log().warning(f"{RELEASE_ESTOP}: refused: {error}")
+            return response
         self._log().info("E-stop released")
         response.success, response.message = True, "E-stop released"
         return response

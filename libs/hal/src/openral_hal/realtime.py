@@ -15,10 +15,10 @@ may be an ordinary one (ROS's executor, a publisher) that the scheduler has set 
 another program. Measured here, on 2 cores: every start of an ``openral`` command next to
 ``deploy real`` latched its E-stop (the bus's reading 24 ms old). A program that keeps a
 robot's time (``deploy real``, the bus emulator) therefore runs inside
-:func:`ahead_of_other_programs`: all its threads, and those they start, at the lowest
-real-time priority, :data:`BACKGROUND_PRIORITY`, above every ordinary program and below its
-own bus threads. Ten ``openral`` starts next to it then latched nothing. It is the
-program's choice, not a library's: a HAL never changes its process's scheduling.
+:func:`ahead_of_other_programs`: all its threads, and those they start, at nice
+:data:`BACKGROUND_NICE`, ahead of every ordinary program and behind its own real-time
+threads. Ten ``openral`` starts next to it then latched nothing. It is the program's
+choice, not a library's: a HAL never changes its process's scheduling.
 """
 
 from __future__ import annotations
@@ -31,8 +31,10 @@ from pathlib import Path
 
 PRIORITY = 10
 """Real-time priority asked for (1 to 99; low: above ordinary threads, below the system's)."""
-BACKGROUND_PRIORITY = 1
-"""Real-time priority of every thread of a program that keeps a robot's time."""
+BACKGROUND_NICE = -20
+"""Nice value of every thread of a program that keeps a robot's time (the highest share of
+the cores an ordinary thread can have; real-time round-robin at one priority would let
+its threads keep a core from each other for a whole 100 ms time slice)."""
 
 
 def answer_first(priority: int = PRIORITY) -> bool:
@@ -45,25 +47,23 @@ def answer_first(priority: int = PRIORITY) -> bool:
 
 @contextlib.contextmanager
 def ahead_of_other_programs() -> Iterator[int]:
-    """Every ordinary thread of this process, and each it starts meanwhile (Linux threads
-    inherit their scheduling), at :data:`BACKGROUND_PRIORITY` inside the block; as before
-    after it. Yields how many threads were raised (0: real-time scheduling refused)."""
-    raised = []
+    """Every thread of this process at nice :data:`BACKGROUND_NICE` inside the block, and
+    each it starts meanwhile (Linux threads inherit their nice value); as before after it.
+    Yields how many threads were raised (0: refused, as to an unprivileged user)."""
+    before = {}
     for tid in _threads():
         with contextlib.suppress(OSError):
-            if os.sched_getscheduler(tid) == os.SCHED_OTHER:
-                os.sched_setscheduler(tid, os.SCHED_RR, os.sched_param(BACKGROUND_PRIORITY))
-                raised.append(tid)
+            nice = os.getpriority(os.PRIO_PROCESS, tid)
+            if nice > BACKGROUND_NICE:
+                os.setpriority(os.PRIO_PROCESS, tid, BACKGROUND_NICE)
+                before[tid] = nice
     try:
-        yield len(raised)
+        yield len(before)
     finally:
-        for tid in _threads():  # those raised and those started meanwhile
+        for tid in _threads():  # those raised, and those started meanwhile
             with contextlib.suppress(OSError):
-                policy = os.sched_getscheduler(tid)
-                if policy == os.SCHED_RR and os.sched_getparam(tid).sched_priority == (
-                    BACKGROUND_PRIORITY
-                ):
-                    os.sched_setscheduler(tid, os.SCHED_OTHER, os.sched_param(0))
+                if os.getpriority(os.PRIO_PROCESS, tid) == BACKGROUND_NICE:
+                    os.setpriority(os.PRIO_PROCESS, tid, before.get(tid, 0))
 
 
 def _threads() -> list[int]:

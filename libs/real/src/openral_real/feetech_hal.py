@@ -56,13 +56,6 @@ from openral_real.motion_envelope import MotionEnvelope
 from openral_real.opencv_cameras import Cameras, camera_devices
 from openral_real.servo_units import ServoUnits
 
-SWITCH_INTERVAL_S = 0.001
-"""Python's thread switch interval while connected [s]: the bus's thread waits at most this
-long for Python's lock after its bytes arrive (the default, 5 ms, is half a control
-period). Restored at disconnect. While connected, the heap found at connect is also frozen
-out of garbage collection (``gc.freeze``, unless the process froze it itself, as deploy
-real does): a full collection of it holds Python's lock for tens of milliseconds."""
-
 
 @dataclass(frozen=True)
 class _Session:
@@ -116,8 +109,10 @@ class FeetechHal(ManifestArm):
         self._session: _Session | None = None
         self._twin = KinematicTwin(robot) if robot.tables.hal_wiring is not None else None
         """The robot's model, compiled here so its frames are known before connecting."""
-        self._switch_interval = sys.getswitchinterval()
         self._froze = False
+        """While connected, the heap found at connect is frozen out of garbage collection
+        (``gc.freeze``, unless the process froze it itself, as deploy real does): a full
+        collection of it holds Python's lock for tens of milliseconds."""
 
     # -- what the HAL is ---------------------------------------------------------------------
 
@@ -159,8 +154,7 @@ class FeetechHal(ManifestArm):
         cycle.seed(readings)
         self._estopped, self.estop_reason = False, None
         self._session = _Session(bus, cycle, units, envelope, self._twin, cameras)
-        self._switch_interval = sys.getswitchinterval()
-        sys.setswitchinterval(min(self._switch_interval, SWITCH_INTERVAL_S))
+        self.quicker_switches(True)
         if not self.defer_cycle:
             cycle.start()
 
@@ -186,7 +180,7 @@ class FeetechHal(ManifestArm):
             pass  # a bus that failed cannot be told anything more
         bus.close()
         session.cameras.close()
-        sys.setswitchinterval(self._switch_interval)
+        self.quicker_switches(False)
         self._thaw()
 
     # -- state and commands ------------------------------------------------------------------

@@ -26,6 +26,7 @@ as deploy sim's gripper controller converts them.
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from collections.abc import Callable
@@ -37,6 +38,7 @@ from openral_core.loaded import LoadedRobot
 from openral_core.real_wiring import Ros2ControlWiring
 from openral_hal.errors import ConfigurationError, EStopLatched, NotConnected
 from openral_hal.factory import RealOptions
+from openral_hal.realtime import answer_first
 from openral_mujoco.action import validated_action
 from openral_mujoco.gripper import SlotMap, slot_map, units_mismatch
 from openral_mujoco.state import FloatArray, JointStateSample
@@ -126,6 +128,7 @@ class Ros2ControlHal(ManifestArm):
             link.close()
             raise
         self._link = link
+        self.quicker_switches(True)
         self._estopped, self.estop_reason = False, None
         self._envelope.start(self._measured())
         self._running = not self.defer_cycle
@@ -144,6 +147,7 @@ class Ros2ControlHal(ManifestArm):
         if self._latest is not None:
             self._send_hold(link)
         link.close()
+        self.quicker_switches(False)
         if self._watchdog is not None:
             self._watchdog.join(2.0)
             self._watchdog = None
@@ -336,21 +340,27 @@ class Ros2ControlHal(ManifestArm):
 
     def _start_watchdog(self) -> None:
         """A thread that wakes when the newest reading turns :data:`STALE_PERIODS` periods
-        old and, if none came meanwhile, latches the E-stop (then checks once a period)."""
+        old and, if none came meanwhile, latches the E-stop. A stream that ended may start
+        again on a clock of its own (a restarted driver): its first stamp is taken."""
 
         def watch() -> None:
+            answer_first()
             period = self.control_period_s
             while self._link is not None:
                 with self._lock:
                     age_s = time.monotonic() - self._received_s
-                if self._estopped or age_s < STALE_PERIODS * period:
-                    time.sleep(period if self._estopped else STALE_PERIODS * period - age_s)
-                elif self._link is not None:
+                if age_s < STALE_PERIODS * period:
+                    time.sleep(STALE_PERIODS * period - age_s)
+                    continue
+                with self._lock:
+                    self._last_stamp_s = -math.inf
+                if not self._estopped and self._link is not None:
                     self.latch_fault(
                         f"the robot driver's {self.wiring.joint_state_topic} stopped "
                         f"({age_s * 1000:.0f} ms without a fresh reading, control period "
                         f"{period * 1000:g} ms)"
                     )
+                time.sleep(period)
 
         self._watchdog = threading.Thread(target=watch, name="openral-ros2-watchdog", daemon=True)
         self._watchdog.start()

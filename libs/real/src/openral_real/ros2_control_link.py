@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from openral_core.real_wiring import Ros2ControlWiring
 from openral_hal.errors import ConfigurationError
+from openral_hal.realtime import answer_first
 from openral_mujoco.state import FloatArray
 
 __all__ = ["JointReading", "Ros2ControlLink", "driver_namespace"]
@@ -197,6 +198,7 @@ class Ros2ControlLink:
     def _spin(self) -> None:
         from rclpy.executors import ExternalShutdownException
 
+        answer_first()  # it is the driver's loop here: each reading is one cycle
         executor = self._executor
         try:
             while executor is not None and self._context is not None and self._context.ok():

@@ -1,0 +1,306 @@
+"""deploy real on a ros2_control driver, with deploy sim as "the robot" (the Panda in
+namespace /robot) and deploy real's own graph under /real, one domain: what a user of
+franka_ros2 would run, in simulation (not on hardware).
+
+- ``rskill run --policy wave`` through deploy real moves the robot's joints as the same
+  policy moves deploy sim directly, within 0.02 rad;
+- deploy real's ``/joint_states`` are the robot's (the gripper in metres, its mimic finger
+  too); a GripperCommand to deploy real moves the robot's fingers; an ``ee_delta_pose``
+  policy through deploy real lifts the robot's TCP;
+- killed and started again, the robot comes back after a release of deploy real's E-stop.
+
+Every process joins the domain before anything moves: on this machine a Python ROS process
+(deploy sim, deploy real) stops for 0.27-0.34 s while Fast DDS discovers a new participant
+(measured: docs/real-ros2-control.md), and a robot whose joint states stop for two periods
+latches deploy real's E-stop, as it must. So the policy runners start before deploy real
+(they wait for its graph), and the releases and goals go out from the test's own node.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from action_msgs.msg import GoalStatus
+from control_msgs.action import FollowJointTrajectory, GripperCommand
+from geometry_msgs.msg import PoseStamped
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Trigger
+from trajectory_msgs.msg import JointTrajectory
+
+from tests.conftest import ROBOTS
+from tests.real.deploy_helpers import Remote, openral, remote_graph, stop
+from tests.ros.action_client import PANDA_ARM, _AtomicActionClient, goal
+from tests.ros.lifecycle_client import deploy_sim
+from tests.ros.ros_helpers import Received, call_trigger, wait_until
+
+pytestmark = pytest.mark.exclusive  # two live graphs and a 100 Hz stream that must not lag
+
+SCENE = ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml"
+WAVE_S = 20.0
+"""How long the wave's runner runs [s] (it waits for deploy real's graph first: 5-10 s)."""
+AGREE_RAD = 0.02
+PERIOD_S = 4.0
+"""The wave's period [s]."""
+
+
+def _deploy_real(remote: Remote) -> subprocess.Popen[str]:
+    return openral(
+        "deploy", "real", "--robot", "franka_panda", "--transport", "ros2_control:robot",
+        "--namespace", "real", "--domain-id", str(remote.domain),
+    )  # fmt: skip
+
+
+def _runner(remote: Remote, namespace: str, *args: str) -> subprocess.Popen[str]:
+    """``rskill run`` started now; it waits up to a minute for the graph it acts on."""
+    return openral(
+        "rskill", "run", "--robot", "franka_panda", "--domain-id", str(remote.domain),
+        "--namespace", namespace, "--frame-timeout", "60", *args,
+    )  # fmt: skip
+
+
+def _finished(runner: subprocess.Popen[str]) -> None:
+    _, err = runner.communicate(timeout=180)
+    assert runner.returncode == 0, err
+
+
+def _wave(remote: Remote, namespace: str) -> subprocess.Popen[str]:
+    return _runner(remote, namespace, "--policy", "wave", "-p", "required_slots=[]",
+                   "--duration", str(WAVE_S))  # fmt: skip
+
+
+def _path(actions: list[Received], states: list[Received]) -> tuple[np.ndarray, np.ndarray]:
+    """(times [s] from the first action, arm joint positions) of the joint states from the
+    first action to the last."""
+    start, end = actions[0].at, actions[-1].at
+    rows = [(s.at - start, _arm(s.msg)) for s in states if start <= s.at <= end]
+    return np.array([t for t, _ in rows]), np.array([q for _, q in rows])
+
+
+def _arm(message: JointState) -> list[float]:
+    positions = dict(zip(message.name, message.position, strict=True))
+    return [positions[name] for name in PANDA_ARM]
+
+
+def _gap(direct: tuple[np.ndarray, np.ndarray], through: tuple[np.ndarray, np.ndarray]) -> float:
+    """The largest joint gap [rad] between the two paths over the time both ran (a wave
+    period at least), the second shifted in time to line up best (its commands take one
+    more hop, and the probe sees each run's first action after its own discovery delay)."""
+    lags = np.arange(-1.5, 1.5, 0.005)
+    end = min(direct[0][-1], through[0][-1] - lags.max()) - 0.1
+    assert end > 1.0 + PERIOD_S, f"too short a common run: {end:.1f} s"
+    grid = np.arange(1.0, end, 0.02)
+
+    def worst(lag: float) -> float:
+        return max(
+            float(
+                np.abs(
+                    np.interp(grid + lag, through[0], through[1][:, j])
+                    - np.interp(grid, direct[0], direct[1][:, j])
+                ).max()
+            )
+            for j in range(len(PANDA_ARM))
+        )
+
+    return min(worst(lag) for lag in lags)
+
+
+def _longest_gaps(remote: Remote) -> list[tuple[float, float]]:
+    """The robot's three longest pauses between joint states as the probe saw them: (at [s,
+    monotonic], pause [ms]) (a robot that paused is the robot's fault, not deploy real's)."""
+    times = np.array([r.at for r in remote.probe.since("/robot/joint_states", 0.0)])
+    gaps = np.diff(times)
+    worst = np.argsort(gaps)[-3:]
+    return [(float(times[i + 1]), float(gaps[i] * 1000)) for i in worst]
+
+
+def _recorded(topics: dict[str, object], run: Callable[[Remote], None], action: str, states: str):  # type: ignore[no-untyped-def]
+    with remote_graph(topics) as remote:
+        run(remote)
+        return remote.probe.since(action, 0.0), remote.probe.since(states, 0.0)
+
+
+def test_a_wave_through_deploy_real_moves_the_robot_as_it_moves_deploy_sim_alone(
+    tmp_path: Path,
+) -> None:
+    def through_deploy_real(remote: Remote) -> None:
+        with deploy_sim(SCENE, remote.domain, tmp_path, ("--namespace", "robot"), robot=True):
+            remote.probe.wait_count("/robot/joint_states", 1, timeout_s=90.0)
+            runner = _wave(remote, "real")  # it waves once deploy real is up
+            real = _deploy_real(remote)
+            try:
+                _finished(runner)
+            finally:
+                _, err = stop(real)
+            assert "E-stop latched" not in err, (err, _longest_gaps(remote))
+
+    def direct(remote: Remote) -> None:
+        with deploy_sim(SCENE, remote.domain, tmp_path):
+            remote.probe.wait_count("/joint_states", 1, timeout_s=90.0)
+            _finished(_wave(remote, ""))
+
+    topics = {
+        "/robot/joint_states": JointState,
+        "/real/joint_states": JointState,
+        "/real/openral/safe_action": Float64MultiArray,
+    }
+    through = _path(
+        *_recorded(topics, through_deploy_real, "/real/openral/safe_action", "/robot/joint_states")
+    )
+    alone = _path(
+        *_recorded(
+            {"/joint_states": JointState, "/openral/safe_action": Float64MultiArray},
+            direct,
+            "/openral/safe_action",
+            "/joint_states",
+        )
+    )
+    assert np.ptp(alone[1][:, 0]) > 0.15 and np.ptp(through[1][:, 0]) > 0.15  # both waved
+    gap = _gap(alone, through)
+    np.savez(tmp_path / "paths.npz", at=alone[0], a=alone[1], tt=through[0], t=through[1])
+    print(f"wave through deploy real vs deploy sim alone: {gap:.4f} rad at most")
+    assert gap <= AGREE_RAD, f"{gap:.4f} rad apart"
+
+
+RISE = '''\
+"""The TCP straight up at a fifth of full scale for two seconds, the gripper open."""
+
+import numpy as np
+from pydantic import BaseModel
+
+
+class RiseConfig(BaseModel):
+    speed: float = 0.2  # of full scale (robosuite: 0.05 m a step)
+    seconds: float = 2.0  # then it holds
+
+
+class Rise:
+    config_type = RiseConfig
+    action_mode = "ee_delta_pose"
+    required_slots = ()
+    needs_privileged = False
+
+    def __init__(self, config: RiseConfig) -> None:
+        self.config = config
+
+    def act(self, obs):
+        up = self.config.speed if obs["time_s"] < self.config.seconds else 0.0
+        return np.array([0.0, 0.0, up, 0.0, 0.0, 0.0, -1.0])
+'''
+FINGERS = ("panda_finger_joint1", "panda_finger_joint2")
+ROBOT_TRAJECTORY = "/robot/joint_trajectory_controller/joint_trajectory"
+FOLLOW = "/real/joint_trajectory_controller/follow_joint_trajectory"
+
+
+def _by_name(message: JointState) -> dict[str, float]:
+    return dict(zip(message.name, message.position, strict=True))
+
+
+def _fingers(remote: Remote) -> list[float]:
+    joints = _by_name(remote.probe.latest("/robot/joint_states"))
+    return [joints[name] for name in FINGERS]
+
+
+def _same_joint_states(remote: Remote) -> None:
+    """deploy real's /joint_states name the robot's joints, in the robot's units."""
+    robot = _by_name(remote.probe.latest("/robot/joint_states"))
+    real = _by_name(remote.probe.latest("/real/joint_states"))
+    assert set(FINGERS) <= set(real) and set(real) == set(robot), (sorted(real), sorted(robot))
+    for name, value in robot.items():
+        assert abs(real[name] - value) < 2e-3, (name, real[name], value)
+
+
+def _grip(remote: Remote, position_m: float) -> None:
+    client = _AtomicActionClient(
+        remote.probe.node, GripperCommand, "/real/gripper_controller/gripper_cmd"
+    )
+    assert client.wait_for_server(timeout_sec=30.0)
+    request = GripperCommand.Goal()
+    request.command.position, request.command.max_effort = position_m, 20.0
+    sent = client.send_goal_async(request)
+    wait_until(sent.done, 10.0, "the gripper goal's answer")
+    assert sent.result().accepted
+    wait_until(
+        lambda: all(abs(q - position_m) < 3e-3 for q in _fingers(remote)), 15.0, "the fingers"
+    )
+
+
+def _rise(remote: Remote, tmp_path: Path) -> subprocess.Popen[str]:
+    """The ee_delta_pose policy's runner, started now (it rises once deploy real is up)."""
+    policy = tmp_path / "rise.py"
+    policy.write_text(RISE)
+    return _runner(remote, "real", "--policy", f"{policy}:Rise", "--duration", "20")
+
+
+def _risen(remote: Remote, runner: subprocess.Popen[str], start: Any) -> None:
+    _finished(runner)
+    after = remote.probe.latest("/robot/openral/tcp_pose").pose.position
+    assert after.z - start.z > 0.1, (start, after)
+    assert abs(after.x - start.x) < 0.02 and abs(after.y - start.y) < 0.02, (start, after)
+
+
+def _release_and_move(remote: Remote, release: Any, follow: Any) -> None:
+    """Release deploy real's E-stop and send it a goal: the robot's joint 1 turns 0.2 rad."""
+    assert call_trigger(release, "/real/openral/release_estop").success
+    start = _arm(remote.probe.latest("/robot/joint_states"))
+    target = [start[0] + 0.2, *start[1:]]
+    sent = follow.send_goal_async(goal(PANDA_ARM, [(2.0, target)]))
+    wait_until(sent.done, 10.0, "the goal's answer")
+    result = sent.result().get_result_async()
+    wait_until(result.done, 30.0, "the goal's result")
+    assert result.result().status == GoalStatus.STATUS_SUCCEEDED
+    time.sleep(0.5)
+    reached = _arm(remote.probe.latest("/robot/joint_states"))
+    assert abs(reached[0] - target[0]) < 0.02, (reached, target)
+
+
+def test_joint_states_gripper_and_an_ee_policy_through_deploy_real_then_a_restart(
+    tmp_path: Path,
+) -> None:
+    topics = {
+        "/robot/joint_states": JointState,
+        "/real/joint_states": JointState,
+        "/robot/openral/tcp_pose": PoseStamped,
+        ROBOT_TRAJECTORY: JointTrajectory,
+    }
+    first, second = tmp_path / "first", tmp_path / "second"
+    for folder in (first, second):
+        folder.mkdir()
+    with remote_graph(topics) as remote:
+        node = remote.probe.node
+        release = node.create_client(Trigger, "/real/openral/release_estop")
+        follow = _AtomicActionClient(node, FollowJointTrajectory, FOLLOW)
+        robot = deploy_sim(SCENE, remote.domain, first, ("--namespace", "robot"), robot=True)
+        process = robot.__enter__()
+        remote.probe.wait_count("/robot/openral/tcp_pose", 1, timeout_s=90.0)
+        start = remote.probe.latest("/robot/openral/tcp_pose").pose.position
+        runner = _rise(remote, tmp_path)
+        real = _deploy_real(remote)
+        try:
+            _risen(remote, runner, start)
+            _same_joint_states(remote)
+            _grip(remote, 0.01)
+            process.kill()
+            process.wait(10)
+            robot.__exit__(None, None, None)
+            time.sleep(1.0)
+            quiet = time.monotonic()
+            time.sleep(1.0)
+            assert not remote.probe.since(ROBOT_TRAJECTORY, quiet)  # nothing sent after it
+            with deploy_sim(SCENE, remote.domain, second, ("--namespace", "robot"), robot=True):
+                remote.probe.wait_count("/robot/joint_states", 1, quiet, timeout_s=90.0)
+                time.sleep(1.0)
+                assert not remote.probe.since(ROBOT_TRAJECTORY, quiet)  # a robot back: no motion
+                _release_and_move(remote, release, follow)
+                _, err = stop(real)  # before this robot goes too
+        finally:
+            if real.returncode is None:  # a failure above: stop it all the same
+                stop(real)
+    fault = [line for line in err.splitlines() if "E-stop latched" in line]
+    assert len(fault) == 1 and "joint_states stopped" in fault[0], err  # one line, one cause
