@@ -129,6 +129,10 @@ bench-trajectory *ARGS:
 bench-real *ARGS:
     python -m benchmarks.real_bus {{ARGS}}
 
+# deploy real on a ros2_control driver (deploy sim as the robot): a policy action to the driver's command, against one DDS hop; writes benchmarks/results/ros2_control_latency.json.
+bench-ros2-control *ARGS:
+    python -m benchmarks.ros2_control_latency {{ARGS}}
+
 # CPU that `deploy sim --record` adds to deploy sim alone on the franka tabletop, and messages dropped; writes benchmarks/results/record_cost.json.
 bench-record *ARGS:
     python -m benchmarks.record_cost {{ARGS}}

@@ -8,7 +8,10 @@ judgement and the state publishers work on a real robot exactly as on a simulate
 control period apart, with no second clock beating against the driver's. The tick runs on
 a thread of its own, woken by the hook: the driver's cycle never waits for the graph (a
 lock held elsewhere, a slow publisher); a tick still running when the next reading comes
-takes that reading next (:attr:`RealCadence.coalesced` counts the readings skipped).
+takes that reading next (:attr:`RealCadence.coalesced` counts the readings skipped). A HAL
+whose robot driver keeps time itself (:class:`~openral_hal.protocol.WritesAfterTick`) is
+written by this thread after the tick, so an action reaches the robot in the cycle that took
+it rather than the next.
 
 What a tick means here: the action of the period (a pending one, or the trajectory's next
 point) is handed to the HAL, whose envelope moves the goals towards it; nothing is stepped.
@@ -25,7 +28,7 @@ from collections.abc import Callable
 
 from openral_core.models import RobotDescription
 from openral_hal.errors import HalError
-from openral_hal.protocol import CycledHal, TwinHal
+from openral_hal.protocol import CycledHal, TwinHal, WritesAfterTick
 from openral_hal.realtime import PRIORITY, answer_first
 from openral_mujoco.state import FloatArray, JointStateSample
 
@@ -50,8 +53,11 @@ class RealCadence:
     def drive(self, tick: Callable[[], None] | None) -> None:
         """Run ``tick`` on a thread of its own after every reading of the HAL's loop (None:
         stop, once a tick in progress has ended)."""
+        writes = isinstance(self.hal, WritesAfterTick)
         if tick is None:
             self.hal.on_cycle = None
+            if writes:
+                self.hal.writes_after_tick = False  # type: ignore[attr-defined]
             self._stop.set()
             self._reading.set()
             thread, self._thread = self._thread, None
@@ -62,6 +68,8 @@ class RealCadence:
         self._stop.clear()
         self._thread = threading.Thread(target=self._run, name="real-control", daemon=True)
         self._thread.start()
+        if writes:
+            self.hal.writes_after_tick = True  # type: ignore[attr-defined]
         self.hal.on_cycle = self._read
 
     def _read(self) -> None:
@@ -78,6 +86,8 @@ class RealCadence:
             if self._stop.is_set() or self._tick is None:
                 return
             self._tick()
+            if isinstance(self.hal, WritesAfterTick) and self.hal.writes_after_tick:
+                self.hal.write_cycle()  # the tick's action in this cycle's command
 
     # -- the plant ---------------------------------------------------------------------------
 

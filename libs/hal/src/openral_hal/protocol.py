@@ -270,6 +270,21 @@ class CycledHal(RobotHal, Protocol):
 
 
 @runtime_checkable
+class WritesAfterTick(Protocol):
+    """A :class:`CycledHal` whose write may wait for the graph's tick on its reading (a
+    robot driver that keeps time itself: a command written a tick later is only later,
+    never missing), so an action taken at the tick reaches the robot in the same cycle."""
+
+    writes_after_tick: bool
+    """True while the graph writes (:meth:`write_cycle` after each tick); False: the HAL's
+    own cycle writes right after :attr:`CycledHal.on_cycle`."""
+
+    def write_cycle(self) -> None:
+        """Write this cycle's command (nothing while the E-stop is latched)."""
+        ...
+
+
+@runtime_checkable
 class TwinHal(Protocol):
     """A HAL that keeps a model of its robot posed at the measured joints."""
 

@@ -39,7 +39,6 @@ from openral_hal.errors import ConfigurationError, NotConnected
 from openral_hal.factory import RealOptions
 from openral_mujoco.action import validated_action
 from openral_mujoco.state import FloatArray, JointStateSample
-from openral_sim.frame_tree import FrameTree
 
 from openral_real.bus_bringup import bring_up
 from openral_real.bus_cycle import BusCycle, CycleTimes
@@ -253,11 +252,6 @@ class FeetechHal(ManifestArm):
         self.estop_reason = self.estop_at = None
 
     # -- frames and cameras ------------------------------------------------------------------
-
-    def frame_tree(self) -> FrameTree | None:
-        """The robot's frames in its own model (None without a sim block); known before
-        connecting."""
-        return self._twin.frame_tree() if self._twin is not None else None
 
     def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
         """The kinematic twin's (model, data), posed by :meth:`pose_twin`."""

@@ -13,7 +13,9 @@ from openral_core.real_wiring import RealWiring
 from openral_hal.errors import ActionRejected
 from openral_hal.protocol import EStopLatch
 from openral_mujoco.state import FloatArray
+from openral_sim.frame_tree import FrameTree
 
+from openral_real.kinematic_twin import KinematicTwin
 from openral_real.motion_envelope import MotionEnvelope
 
 __all__ = ["SWITCH_INTERVAL_S", "ManifestArm"]
@@ -30,6 +32,7 @@ class ManifestArm(EStopLatch):
 
     robot: LoadedRobot
     real: RealWiring
+    _twin: KinematicTwin | None
 
     @property
     def description(self) -> RobotDescription:
@@ -61,6 +64,11 @@ class ManifestArm(EStopLatch):
         elif not on and previous is not None:
             sys.setswitchinterval(previous)
             self._switch_before = None
+
+    def frame_tree(self) -> FrameTree | None:
+        """The robot's frames in its own model (None without a sim block); known before
+        connecting."""
+        return self._twin.frame_tree() if self._twin is not None else None
 
     def manifest_envelope(self) -> MotionEnvelope:
         """A new envelope of the manifest's position and velocity limits at the control

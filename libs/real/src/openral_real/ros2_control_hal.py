@@ -42,7 +42,6 @@ from openral_hal.realtime import answer_first
 from openral_mujoco.action import validated_action
 from openral_mujoco.gripper import SlotMap, slot_map, units_mismatch
 from openral_mujoco.state import FloatArray, JointStateSample
-from openral_sim.frame_tree import FrameTree
 
 from openral_real.kinematic_twin import KinematicTwin
 from openral_real.manifest_arm import ManifestArm
@@ -84,6 +83,8 @@ class Ros2ControlHal(ManifestArm):
         self.on_cycle: Callable[[], None] | None = None
         self.on_fault: Callable[[str], None] = lambda line: None
         self.defer_cycle = False
+        self.writes_after_tick = False
+        """True while the graph's tick writes each cycle (see WritesAfterTick)."""
         self.estop_reason: str | None = None
         self.sent = 0
         """Trajectories sent to the driver."""
@@ -222,10 +223,6 @@ class Ros2ControlHal(ManifestArm):
 
     # -- frames ------------------------------------------------------------------------------
 
-    def frame_tree(self) -> FrameTree | None:
-        """The robot's frames in its own model (None without a sim block)."""
-        return self._twin.frame_tree() if self._twin is not None else None
-
     def mujoco_handles(self) -> tuple[mujoco.MjModel, mujoco.MjData] | None:
         """The kinematic twin's (model, data), posed by :meth:`pose_twin`."""
         return (self._twin.model, self._twin.data) if self._twin is not None else None
@@ -261,8 +258,8 @@ class Ros2ControlHal(ManifestArm):
             return
         if self.on_cycle is not None:
             self.on_cycle()
-        if not self._estopped:
-            self._write(self._link)
+        if not self.writes_after_tick:
+            self.write_cycle()
 
     def _sample(
         self, values: dict[str, tuple[float, float, float]], stamp_s: float
@@ -277,6 +274,12 @@ class Ros2ControlHal(ManifestArm):
         return JointStateSample(
             self.joint_names, positions, velocities, efforts, round(stamp_s * 1e9), None, False
         )
+
+    def write_cycle(self) -> None:
+        """Send this cycle's goal (nothing while the E-stop is latched or unconnected)."""
+        link = self._link
+        if link is not None and self._running and not self._estopped:
+            self._write(link)
 
     def _write(self, link: Ros2ControlLink) -> None:
         """Send the next goal, reached no sooner than the velocity limits allow from the
