@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 import pytest
+from openral_core.errors import OpenralError
 from openral_eval.policies import Observation
 from openral_nodes.rskill_runner import (
     MissingSlots,
@@ -137,11 +138,20 @@ class _EndEffectorPolicy:
         return np.zeros(7)
 
 
-def test_runner_refuses_a_policy_that_acts_in_end_effector_deltas() -> None:
-    with ros_session(DOMAIN_ID) as context, pytest.raises(RunnerAborted) as caught:
-        RskillRunnerNode(
+def test_an_end_effector_policy_needs_a_robot_with_a_tool_centre_point() -> None:
+    with ros_session(DOMAIN_ID) as context:
+        node = RskillRunnerNode(
             context=context,
             parameter_overrides=runner_parameters("franka_panda"),
             policy=_EndEffectorPolicy(),
         )
-    assert "acts in ee_delta_pose; a ROS graph takes joint targets" in str(caught.value)
+        node.destroy_node()  # type: ignore[no-untyped-call]
+        with pytest.raises(OpenralError) as caught:
+            RskillRunnerNode(
+                context=context,
+                parameter_overrides=runner_parameters("ur5e"),
+                policy=_EndEffectorPolicy(),
+            )
+    assert str(caught.value) == (
+        "ur5e has no tool centre point (sim.tcp): ee_delta_pose actions need one"
+    )

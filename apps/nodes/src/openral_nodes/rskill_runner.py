@@ -194,6 +194,11 @@ class RskillRunnerNode(NamespacedEntities, Node):
         self._first_act: float | None = None
         self.abort_error: OpenralError | None = None
         self.status = RunnerStatus("waiting", (), 0)
+        self._connect(rate_hz)
+
+    def _connect(self, rate_hz: float) -> None:
+        """Subscribe to the frames, joint states and action spec; publish actions each
+        ``1 / rate_hz`` seconds."""
         for entry in self.slot_table:
             self.create_subscription(
                 Image,
