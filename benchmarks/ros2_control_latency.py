@@ -46,7 +46,7 @@ SCENE = Path(__file__).parents[1] / "robots" / "franka_panda" / "scenes" / "tabl
 PERIOD_S = 0.01
 """The Panda's real.control_rate_hz is 100."""
 ROBOT = ["nice", "-n", "-20", str(OPENRAL), "deploy", "sim", "--config", str(SCENE),
-         "--no-viewer", "--namespace", "robot"]  # fmt: skip
+         "--no-viewer", "--namespace", "robot", "--camera-rate", "0.1"]  # fmt: skip
 """The robot: deploy sim ahead of ordinary programs, as a driver's loop runs."""
 REAL = [str(OPENRAL), "deploy", "real", "--robot", "franka_panda", "--transport",
         "ros2_control:robot", "--namespace", "real"]  # fmt: skip
