@@ -248,6 +248,18 @@ def _risen(remote: Remote, runner: subprocess.Popen[str], start: Any) -> None:
     assert abs(after.x - start.x) < 0.02 and abs(after.y - start.y) < 0.02, (start, after)
 
 
+def _steady(remote: Remote, seconds: float = 2.0) -> None:
+    """Wait until the robot's joint states have come every period for ``seconds``."""
+
+    def steady() -> bool:
+        times = [
+            r.at for r in remote.probe.since("/robot/joint_states", time.monotonic() - seconds)
+        ]
+        return len(times) > seconds * 80 and max(np.diff(times)) < 0.015
+
+    wait_until(steady, 60.0, "a steady stream from the restarted robot")
+
+
 def _release_and_move(remote: Remote, release: Any, follow: Any) -> None:
     """Release deploy real's E-stop and send it a goal: the robot's joint 1 turns 0.2 rad."""
     assert call_trigger(release, "/real/openral/release_estop").success
@@ -298,7 +310,7 @@ def test_joint_states_gripper_and_an_ee_policy_through_deploy_real_then_a_restar
             assert not remote.probe.since(ROBOT_TRAJECTORY, quiet)  # nothing sent after it
             with deploy_sim(SCENE, remote.domain, second, ("--namespace", "robot"), robot=True):
                 remote.probe.wait_count("/robot/joint_states", 1, quiet, timeout_s=90.0)
-                time.sleep(1.0)
+                _steady(remote)  # its discovery may pause the stream once: release after it
                 assert not remote.probe.since(ROBOT_TRAJECTORY, quiet)  # a robot back: no motion
                 _release_and_move(remote, release, follow)
                 _, err = stop(real)  # before this robot goes too

@@ -120,6 +120,7 @@ def test_killing_the_robot_latches_the_estop_within_two_periods_and_a_restart_re
     domain = int(os.environ["ROS_DOMAIN_ID"])
     with deploy_sim(SCENE, domain, tmp_path, ("--namespace", "robot"), robot=True):
         wait_until(lambda: not hal.read_state().stale, 90.0, "the restarted robot's readings")
+        _steady(hal)  # its discovery may pause the stream once: release after it
         assert hal.estopped and hal.sent == sent  # a robot back is no release
         hal.release_estop()
         target = hal.hold_action()
@@ -128,3 +129,14 @@ def test_killing_the_robot_latches_the_estop_within_two_periods_and_a_restart_re
         arm = lambda: abs(hal.read_state().positions[0] - target[0]) < 0.01  # noqa: E731
         wait_until(lambda: hal.estopped or arm(), 10.0, "joint 1 after the release")
         assert not hal.estopped, hal.estop_reason
+
+
+def _steady(hal: Ros2ControlHal, seconds: float = 2.0) -> None:
+    """Wait until the readings have stayed fresh for ``seconds`` on end."""
+    deadline = time.monotonic() + 60.0
+    since = time.monotonic()
+    while time.monotonic() - since < seconds:
+        assert time.monotonic() < deadline, "no steady stream from the restarted robot"
+        if hal.read_state().stale:
+            since = time.monotonic()
+        time.sleep(0.002)
