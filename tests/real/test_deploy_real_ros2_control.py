@@ -9,15 +9,13 @@ import time
 from pathlib import Path
 
 import pytest
-from action_msgs.msg import GoalStatus
 from control_msgs.action import FollowJointTrajectory
 from sensor_msgs.msg import JointState
 
 from tests.conftest import ROBOTS
 from tests.real.deploy_helpers import openral, remote_graph, stop
-from tests.ros.action_client import PANDA_ARM, _AtomicActionClient, goal
+from tests.ros.action_client import PANDA_ARM, _AtomicActionClient, goal, succeeded
 from tests.ros.lifecycle_client import deploy_output, deploy_sim
-from tests.ros.ros_helpers import wait_until
 
 pytestmark = pytest.mark.exclusive  # two live graphs and a 100 Hz stream that must not lag
 
@@ -46,13 +44,7 @@ def test_deploy_real_drives_the_robot_through_its_ros2_control_driver(tmp_path: 
             assert client.wait_for_server(timeout_sec=60.0), stop(real)
             start = _arm(remote.probe.latest(ROBOT_STATES))
             target = [start[0] + 0.3, *start[1:]]
-            sent = client.send_goal_async(goal(PANDA_ARM, [(2.0, target)]))
-            wait_until(sent.done, 10.0, "the goal's answer")
-            handle = sent.result()
-            assert handle.accepted
-            result = handle.get_result_async()
-            wait_until(result.done, 30.0, "the goal's result")
-            assert result.result().status == GoalStatus.STATUS_SUCCEEDED
+            succeeded(client, goal(PANDA_ARM, [(2.0, target)]))
             time.sleep(0.5)
             reached = _arm(remote.probe.latest(ROBOT_STATES))
             assert max(abs(a - b) for a, b in zip(reached, target, strict=True)) < 0.02

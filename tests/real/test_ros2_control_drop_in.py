@@ -26,7 +26,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from action_msgs.msg import GoalStatus
 from control_msgs.action import FollowJointTrajectory, GripperCommand
 from geometry_msgs.msg import PoseStamped
 from sensor_msgs.msg import JointState
@@ -36,7 +35,7 @@ from trajectory_msgs.msg import JointTrajectory
 
 from tests.conftest import ROBOTS
 from tests.real.deploy_helpers import Remote, openral, remote_graph, stop
-from tests.ros.action_client import PANDA_ARM, _AtomicActionClient, goal
+from tests.ros.action_client import PANDA_ARM, _AtomicActionClient, goal, succeeded
 from tests.ros.lifecycle_client import deploy_sim
 from tests.ros.ros_helpers import Received, call_trigger, wait_until
 
@@ -265,11 +264,7 @@ def _release_and_move(remote: Remote, release: Any, follow: Any) -> None:
     assert call_trigger(release, "/real/openral/release_estop").success
     start = _arm(remote.probe.latest("/robot/joint_states"))
     target = [start[0] + 0.2, *start[1:]]
-    sent = follow.send_goal_async(goal(PANDA_ARM, [(2.0, target)]))
-    wait_until(sent.done, 10.0, "the goal's answer")
-    result = sent.result().get_result_async()
-    wait_until(result.done, 30.0, "the goal's result")
-    assert result.result().status == GoalStatus.STATUS_SUCCEEDED
+    succeeded(follow, goal(PANDA_ARM, [(2.0, target)]))
     time.sleep(0.5)
     reached = _arm(remote.probe.latest("/robot/joint_states"))
     assert abs(reached[0] - target[0]) < 0.02, (reached, target)

@@ -137,3 +137,18 @@ class TrajectoryActionClient:
 
     def destroy(self) -> None:
         self.client.destroy()
+
+
+def succeeded(client: Any, message: Any, what: str = "the goal") -> Any:
+    """Send ``message`` through ``client``; assert it is accepted and SUCCEEDED (10 s for the
+    answer, 30 s for the result); the result."""
+    from action_msgs.msg import GoalStatus
+
+    sent = client.send_goal_async(message)
+    wait_until(sent.done, 10.0, f"{what}'s answer")
+    handle = sent.result()
+    assert handle.accepted, f"{what} was rejected"
+    result = handle.get_result_async()
+    wait_until(result.done, 30.0, f"{what}'s result")
+    assert result.result().status == GoalStatus.STATUS_SUCCEEDED, result.result()
+    return result.result().result
