@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from typing import Any, Protocol, cast
 
+from openral_hal.unlocked_publisher import UnlockedPublisher
+
 
 class Namespaced(Protocol):
     """Anything with a ROS namespace (a node)."""
@@ -28,12 +30,14 @@ def graph_name(node: Namespaced, name: str) -> str:
 class NamespacedEntities:
     """Mixin for a node class (before rclpy's ``Node`` in its bases): every publisher,
     subscription and service it creates under an absolute name lands under the
-    node's namespace (:func:`graph_name`)."""
+    node's namespace (:func:`graph_name`); its publishers let go of Python's lock while
+    they send (:class:`~openral_hal.unlocked_publisher.UnlockedPublisher`)."""
 
     def _graph_name(self, name: str) -> str:
         return graph_name(cast(Namespaced, self), name)
 
     def create_publisher(self, msg_type: Any, topic: str, *args: Any, **kwargs: Any) -> Any:
+        kwargs.setdefault("publisher_class", UnlockedPublisher)  # no graph-wide freeze
         return super().create_publisher(msg_type, self._graph_name(topic), *args, **kwargs)  # type: ignore[misc]
 
     def create_subscription(self, msg_type: Any, topic: str, *args: Any, **kwargs: Any) -> Any:

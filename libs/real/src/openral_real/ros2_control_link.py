@@ -24,6 +24,7 @@ import numpy as np
 from openral_core.real_wiring import Ros2ControlWiring
 from openral_hal.errors import ConfigurationError
 from openral_hal.realtime import answer_first
+from openral_hal.unlocked_publisher import UnlockedPublisher
 from openral_mujoco.state import FloatArray
 
 __all__ = ["JointReading", "Ros2ControlLink", "driver_namespace"]
@@ -107,7 +108,9 @@ class Ros2ControlLink:
         controller = self.wiring.controller
         if self.wiring.command_interface == "topic":
             topic = self.name(f"{controller}/joint_trajectory")
-            self._trajectory = self._node.create_publisher(JointTrajectory, topic, 10)
+            self._trajectory = self._node.create_publisher(
+                JointTrajectory, topic, 10, publisher_class=UnlockedPublisher
+            )
         else:
             from control_msgs.action import FollowJointTrajectory
             from rclpy.action.client import ActionClient
