@@ -35,7 +35,7 @@ from trajectory_msgs.msg import JointTrajectory
 
 from tests.conftest import ROBOTS
 from tests.real.deploy_helpers import Remote, openral, remote_graph, stop
-from tests.ros.action_client import PANDA_ARM, _AtomicActionClient, goal, succeeded
+from tests.ros.action_client import PANDA_ARM, _AtomicActionClient, ended, goal
 from tests.ros.lifecycle_client import deploy_sim
 from tests.ros.ros_helpers import Received, call_trigger, wait_until
 
@@ -50,6 +50,8 @@ PERIOD_S = 4.0
 SETTLED_S = 3.0
 """The comparison starts this long after the first action [s] (deploy real's start-up,
 whose discovery can stop the robot's stream for 0.3 s, is over by then)."""
+RELEASES = 3
+"""Releases the restart test may take (see ``_release_and_move``)."""
 
 
 def _deploy_real(remote: Remote) -> subprocess.Popen[str]:
@@ -259,15 +261,26 @@ def _steady(remote: Remote, seconds: float = 2.0) -> None:
     wait_until(steady, 60.0, "a steady stream from the restarted robot")
 
 
-def _release_and_move(remote: Remote, release: Any, follow: Any) -> None:
-    """Release deploy real's E-stop and send it a goal: the robot's joint 1 turns 0.2 rad."""
-    assert call_trigger(release, "/real/openral/release_estop").success
-    start = _arm(remote.probe.latest("/robot/joint_states"))
-    target = [start[0] + 0.2, *start[1:]]
-    succeeded(follow, goal(PANDA_ARM, [(2.0, target)]))
-    time.sleep(0.5)
-    reached = _arm(remote.probe.latest("/robot/joint_states"))
-    assert abs(reached[0] - target[0]) < 0.02, (reached, target)
+def _release_and_move(remote: Remote, release: Any, follow: Any) -> int:
+    """Release deploy real's E-stop and send it a goal: the robot's joint 1 turns 0.2 rad.
+    Returns the releases it took: the stand-in robot (a Python simulator on two shared
+    cores) misses its 20 ms deadline now and then, and deploy real latches, as it must; it
+    is released again once its stream is steady, at most :data:`RELEASES` times."""
+    from action_msgs.msg import GoalStatus
+
+    for attempt in range(1, RELEASES + 1):
+        assert call_trigger(release, "/real/openral/release_estop").success
+        start = _arm(remote.probe.latest("/robot/joint_states"))
+        target = [start[0] + 0.2, *start[1:]]
+        status, result = ended(follow, goal(PANDA_ARM, [(2.0, target)]))
+        if status == GoalStatus.STATUS_SUCCEEDED:
+            time.sleep(0.5)
+            reached = _arm(remote.probe.latest("/robot/joint_states"))
+            assert abs(reached[0] - target[0]) < 0.02, (reached, target)
+            return attempt
+        assert "E-stop is latched" in result.error_string, result
+        _steady(remote)
+    raise AssertionError(f"the goal stopped at the E-stop after each of {RELEASES} releases")
 
 
 def test_joint_states_gripper_and_an_ee_policy_through_deploy_real_then_a_restart(
@@ -307,10 +320,11 @@ def test_joint_states_gripper_and_an_ee_policy_through_deploy_real_then_a_restar
                 remote.probe.wait_count("/robot/joint_states", 1, quiet, timeout_s=90.0)
                 _steady(remote)  # its discovery may pause the stream once: release after it
                 assert not remote.probe.since(ROBOT_TRAJECTORY, quiet)  # a robot back: no motion
-                _release_and_move(remote, release, follow)
+                releases = _release_and_move(remote, release, follow)
                 _, err = stop(real)  # before this robot goes too
         finally:
             if real.returncode is None:  # a failure above: stop it all the same
                 stop(real)
     fault = [line for line in err.splitlines() if "E-stop latched" in line]
-    assert len(fault) == 1 and "joint_states stopped" in fault[0], err  # one line, one cause
+    assert len(fault) == releases, err  # the kill's, and one per release the stand-in missed
+    assert all("joint_states stopped" in line for line in fault), err  # one line, one cause

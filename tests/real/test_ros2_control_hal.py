@@ -32,6 +32,10 @@ PERIOD_S = 0.01
 """The Panda's real.control_rate_hz is 100."""
 WAKE_SLACK_S = 0.003
 """How late the watchdog's thread may wake on a loaded machine [s]."""
+RELEASES = 3
+"""Releases the restart may take: the stand-in robot (a Python simulator on two shared
+cores) misses its 20 ms deadline now and then after it starts, and the HAL latches, as it
+must; each latch must name the stream."""
 
 
 @pytest.fixture(scope="module")
@@ -122,13 +126,24 @@ def test_killing_the_robot_latches_the_estop_within_two_periods_and_a_restart_re
         wait_until(lambda: not hal.read_state().stale, 90.0, "the restarted robot's readings")
         _steady(hal)  # its discovery may pause the stream once: release after it
         assert hal.estopped and hal.sent == sent  # a robot back is no release
-        hal.release_estop()
-        target = hal.hold_action()
-        target[0] -= 0.2
-        hal.send_action(target)
-        arm = lambda: abs(hal.read_state().positions[0] - target[0]) < 0.01  # noqa: E731
-        wait_until(lambda: hal.estopped or arm(), 10.0, "joint 1 after the release")
+        for _ in range(RELEASES):  # the stand-in robot misses its deadline now and then
+            hal.release_estop()
+            if _turned(hal, -0.2):
+                break
+            assert "joint_states stopped" in faults[-1][1], faults[-1][1]  # the stream rule
+            _steady(hal)
         assert not hal.estopped, hal.estop_reason
+
+
+def _turned(hal: Ros2ControlHal, by_rad: float) -> bool:
+    """Send joint 1 ``by_rad`` from where it holds; True once it is there, False when the
+    E-stop latches first (10 s at most)."""
+    target = hal.hold_action()
+    target[0] += by_rad
+    hal.send_action(target)
+    there = lambda: abs(hal.read_state().positions[0] - target[0]) < 0.01  # noqa: E731
+    wait_until(lambda: hal.estopped or there(), 10.0, "joint 1 after the release")
+    return not hal.estopped
 
 
 def _steady(hal: Ros2ControlHal, seconds: float = 2.0) -> None:

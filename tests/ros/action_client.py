@@ -139,16 +139,23 @@ class TrajectoryActionClient:
         self.client.destroy()
 
 
-def succeeded(client: Any, message: Any, what: str = "the goal") -> Any:
-    """Send ``message`` through ``client``; assert it is accepted and SUCCEEDED (10 s for the
-    answer, 30 s for the result); the result."""
-    from action_msgs.msg import GoalStatus
-
+def ended(client: Any, message: Any, what: str = "the goal") -> tuple[int, Any]:
+    """Send ``message`` through ``client``; assert it is accepted (10 s for the answer);
+    (status, result) once it ends (30 s)."""
     sent = client.send_goal_async(message)
     wait_until(sent.done, 10.0, f"{what}'s answer")
     handle = sent.result()
     assert handle.accepted, f"{what} was rejected"
     result = handle.get_result_async()
     wait_until(result.done, 30.0, f"{what}'s result")
-    assert result.result().status == GoalStatus.STATUS_SUCCEEDED, result.result()
-    return result.result().result
+    return result.result().status, result.result().result
+
+
+def succeeded(client: Any, message: Any, what: str = "the goal") -> Any:
+    """Send ``message`` through ``client``; assert it is accepted and SUCCEEDED (10 s for the
+    answer, 30 s for the result); the result."""
+    from action_msgs.msg import GoalStatus
+
+    status, result = ended(client, message, what)
+    assert status == GoalStatus.STATUS_SUCCEEDED, result
+    return result
