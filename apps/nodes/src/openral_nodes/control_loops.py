@@ -25,7 +25,7 @@ from openral_bridge.real_cadence import RealCadence
 from openral_bridge.trajectory_follower import follower_for
 from openral_core import LoadedRobot
 from openral_hal.factory import can_tick
-from openral_hal.protocol import CycledHal, RobotHal
+from openral_hal.protocol import CycledHal, PathScreen, RobotHal
 
 if TYPE_CHECKING:
     from rclpy.node import Node
@@ -44,6 +44,8 @@ def start_control_loop(
     """The running control loop of ``hal`` (see the module doc), or None."""
     joints = robot is not None and hal.action_names == hal.joint_names
     follower = follower_for(robot) if robot is not None and joints else None
+    if follower is not None and isinstance(hal, PathScreen):
+        follower.screen = hal.path_contact  # a twin scene refuses a goal into its table
     if can_tick(hal):
         loop = ControlLoop(
             node, hal, on_tick=on_tick, lock=lock, follower=follower, on_reset=on_reset

@@ -30,10 +30,12 @@ PARAMETERS: dict[str, Any] = {
     "calibration_file": "",
     "arm_id": "",
     "cameras": [""],
+    "twin_scene": "",
 }
 """Every parameter and its default. A real robot's: ``transport`` (its bus or address),
 ``calibration_file`` and ``arm_id`` (which calibration), ``cameras`` (``NAME=DEVICE``
-strings over the manifest's devices; ``[""]`` for none, as ROS has no empty list type)."""
+strings over the manifest's devices; ``[""]`` for none, as ROS has no empty list type),
+``twin_scene`` (a scene file the real robot is posed in: ``deploy real --twin``)."""
 
 RATE_RANGE_HZ = (0.1, 1000.0)
 """Accepted ``camera_publish_rate_hz`` (or 0) and ``joint_state_rate_hz``, inclusive [Hz]."""
@@ -94,11 +96,14 @@ def robot_and_scene(
     )
 
 
-def real_options(calibration_file: str, arm_id: str, cameras: list[str]) -> RealOptions:
-    """The real driver's options from the parameters.
+def real_options(
+    calibration_file: str, arm_id: str, cameras: list[str], twin_scene: str = ""
+) -> RealOptions:
+    """The real driver's options from the parameters (the twin scene read once).
 
     Raises:
         ValueError: A ``cameras`` entry that is not ``NAME=DEVICE``.
+        OpenralError: A twin scene file that does not load (located).
     """
     devices = {}
     for entry in (item for item in cameras if item):
@@ -110,6 +115,7 @@ def real_options(calibration_file: str, arm_id: str, cameras: list[str]) -> Real
         calibration_file=Path(calibration_file) if calibration_file else None,
         arm_id=arm_id or None,
         cameras=devices,
+        twin_scene=load_scene(Path(twin_scene)) if twin_scene else None,
     )
 
 
@@ -124,8 +130,13 @@ def configured_hal(values: dict[str, Any]) -> tuple[LoadedRobot, RobotHal]:
     robot, scene = robot_and_scene(
         str(values["robot_id"]), str(values["manifest_path"]), str(values["sim_env_yaml"])
     )
+    if values["twin_scene"] and values["hal_mode"] != "real":
+        raise ValueError("parameter twin_scene is for a real robot (hal_mode real)")
     options = real_options(
-        str(values["calibration_file"]), str(values["arm_id"]), list(values["cameras"])
+        str(values["calibration_file"]),
+        str(values["arm_id"]),
+        list(values["cameras"]),
+        str(values["twin_scene"]),
     )
     hal = build_hal(
         robot,

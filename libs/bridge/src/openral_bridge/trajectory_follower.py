@@ -31,6 +31,7 @@ from openral_mujoco.state import FloatArray
 from openral_bridge.joint_path import (
     JointPath,
     PathLimits,
+    PathRefused,
     PathStart,
     TrajectoryRequest,
     plan_path,
@@ -38,6 +39,9 @@ from openral_bridge.joint_path import (
 
 SAME_TIME_S = 1e-9
 """Times closer than this are the same instant [s]."""
+SCREEN_STEP_S = 0.01
+"""A path is handed to :attr:`TrajectoryFollower.screen` sampled this often [s] (the screen
+fills in straight steps between samples)."""
 
 
 def path_limits(robot: LoadedRobot) -> PathLimits:
@@ -91,6 +95,9 @@ class TrajectoryFollower:
         """
         self.limits = limits
         self.start_tolerance = float(start_tolerance)
+        self.screen: Callable[[FloatArray], str | None] | None = None
+        """Says where a planned path (rows of action values at :data:`SCREEN_STEP_S`)
+        would touch the scene, refusing it (None: no screen; a twin scene's)."""
         self.on_end: Callable[[JointPath, str], None] | None = None
         """Told about each path that ends before its last point, and why (any thread, no
         lock of the follower held)."""
@@ -137,12 +144,30 @@ class TrajectoryFollower:
                 velocities[self._running.slots] = speed
             start = PathStart(now_s, positions, velocities, measured, self.start_tolerance)
             path = plan_path(request, self.limits, start)
+        self._screened(path, positions)
+        with self._lock:
             dropped, self._waiting = self._waiting, path
             if dropped is not None:
                 self.cancelled += 1
         if dropped is not None:
             self._ended(dropped, f"replaced by {path.source} before it started")
         return path
+
+    def _screened(self, path: JointPath, targets: FloatArray) -> None:
+        """Refuse ``path`` when :attr:`screen` finds a contact along it.
+
+        Raises:
+            PathRefused: The screen's line.
+        """
+        if self.screen is None:
+            return
+        times = np.arange(path.start_s, path.end_s, SCREEN_STEP_S)
+        rows = np.tile(targets, (len(times) + 1, 1))
+        for row, time_s in zip(rows, [*times, path.end_s], strict=True):
+            row[path.slots] = path.sample(float(time_s))[0]
+        contact = self.screen(rows)
+        if contact is not None:
+            raise PathRefused(contact)
 
     def reference(
         self, time_s: float

@@ -53,6 +53,10 @@ class RealOptions:
     """Which arm of this robot type (LeRobot's ``--robot.id``); None: the robot's name."""
     cameras: Mapping[str, str] = field(default_factory=dict)
     """RGB sensor → camera device, over the manifest's ``device`` entries."""
+    twin_scene: DeployScene | None = None
+    """A scene whose robot follows the measured joints (``deploy real --twin``): its
+    cameras render the real pose and commands that would touch its fixed geometry are
+    refused. None: the robot's own model alone."""
 
 
 RealDriver = Callable[[LoadedRobot, str | None, RealOptions], RobotHal]

@@ -190,6 +190,7 @@ __all__ = [
     "MobileBaseHal",
     "MujocoBacked",
     "ObservingHal",
+    "PathScreen",
     "RobotHal",
     "StateSensorSource",
     "Tickable",
@@ -290,6 +291,17 @@ class TwinHal(Protocol):
 
     def pose_twin(self, sample: JointStateSample) -> None:
         """Pose the model at the reading ``sample`` came from."""
+        ...
+
+
+@runtime_checkable
+class PathScreen(Protocol):
+    """A real HAL with a twin scene: it can tell where a joint path would touch it."""
+
+    def path_contact(self, rows: FloatArray) -> str | None:
+        """Where the path from the measured pose through ``rows`` (action values, one row
+        per point) first touches the scene's fixed geometry, in one line naming the pair;
+        None: nowhere (or no scene)."""
         ...
 
 

@@ -26,7 +26,7 @@ from __future__ import annotations
 import gc
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import mujoco
@@ -49,7 +49,7 @@ from openral_real.calibration import (
 )
 from openral_real.errors import BusError, BusFault
 from openral_real.feetech_bus import FeetechBus, ServoReading
-from openral_real.kinematic_twin import KinematicTwin
+from openral_real.kinematic_twin import KinematicTwin, twin_for
 from openral_real.manifest_arm import ManifestArm
 from openral_real.motion_envelope import MotionEnvelope
 from openral_real.opencv_cameras import Cameras, camera_devices
@@ -106,8 +106,8 @@ class FeetechHal(ManifestArm):
         self._rgb = {s.name: s for s in robot.description.sensors if isinstance(s, RgbSensor)}
         self._devices = camera_devices(self._rgb, self.options.cameras)
         self._session: _Session | None = None
-        self._twin = KinematicTwin(robot) if robot.tables.hal_wiring is not None else None
-        """The robot's model, compiled here so its frames are known before connecting."""
+        self.attach_twin(twin_for(robot, self.options.twin_scene))  # frames known at once
+        _one_source_per_camera(self._devices, self.camera_sensors())
         self._froze = False
         """While connected, the heap found at connect is frozen out of garbage collection
         (``gc.freeze``, unless the process froze it itself, as deploy real does): a full
@@ -334,6 +334,20 @@ def _bus_of(robot: LoadedRobot) -> tuple[RealWiring, FeetechWiring]:
             "driven by the feetech driver"
         )
     return real, real.feetech
+
+
+def _one_source_per_camera(devices: Mapping[str, str], rendered: Mapping[str, object]) -> None:
+    """Refuse a camera that has a device and is rendered by the twin scene as well.
+
+    Raises:
+        ConfigurationError: One line naming the camera.
+    """
+    both = sorted(set(devices) & set(rendered))
+    if both:
+        raise ConfigurationError(
+            f"camera {both[0]} has a device ({devices[both[0]]}) and the twin scene renders "
+            "it too: drop its --camera or use a scene without it"
+        )
 
 
 def _say(line: str) -> None:

@@ -10,6 +10,7 @@ import numpy as np
 from openral_core.loaded import LoadedRobot
 from openral_core.models import LimitedJoint, RobotDescription
 from openral_core.real_wiring import RealWiring
+from openral_hal.attached_sensors import AttachedSensors
 from openral_hal.errors import ActionRejected
 from openral_hal.protocol import EStopLatch
 from openral_mujoco.state import FloatArray
@@ -26,9 +27,10 @@ waits at most this long for Python's lock after a reading arrives (the default, 
 half a 100 Hz period). Restored at disconnect."""
 
 
-class ManifestArm(EStopLatch):
+class ManifestArm(AttachedSensors, EStopLatch):
     """A real arm driven through the manifest: one action slot per joint (a mixin; the HAL
-    sets :attr:`robot` and :attr:`real`)."""
+    sets :attr:`robot` and :attr:`real`). With a twin scene it serves the scene's sensors,
+    rendered at the measured pose (:meth:`attach_twin`)."""
 
     robot: LoadedRobot
     real: RealWiring
@@ -65,6 +67,17 @@ class ManifestArm(EStopLatch):
             sys.setswitchinterval(previous)
             self._switch_before = None
 
+    def attach_twin(self, twin: KinematicTwin | None) -> None:
+        """Make ``twin`` the HAL's model (its scene's sensors the HAL's own)."""
+        self._twin = twin
+        self._suite = twin.sensors if twin is not None else None
+
+    def path_contact(self, rows: FloatArray) -> str | None:
+        """Where the joint path from the measured pose through ``rows`` (action values,
+        one row per point) first touches the twin scene's fixed geometry, in one line;
+        None: nowhere, or no twin scene (see :mod:`openral_real.twin_contacts`)."""
+        return self._twin.first_contact(rows) if self._twin is not None else None
+
     def frame_tree(self) -> FrameTree | None:
         """The robot's frames in its own model (None without a sim block); known before
         connecting."""
@@ -85,11 +98,13 @@ class ManifestArm(EStopLatch):
         )
 
     def screen_action(self, values: FloatArray) -> None:
-        """Refuse an all-zero action (unless the manifest allows it) and any action while
-        the E-stop is latched; ``values`` already has the right width and is finite.
+        """Refuse an all-zero action (unless the manifest allows it), any action while
+        the E-stop is latched, and one whose way from the measured pose touches the twin
+        scene; ``values`` already has the right width and is finite.
 
         Raises:
-            ActionRejected: All zeros. EStopLatched: The E-stop is latched.
+            ActionRejected: All zeros, or the way there touches the twin scene's fixed
+                geometry (the pair named). EStopLatched: The E-stop is latched.
         """
         if self.real.refuse_zero_action and not np.any(values):
             raise ActionRejected(
@@ -98,3 +113,6 @@ class ManifestArm(EStopLatch):
                 "action (/openral/action_spec) or the measured positions"
             )
         self._refuse_when_estopped()
+        contact = self.path_contact(values)
+        if contact is not None:
+            raise ActionRejected(contact)

@@ -35,6 +35,7 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
+from openral_core.models import DeployScene
 from openral_core.real_wiring import Ros2ControlWiring
 from openral_hal.errors import ConfigurationError, EStopLatched, NotConnected
 from openral_hal.factory import RealOptions
@@ -43,7 +44,7 @@ from openral_mujoco.action import validated_action
 from openral_mujoco.gripper import SlotMap, slot_map, units_mismatch
 from openral_mujoco.state import FloatArray, JointStateSample
 
-from openral_real.kinematic_twin import KinematicTwin
+from openral_real.kinematic_twin import twin_for
 from openral_real.manifest_arm import ManifestArm
 from openral_real.ros2_control_link import JointReading, Ros2ControlLink, driver_namespace
 
@@ -61,7 +62,7 @@ def ros2_control_hal(
     robot: LoadedRobot, transport: str | None, options: RealOptions
 ) -> Ros2ControlHal:
     """The ``ros2_control`` real driver (the ``openral.real_drivers`` entry point)."""
-    return Ros2ControlHal(robot, driver_namespace(transport))
+    return Ros2ControlHal(robot, driver_namespace(transport), options.twin_scene)
 
 
 class Ros2ControlHal(ManifestArm):
@@ -69,7 +70,9 @@ class Ros2ControlHal(ManifestArm):
 
     is_real = True
 
-    def __init__(self, robot: LoadedRobot, namespace: str) -> None:
+    def __init__(
+        self, robot: LoadedRobot, namespace: str, twin_scene: DeployScene | None = None
+    ) -> None:
         """Wire the HAL; nothing is opened until :meth:`connect`.
 
         Raises:
@@ -89,7 +92,7 @@ class Ros2ControlHal(ManifestArm):
         self.sent = 0
         """Trajectories sent to the driver."""
         self._gripper = _gripper_map(robot, self.wiring)
-        self._twin = KinematicTwin(robot) if robot.tables.hal_wiring is not None else None
+        self.attach_twin(twin_for(robot, twin_scene))
         self._link: Ros2ControlLink | None = None
         self._envelope = self.manifest_envelope()
         self._speeds = np.array([float(j.velocity_limit) for j in robot.description.joints])

@@ -140,6 +140,16 @@ def sim(
     out.print(stopped, soft_wrap=False, highlight=True)
 
 
+Twin = Annotated[
+    Path | None,
+    typer.Option(
+        "--twin",
+        help="SCENE: pose the real robot in this scene (its cameras, TF, view); commands "
+        "into its fixed geometry are refused.",
+    ),
+]
+
+
 @app.command("real")
 def real(
     transport: Annotated[
@@ -165,6 +175,7 @@ def real(
             help="NAME=DEVICE: an RGB sensor's camera (0, /dev/video0, file:clip.mp4).",
         ),
     ] = None,
+    twin: Twin = None,
     no_tf: NoTf = False,
     no_static_tf: NoStaticTf = False,
     namespace: Namespace = "",
@@ -177,7 +188,7 @@ def real(
     if (robot is None) == (manifest is None):
         raise typer.BadParameter("give the robot: --robot ID or --manifest FILE (one of them)")
     parameters = _real_parameters(robot, manifest, transport, arm_id, calibration, camera)
-    parameters.update(_tf_parameters(no_tf, no_static_tf))
+    parameters.update(_tf_parameters(no_tf, no_static_tf), twin_scene=_twin_scene(twin))
     require_ros()
     from openral_hal.realtime import ahead_of_other_programs
     from openral_nodes.runtime import ros_session
@@ -221,6 +232,14 @@ def _real_parameters(
         "arm_id": arm_id or "",
         "cameras": list(cameras or [""]),
     }
+
+
+def _twin_scene(twin: Path | None) -> str:
+    """The ``twin_scene`` parameter of ``--twin`` (the file checked first; "" for none)."""
+    if twin is None:
+        return ""
+    _require_file(twin, "twin scene", "robots/franka_panda/scenes/tabletop.yaml")
+    return str(twin.resolve())
 
 
 def _tf_parameters(no_tf: bool, no_static_tf: bool) -> dict[str, Any]:
