@@ -200,3 +200,24 @@ def test_path_limits_are_the_manifest_envelope_per_action_slot() -> None:
     fast = TrajectoryRequest(("panda_joint1",), (PathPoint(0.1, (0.5,)),))
     with pytest.raises(PathRefused, match=r"panda_joint1 would need 5 rad/s .* 2\.175 rad/s"):
         follower.submit(fast, np.zeros(8), 0.0)
+
+
+def test_a_screen_sees_the_whole_path_and_its_line_refuses_it() -> None:
+    follower = TrajectoryFollower(LIMITS)
+    seen: list[FloatArray] = []
+
+    def table_below(rows: FloatArray) -> str | None:
+        seen.append(rows)
+        return "the path would bring hand into world (table)" if rows[:, 0].max() > 0.5 else None
+
+    follower.screen = table_below
+    follower.submit(_request((0.2, 0.3)), HOLD, NOW)  # stays above the "table"
+    assert follower.active
+    rows = seen[-1]
+    assert rows[0].tolist() == pytest.approx(HOLD.tolist())  # from the hold
+    assert rows[-1].tolist() == pytest.approx([0.3, HOLD[1], HOLD[2]])  # to the last point
+    assert np.all(np.diff(rows[:, 0]) >= 0) and len(rows) >= 20  # every 10 ms of 0.2 s
+    follower.cancel()
+    with pytest.raises(PathRefused, match="hand into world"):
+        follower.submit(_request((1.0, 0.9)), HOLD, NOW)
+    assert not follower.active  # nothing waits, nothing runs
