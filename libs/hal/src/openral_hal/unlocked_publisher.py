@@ -8,9 +8,10 @@ is the driver's loop: its reading goes stale and the two-period rule latches the
 (:mod:`openral_real.bus_cycle`).
 
 :class:`UnlockedPublisher` is a drop-in ``publisher_class`` for ``Node.create_publisher``:
-the message is serialised in Python (as rclpy does), then handed to
-``rcl_publish_serialized_message`` through :mod:`ctypes`, which releases the lock for the
-foreign call. The thread that publishes still waits for the middleware; every other thread
+the message is converted to its C form by its type's own converter (as rclpy
+does, holding the lock), then handed to ``rcl_publish`` through :mod:`ctypes`, which
+releases the lock for the foreign call; the bytes on the wire are rclpy's own. The
+thread that publishes still waits for the middleware; every other thread
 (the driver's loop, the executor) runs on.
 """
 
@@ -18,35 +19,42 @@ from __future__ import annotations
 
 import ctypes
 import sys
+from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 from typing import Any, cast
 
 from rclpy.publisher import Publisher
-from rclpy.serialization import serialize_message
+
+_CREATE = ctypes.CFUNCTYPE(ctypes.c_void_p)
+_DESTROY = ctypes.CFUNCTYPE(None, ctypes.c_void_p)
+_FROM_PY = ctypes.PYFUNCTYPE(ctypes.c_bool, ctypes.py_object, ctypes.c_void_p)
+"""The message type's own converters (rosidl's capsules; converting needs Python's lock)."""
 
 
-class _Allocator(ctypes.Structure):
-    """``rcutils_allocator_t`` (unused by a publish; present for the layout)."""
-
-    _fields_ = [
-        ("allocate", ctypes.c_void_p),
-        ("deallocate", ctypes.c_void_p),
-        ("reallocate", ctypes.c_void_p),
-        ("zero_allocate", ctypes.c_void_p),
-        ("state", ctypes.c_void_p),
-    ]
+@dataclass(frozen=True)
+class _Converters:
+    create: Any
+    from_py: Any
+    destroy: Any
 
 
-class _SerializedMessage(ctypes.Structure):
-    """``rcl_serialized_message_t`` (``rcutils_uint8_array_t``)."""
+@cache
+def _converters(msg_type: type) -> _Converters:
+    """The C functions that make, fill and free ``msg_type``'s C message."""
+    get = ctypes.pythonapi.PyCapsule_GetPointer
+    get.restype, get.argtypes = ctypes.c_void_p, [ctypes.py_object, ctypes.c_char_p]
+    kind = type(msg_type)
+    kind.__import_type_support__()  # type: ignore[attr-defined]
 
-    _fields_ = [
-        ("buffer", ctypes.c_void_p),
-        ("buffer_length", ctypes.c_size_t),
-        ("buffer_capacity", ctypes.c_size_t),
-        ("allocator", _Allocator),
-    ]
+    def pointer(name: str) -> int:
+        return int(get(getattr(kind, name), None))
+
+    return _Converters(
+        _CREATE(pointer("_CREATE_ROS_MESSAGE")),
+        _FROM_PY(pointer("_CONVERT_FROM_PY")),
+        _DESTROY(pointer("_DESTROY_ROS_MESSAGE")),
+    )
 
 
 @cache
@@ -57,9 +65,8 @@ def _rcl() -> ctypes.CDLL:
         library = ctypes.CDLL("librcl.so")
     except OSError:
         library = ctypes.CDLL(str(Path(sys.prefix) / "lib" / "librcl.so"))
-    publish = library.rcl_publish_serialized_message
-    publish.argtypes = [ctypes.c_void_p, ctypes.POINTER(_SerializedMessage), ctypes.c_void_p]
-    publish.restype = ctypes.c_int
+    library.rcl_publish.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
+    library.rcl_publish.restype = ctypes.c_int
     library.rcutils_get_error_string.restype = ctypes.c_char * 1024
     return library
 
@@ -68,28 +75,27 @@ class UnlockedPublisher(Publisher):
     """``Publisher`` whose :meth:`publish` releases Python's lock (see the module doc)."""
 
     def publish(self, msg: Any) -> None:
-        """Send ``msg`` (an instance of the publisher's type; raw bytes are sent as they
-        are, already serialised).
+        """Send ``msg`` (an instance of the publisher's type).
 
         Raises:
             TypeError: ``msg`` is not of the publisher's type.
             RuntimeError: rcl refused it (its error text, naming the topic).
         """
-        if isinstance(msg, bytes):
-            data = msg
-        elif isinstance(msg, cast(type, self.msg_type)):
-            data = serialize_message(msg)
-        else:
+        kind = cast(type, self.msg_type)
+        if not isinstance(msg, kind):
             raise TypeError(f"Expected {self.msg_type}, got {type(msg)}")
-        payload = ctypes.c_char_p(data)  # points into ``data``: no copy
-        message = _SerializedMessage(
-            ctypes.cast(payload, ctypes.c_void_p), len(data), len(data), _Allocator()
-        )
-        library = _rcl()
-        with self.handle:
-            code = library.rcl_publish_serialized_message(
-                self.handle.pointer, ctypes.byref(message), None
-            )
+        convert = _converters(kind)
+        message = convert.create()
+        if not message:
+            raise MemoryError(f"{self.topic_name}: no memory for a {kind.__name__} message")
+        try:
+            if not convert.from_py(msg, message):
+                raise TypeError(f"{self.topic_name}: the {kind.__name__} does not convert")
+            library = _rcl()
+            with self.handle:
+                code = library.rcl_publish(self.handle.pointer, message, None)  # lock let go
+        finally:
+            convert.destroy(message)
         if code != 0:
             text = library.rcutils_get_error_string().value.decode(errors="replace")
             library.rcutils_reset_error()
