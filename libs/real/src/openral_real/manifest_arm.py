@@ -5,8 +5,11 @@ and ros2_control)."""
 from __future__ import annotations
 
 import sys
+from collections.abc import Mapping
 
+import mujoco
 import numpy as np
+import numpy.typing as npt
 from openral_core.loaded import LoadedRobot
 from openral_core.models import LimitedJoint, RobotDescription
 from openral_core.real_wiring import RealWiring
@@ -15,6 +18,7 @@ from openral_hal.errors import ActionRejected
 from openral_hal.protocol import EStopLatch
 from openral_mujoco.state import FloatArray
 from openral_sim.frame_tree import FrameTree
+from openral_sim.sensor_sources import StateSpec
 
 from openral_real.kinematic_twin import KinematicTwin
 from openral_real.motion_envelope import MotionEnvelope
@@ -77,6 +81,25 @@ class ManifestArm(AttachedSensors, EStopLatch):
         one row per point) first touches the twin scene's fixed geometry, in one line;
         None: nowhere, or no twin scene (see :mod:`openral_real.twin_contacts`)."""
         return self._twin.first_contact(rows) if self._twin is not None else None
+
+    def read_images(self) -> dict[str, npt.NDArray[np.uint8]]:
+        """No camera of its own (a driver with devices serves theirs)."""
+        return {}
+
+    def camera_fovy_deg(self, sensor: str) -> float | None:
+        """Vertical field of view [deg] of the twin scene's camera that renders ``sensor``."""
+        scene = self._twin.scene if self._twin is not None else None
+        camera = scene.camera_models.get(sensor) if scene is not None else None
+        if scene is None or camera is None:
+            return None
+        model = self._twin.model  # type: ignore[union-attr]
+        index = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera)
+        return float(model.cam_fovy[index]) if index >= 0 else None
+
+    def state_sensors(self) -> Mapping[str, StateSpec]:
+        """None: a twin is never stepped, so an IMU or force-torque reading from it would
+        be made up."""
+        return {}
 
     def frame_tree(self) -> FrameTree | None:
         """The robot's frames in its own model (None without a sim block); known before
