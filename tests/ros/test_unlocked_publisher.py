@@ -12,7 +12,7 @@ from itertools import pairwise
 from typing import Any
 
 import pytest
-from openral_hal.unlocked_publisher import UnlockedPublisher, _rcl
+from openral_hal.unlocked_publisher import UnlockedPublisher, _rcl, rcl_error
 from openral_nodes.graph_names import namespaced_node
 from rclpy.context import Context
 from rclpy.node import Node
@@ -76,6 +76,13 @@ def test_the_bytes_on_the_wire_are_rclpys_own(node: Node) -> None:
         stop()
     assert len(set(raw["/wire/locked"])) == 1  # one message, one set of bytes
     assert set(raw["/wire/unlocked"]) == set(raw["/wire/locked"])
+
+
+def test_rcls_refusal_is_read_as_text() -> None:
+    """The error path: rcl's own text (the error string is a struct returned by value)."""
+    assert _rcl().rcl_publish(None, None, None) != 0
+    assert "publisher pointer is invalid" in rcl_error(1)
+    assert rcl_error(1) == "rcl 1"  # reset: nothing left to say
 
 
 def test_a_graph_node_publishes_unlocked(ros_context: Context) -> None:

@@ -67,8 +67,23 @@ def _rcl() -> ctypes.CDLL:
         library = ctypes.CDLL(str(Path(sys.prefix) / "lib" / "librcl.so"))
     library.rcl_publish.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_void_p]
     library.rcl_publish.restype = ctypes.c_int
-    library.rcutils_get_error_string.restype = ctypes.c_char * 1024
+    library.rcutils_get_error_string.restype = _ErrorString  # returned by value
     return library
+
+
+class _ErrorString(ctypes.Structure):
+    """``rcutils_error_string_t`` (a struct of one 1024-byte string: an array return type
+    would crash ctypes)."""
+
+    _fields_ = [("text", ctypes.c_char * 1024)]
+
+
+def rcl_error(code: int) -> str:
+    """rcl's error text for a call that returned ``code``, and the error state reset."""
+    library = _rcl()
+    text = library.rcutils_get_error_string().text.decode(errors="replace")
+    library.rcutils_reset_error()
+    return text if text and text != "error not set" else f"rcl {code}"
 
 
 class UnlockedPublisher(Publisher):
@@ -97,6 +112,4 @@ class UnlockedPublisher(Publisher):
         finally:
             convert.destroy(message)
         if code != 0:
-            text = library.rcutils_get_error_string().value.decode(errors="replace")
-            library.rcutils_reset_error()
-            raise RuntimeError(f"{self.topic_name}: publish failed ({text or f'rcl {code}'})")
+            raise RuntimeError(f"{self.topic_name}: publish failed ({rcl_error(code)})")
