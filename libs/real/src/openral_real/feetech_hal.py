@@ -100,9 +100,9 @@ class FeetechHal(ManifestArm):
         self.estop_at: float | None = None
         """When it latched [s, system clock] (None while released)."""
         self.on_fault: Callable[[str], None] = _say
+        """Called once, on the bus's thread, with the line that says why a fault latched."""
         self.defer_cycle = False
         """True: :meth:`connect` holds the arm and leaves the loop to :meth:`start_cycle`."""
-        """Called once, on the bus's thread, with the line that says why a fault latched."""
         self._rgb = {s.name: s for s in robot.description.sensors if isinstance(s, RgbSensor)}
         self._devices = camera_devices(self._rgb, self.options.cameras)
         self._session: _Session | None = None

@@ -71,11 +71,14 @@ class KinematicTwin:
             self._fingers.append((gripper.slot, [int(a) for a in gripper.finger_qpos[1:]]))
         joints = _joints_at(self.model, self._qpos)
         self._dof = np.array([int(self.model.jnt_dofadr[j]) for j in joints])
-        self.contacts = TwinContacts(self.model, joints, [g.slot for g in addresses.grippers])
+        self.contacts: TwinContacts | None = None
+        """The scene's contact screen (None: no scene, nothing to touch)."""
+        if self.scene is not None:
+            grippers = [g.slot for g in addresses.grippers]
+            self.contacts = TwinContacts(self.model, joints, grippers)
         self.posed: FloatArray | None = None
         """The joint angles of the last :meth:`pose` (None: never posed)."""
         self._tree: FrameTree | None = None
-        mujoco.mj_kinematics(self.model, self.data)
 
     @property
     def sensors(self) -> SensorSuite | None:
@@ -108,7 +111,7 @@ class KinematicTwin:
         """Where the joint path through ``rows`` (one row of manifest joint values per
         point, from the posed joints) first touches the scene's fixed geometry, as one
         line naming the pair; None: nowhere, or no scene, or not posed yet."""
-        if self.scene is None or self.posed is None:
+        if self.contacts is None or self.posed is None:
             return None
         return self.contacts.first(self.data, self.posed, rows, self.set_joints)
 

@@ -16,6 +16,7 @@ Free objects (a cube) are neither fixed nor checked: pushing one is a task, not 
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Callable, Sequence
 from itertools import pairwise
 
@@ -44,11 +45,12 @@ class TwinContacts:
         manifest slots that are grippers (held at their measured value)."""
         self.model = model
         self._scratch = mujoco.MjData(model)
+        self._lock = threading.Lock()
+        """One check at a time on the scratch data (an action's and a goal's may overlap)."""
         self._grippers = np.array(grippers, dtype=np.intp)
         moved = {int(model.jnt_bodyid[j]) for j in joints}
         bodies = [b for b in range(model.nbody) if _under(model, b, moved)]
-        self._moving = np.zeros(model.ngeom, dtype=bool)
-        self._moving[[g for g in range(model.ngeom) if int(model.geom_bodyid[g]) in bodies]] = True
+        self._moving = np.isin(model.geom_bodyid, bodies)
         self._fixed = model.body_weldid[model.geom_bodyid] == 0
 
     def first(
@@ -56,6 +58,12 @@ class TwinContacts:
     ) -> str | None:
         """The first new arm-against-fixed contact along ``start`` → ``rows`` (one line),
         else None. ``live`` gives everything else's positions (objects stay put)."""
+        with self._lock:
+            return self._first(live, start, rows, pose)
+
+    def _first(
+        self, live: mujoco.MjData, start: FloatArray, rows: FloatArray, pose: Pose
+    ) -> str | None:
         data = self._scratch
         data.qpos[:] = live.qpos
         start = np.asarray(start, dtype=np.float64)
