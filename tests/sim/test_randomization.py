@@ -164,3 +164,18 @@ def test_lights_cameras_and_joint_noise_follow_the_seed(tmp_path: Path) -> None:
     again.reset(seed=4)
     assert np.array_equal(again.data.qpos, jittered.data.qpos)
     assert np.array_equal(again.model.cam_quat, model.cam_quat)
+
+
+def test_a_zero_width_range_written_with_a_negative_zero_is_drawn(tmp_path: Path) -> None:
+    """0.0 to -0.0 is a range the scene rules accept (low is not above high); drawing from
+    it gives that value (the fuzzer found ``rng.uniform`` refusing it at reset)."""
+    text = FRANKA.read_text().replace(
+        "position_max_m: [0.05, 0.05, 0.0]", "position_max_m: [0.05, 0.05, -0.0]"
+    )
+    assert "-0.0]" in text
+    (tmp_path / "tabletop.yaml").write_text(text)
+    env = scene(tmp_path / "tabletop.yaml")
+    env.reset(seed=4)
+    base = scene()
+    base.reset(seed=4)
+    np.testing.assert_array_equal(cube(env)[0], cube(base)[0])  # the same draws

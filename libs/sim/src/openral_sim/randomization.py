@@ -68,7 +68,7 @@ class Randomizer:
         self._cameras_jitter(rng)
         if self.ranges.joint_noise:
             noise = self.ranges.joint_noise
-            data.qpos[arm_qpos] += rng.uniform(-noise, noise, len(arm_qpos))
+            data.qpos[arm_qpos] += _between(rng, -noise, noise, len(arm_qpos))
 
     def _object(
         self,
@@ -84,8 +84,8 @@ class Randomizer:
         body = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"scene_{name}")
         offset = np.zeros(AXES)
         if low is not None and high is not None:
-            offset = rng.uniform(np.asarray(low), np.asarray(high))
-        yaw = math.radians(rng.uniform(yaw_deg[0], yaw_deg[1])) if yaw_deg is not None else 0.0
+            offset = _between(rng, np.asarray(low), np.asarray(high), AXES)
+        yaw = math.radians(_one(rng, yaw_deg[0], yaw_deg[1])) if yaw_deg is not None else 0.0
         joint = int(model.body_jntadr[body])
         if joint >= 0 and model.jnt_type[joint] == mujoco.mjtJoint.mjJNT_FREE:
             adr = int(model.jnt_qposadr[joint])
@@ -100,7 +100,7 @@ class Randomizer:
         assert ranges is not None
         if ranges.light_intensity_scale is not None:
             low, high = ranges.light_intensity_scale
-            self.model.light_diffuse[:] = self._light_diffuse * rng.uniform(low, high)
+            self.model.light_diffuse[:] = self._light_diffuse * _one(rng, low, high)
         if ranges.light_direction_deg:
             tilt = ranges.light_direction_deg
             for light in range(self.model.nlight):
@@ -112,11 +112,12 @@ class Randomizer:
         for camera in self._cameras:
             if ranges.camera_position_m:
                 step = ranges.camera_position_m
-                self.model.cam_pos[camera] = self._cam_pos[camera] + rng.uniform(-step, step, AXES)
+                offset = _between(rng, -step, step, AXES)
+                self.model.cam_pos[camera] = self._cam_pos[camera] + offset
             if ranges.camera_angle_deg:
                 turn = np.empty(4)
                 axis = rng.normal(size=AXES)
-                angle = math.radians(rng.uniform(-ranges.camera_angle_deg, ranges.camera_angle_deg))
+                angle = math.radians(_one(rng, -ranges.camera_angle_deg, ranges.camera_angle_deg))
                 mujoco.mju_axisAngle2Quat(turn, axis / np.linalg.norm(axis), angle)
                 turned = np.empty(4)
                 mujoco.mju_mulQuat(turned, turn, self._cam_quat[camera])
@@ -131,7 +132,20 @@ def _tilted(direction: FloatArray, max_deg: float, rng: np.random.Generator) -> 
     if norm < 1e-9:
         return direction.copy()
     turn = np.empty(4)
-    mujoco.mju_axisAngle2Quat(turn, axis / norm, math.radians(rng.uniform(0.0, max_deg)))
+    mujoco.mju_axisAngle2Quat(turn, axis / norm, math.radians(_one(rng, 0.0, max_deg)))
     turned = np.empty(3)
     mujoco.mju_rotVecQuat(turned, direction, turn)
     return turned
+
+
+def _between(
+    rng: np.random.Generator, low: float | FloatArray, high: float | FloatArray, size: int
+) -> FloatArray:
+    """``size`` uniform draws between ``low`` and ``high`` (the very draws of
+    ``rng.uniform``, which refuses a range the scene rules accept: 0.0 to -0.0)."""
+    return np.asarray(low + (np.asarray(high) - low) * rng.random(size), dtype=np.float64)
+
+
+def _one(rng: np.random.Generator, low: float, high: float) -> float:
+    """One uniform draw between ``low`` and ``high`` (see :func:`_between`)."""
+    return float(low + (high - low) * rng.random())
