@@ -27,13 +27,22 @@ from typing import TYPE_CHECKING, Any
 from openral_core import loaded_robot, open_robot_by_id
 from openral_core.loader import load_robot, load_scene
 
-from tests.fuzz.outcome import HANG_SECONDS, Outcome, Result, classify, classify_lines
+from tests.fuzz.outcome import (
+    HANG_SECONDS,
+    Outcome,
+    Result,
+    classify,
+    classify_lines,
+    unlocated_lines,
+)
 from tests.fuzz.seeds import Kind
 
 if TYPE_CHECKING:
     from openral_hal.protocol import RobotHal
 
 StageHook = Callable[[str], None]
+WARNING = "! "
+"""How ``robot check`` marks a warning (a deprecated form, say): said, not a refusal."""
 _SUMMARY = re.compile(
     r"^\d+ of \d+ robot\(s\) "
     r"(do not match their model(; \d+ could not be checked)?|could not be checked)$"
@@ -165,8 +174,15 @@ def robot_check(file: Path) -> None:
     if result.exit_code == 0:
         return
     printed = _ANSI.sub("", result.stderr).splitlines()
-    lines = [line.removeprefix("✗ ") for line in printed if not _SUMMARY.match(line)]
+    warned = [line.removeprefix(WARNING) for line in printed if line.startswith(WARNING)]
+    lines = [
+        line.removeprefix("✗ ")
+        for line in printed
+        if not _SUMMARY.match(line) and not line.startswith(WARNING)
+    ]
     if result.exit_code == 1 and not lines:
+        if unlocated_lines("\n".join(warned), file) and warned:
+            raise CheckRefused(warned)  # a warning must point into the file too
         return  # mismatches only: the HAL stage must refuse them at the manifest's fields
     raise CheckRefused(lines or [f"exit code {result.exit_code} and nothing printed"])
 
