@@ -11,22 +11,18 @@ from pathlib import Path
 import pytest
 from control_msgs.action import FollowJointTrajectory
 from sensor_msgs.msg import JointState
+from std_srvs.srv import Trigger
 
 from tests.conftest import ROBOTS
 from tests.real.deploy_helpers import openral, remote_graph, stop
-from tests.ros.action_client import PANDA_ARM, _AtomicActionClient, goal, succeeded
+from tests.real.stand_in import RELEASE, ROBOT_STATES, release_and_move, steady
+from tests.ros.action_client import _AtomicActionClient
 from tests.ros.lifecycle_client import deploy_output, deploy_sim
 
 pytestmark = pytest.mark.exclusive  # two live graphs and a 100 Hz stream that must not lag
 
 SCENE = ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml"
-ROBOT_STATES = "/robot/joint_states"
 ACTION = "/real/joint_trajectory_controller/follow_joint_trajectory"
-
-
-def _arm(message: JointState) -> list[float]:
-    positions = dict(zip(message.name, message.position, strict=True))
-    return [positions[name] for name in PANDA_ARM]
 
 
 def test_deploy_real_drives_the_robot_through_its_ros2_control_driver(tmp_path: Path) -> None:
@@ -42,16 +38,21 @@ def test_deploy_real_drives_the_robot_through_its_ros2_control_driver(tmp_path: 
         try:
             client = _AtomicActionClient(remote.probe.node, FollowJointTrajectory, ACTION)
             assert client.wait_for_server(timeout_sec=60.0), stop(real)
-            start = _arm(remote.probe.latest(ROBOT_STATES))
-            target = [start[0] + 0.3, *start[1:]]
-            succeeded(client, goal(PANDA_ARM, [(2.0, target)]))
-            time.sleep(0.5)
-            reached = _arm(remote.probe.latest(ROBOT_STATES))
-            assert max(abs(a - b) for a, b in zip(reached, target, strict=True)) < 0.02
+            steady(remote)  # deploy real joining may have paused the robot's stream once
+            release = remote.probe.node.create_client(Trigger, RELEASE)
+            release_and_move(remote, release, client, 0.3)
+            killed_at = time.time()
             robot.kill()
             robot.wait(10)
             time.sleep(1.0)
         finally:
             _, err = stop(real)
     fault = [line for line in err.splitlines() if "E-stop latched" in line]
-    assert len(fault) == 1 and "joint_states stopped" in fault[0], (fault, deploy_output(tmp_path))
+    assert all("joint_states stopped" in line for line in fault), (fault, deploy_output(tmp_path))
+    after_kill = [line for line in fault if _logged_at(line) >= killed_at]
+    assert len(after_kill) == 1, (fault, deploy_output(tmp_path))  # one line for the kill
+
+
+def _logged_at(line: str) -> float:
+    """The wall-clock time [s] of a ROS log line (``[LEVEL] [sec.nsec] [node]: ...``)."""
+    return float(line.split("] [", 2)[1])

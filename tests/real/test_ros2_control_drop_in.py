@@ -35,9 +35,10 @@ from trajectory_msgs.msg import JointTrajectory
 
 from tests.conftest import ROBOTS
 from tests.real.deploy_helpers import Remote, openral, remote_graph, stop
-from tests.ros.action_client import PANDA_ARM, _AtomicActionClient, ended, goal
+from tests.real.stand_in import arm_joints, release_and_move, steady
+from tests.ros.action_client import PANDA_ARM, _AtomicActionClient
 from tests.ros.lifecycle_client import deploy_sim
-from tests.ros.ros_helpers import Received, call_trigger, wait_until
+from tests.ros.ros_helpers import Received, wait_until
 
 pytestmark = pytest.mark.exclusive  # two live graphs and a 100 Hz stream that must not lag
 
@@ -50,8 +51,6 @@ PERIOD_S = 4.0
 SETTLED_S = 3.0
 """The comparison starts this long after the first action [s] (deploy real's start-up,
 whose discovery can stop the robot's stream for 0.3 s, is over by then)."""
-RELEASES = 3
-"""Releases the restart test may take (see ``_release_and_move``)."""
 
 
 def _deploy_real(remote: Remote) -> subprocess.Popen[str]:
@@ -83,13 +82,8 @@ def _path(actions: list[Received], states: list[Received]) -> tuple[np.ndarray, 
     """(times [s] from the first action, arm joint positions) of the joint states from the
     first action to the last."""
     start, end = actions[0].at, actions[-1].at
-    rows = [(s.at - start, _arm(s.msg)) for s in states if start <= s.at <= end]
+    rows = [(s.at - start, arm_joints(s.msg)) for s in states if start <= s.at <= end]
     return np.array([t for t, _ in rows]), np.array([q for _, q in rows])
-
-
-def _arm(message: JointState) -> list[float]:
-    positions = dict(zip(message.name, message.position, strict=True))
-    return [positions[name] for name in PANDA_ARM]
 
 
 def _gap(direct: tuple[np.ndarray, np.ndarray], through: tuple[np.ndarray, np.ndarray]) -> float:
@@ -249,40 +243,6 @@ def _risen(remote: Remote, runner: subprocess.Popen[str], start: Any) -> None:
     assert abs(after.x - start.x) < 0.02 and abs(after.y - start.y) < 0.02, (start, after)
 
 
-def _steady(remote: Remote, seconds: float = 2.0) -> None:
-    """Wait until the robot's joint states have come every period for ``seconds``."""
-
-    def steady() -> bool:
-        times = [
-            r.at for r in remote.probe.since("/robot/joint_states", time.monotonic() - seconds)
-        ]
-        return len(times) > seconds * 80 and max(np.diff(times)) < 0.015
-
-    wait_until(steady, 60.0, "a steady stream from the restarted robot")
-
-
-def _release_and_move(remote: Remote, release: Any, follow: Any) -> int:
-    """Release deploy real's E-stop and send it a goal: the robot's joint 1 turns 0.2 rad.
-    Returns the releases it took: the stand-in robot (a Python simulator on two shared
-    cores) misses its 20 ms deadline now and then, and deploy real latches, as it must; it
-    is released again once its stream is steady, at most :data:`RELEASES` times."""
-    from action_msgs.msg import GoalStatus
-
-    for attempt in range(1, RELEASES + 1):
-        assert call_trigger(release, "/real/openral/release_estop").success
-        start = _arm(remote.probe.latest("/robot/joint_states"))
-        target = [start[0] + 0.2, *start[1:]]
-        status, result = ended(follow, goal(PANDA_ARM, [(2.0, target)]))
-        if status == GoalStatus.STATUS_SUCCEEDED:
-            time.sleep(0.5)
-            reached = _arm(remote.probe.latest("/robot/joint_states"))
-            assert abs(reached[0] - target[0]) < 0.02, (reached, target)
-            return attempt
-        assert "E-stop is latched" in result.error_string, result
-        _steady(remote)
-    raise AssertionError(f"the goal stopped at the E-stop after each of {RELEASES} releases")
-
-
 def test_joint_states_gripper_and_an_ee_policy_through_deploy_real_then_a_restart(
     tmp_path: Path,
 ) -> None:
@@ -318,9 +278,9 @@ def test_joint_states_gripper_and_an_ee_policy_through_deploy_real_then_a_restar
             assert not remote.probe.since(ROBOT_TRAJECTORY, quiet)  # nothing sent after it
             with deploy_sim(SCENE, remote.domain, second, ("--namespace", "robot"), robot=True):
                 remote.probe.wait_count("/robot/joint_states", 1, quiet, timeout_s=90.0)
-                _steady(remote)  # its discovery may pause the stream once: release after it
+                steady(remote)  # its discovery may pause the stream once: release after it
                 assert not remote.probe.since(ROBOT_TRAJECTORY, quiet)  # a robot back: no motion
-                releases = _release_and_move(remote, release, follow)
+                releases = release_and_move(remote, release, follow, 0.2)
                 _, err = stop(real)  # before this robot goes too
         finally:
             if real.returncode is None:  # a failure above: stop it all the same

@@ -16,7 +16,8 @@ from std_msgs.msg import String
 from std_srvs.srv import Trigger
 
 from tests.conftest import ROBOTS
-from tests.real.deploy_helpers import Remote, openral, remote_graph, stop
+from tests.real.deploy_helpers import openral, remote_graph, stop
+from tests.real.stand_in import RELEASE, ROBOT_STATES, arm_joints
 from tests.ros.action_client import PANDA_ARM, _AtomicActionClient, goal
 from tests.ros.lifecycle_client import deploy_sim
 from tests.ros.ros_helpers import call_trigger, wait_until
@@ -26,17 +27,10 @@ pytestmark = pytest.mark.exclusive  # two live graphs on a real-time link
 SCENE = ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml"
 FOLLOW = "/real/joint_trajectory_controller/follow_joint_trajectory"
 REFUSED = "/real/openral/joint_trajectory/refused"
-RELEASE = "/real/openral/release_estop"
 TWIN_CAMERA = "/real/openral/cameras/agentview/image"
 ROBOT_CAMERA = "/robot/openral/cameras/agentview/image"
 SAME_PICTURE = 3.0
 """Largest mean difference [of 255] between the twin's frame and the robot's own."""
-
-
-def _arm(remote: Remote) -> np.ndarray:
-    message = remote.probe.latest("/robot/joint_states")
-    positions = dict(zip(message.name, message.position, strict=True))
-    return np.array([positions[name] for name in PANDA_ARM])
 
 
 def _pixels(message: Image) -> np.ndarray:
@@ -49,7 +43,7 @@ def test_a_goal_into_the_table_is_refused_and_the_twin_shows_the_measured_pose(
     tmp_path: Path,
 ) -> None:
     topics = {
-        "/robot/joint_states": JointState,
+        ROBOT_STATES: JointState,
         REFUSED: String,
         TWIN_CAMERA: Image,
         ROBOT_CAMERA: Image,
@@ -57,7 +51,7 @@ def test_a_goal_into_the_table_is_refused_and_the_twin_shows_the_measured_pose(
     with remote_graph(topics) as remote:
         follow = _AtomicActionClient(remote.probe.node, FollowJointTrajectory, FOLLOW)
         with deploy_sim(SCENE, remote.domain, tmp_path, ("--namespace", "robot"), robot=True):
-            remote.probe.wait_count("/robot/joint_states", 1, timeout_s=90.0)
+            remote.probe.wait_count(ROBOT_STATES, 1, timeout_s=90.0)
             real = openral(
                 "deploy", "real", "--robot", "franka_panda", "--transport",
                 "ros2_control:robot", "--twin", str(SCENE), "--namespace", "real",
@@ -68,7 +62,7 @@ def test_a_goal_into_the_table_is_refused_and_the_twin_shows_the_measured_pose(
                 time.sleep(2.0)  # every camera's renderer made (each holds Python's lock)
                 release = remote.probe.node.create_client(Trigger, RELEASE)
                 call_trigger(release, RELEASE)  # a latch while they were made: released
-                before = _arm(remote)
+                before = np.array(arm_joints(remote.probe.latest(ROBOT_STATES)))
                 into_table = before.copy()
                 into_table[1], into_table[3] = 1.5, -1.0  # the hand reaches down, far
                 sent = follow.send_goal_async(goal(PANDA_ARM, [(3.0, list(into_table))]))
@@ -78,7 +72,8 @@ def test_a_goal_into_the_table_is_refused_and_the_twin_shows_the_measured_pose(
                 line = remote.probe.latest(REFUSED).data
                 assert "scene_table" in line and "\n" not in line, line
                 time.sleep(2.0)
-                assert np.abs(_arm(remote) - before).max() < 0.005  # the robot never moved
+                after = np.array(arm_joints(remote.probe.latest(ROBOT_STATES)))
+                assert np.abs(after - before).max() < 0.005  # the robot never moved
                 asked = time.monotonic()  # the robot renders every 10 s: its next frame
                 remote.probe.wait_count(ROBOT_CAMERA, 1, asked, timeout_s=30.0)
                 robot_frame = _pixels(remote.probe.latest(ROBOT_CAMERA))
