@@ -15,8 +15,8 @@ import mujoco
 import numpy as np
 import numpy.typing as npt
 import pytest
-from openral_bridge.frame_renderer import RETRY_S, FrameRenderer
-from openral_sim.mujoco_capture import MujocoCapture
+from openral_bridge.frame_renderer import RETRY_S, FrameRenderer, renderers_opened
+from openral_sim.mujoco_capture import MujocoCapture, _Developer
 from openral_sim.native_scene import NativeScene
 from openral_sim.scene import build_sim_env_from_yaml
 
@@ -277,3 +277,37 @@ def test_without_observation_rendering_step_renders_nothing(franka: NativeScene)
     assert franka.image_size == (128, 128)
     with pytest.raises(KeyError, match="belly"):
         franka.render_cameras(franka.data, ("belly",))
+
+
+class SlowOpening(MujocoCapture[Image]):
+    """A capture whose renderer is made once ``gate`` opens (or fails to be, ``fail``)."""
+
+    def __init__(self, handles: tuple[mujoco.MjModel, mujoco.MjData], fail: bool) -> None:
+        super().__init__(*handles, ("a",), (16, 16), lambda r, d, s: np.zeros((1, 1, 3), np.uint8))
+        self.gate, self.fail = threading.Event(), fail
+
+    def open(self) -> _Developer[Image]:
+        assert self.gate.wait(WAIT_S)
+        if self.fail:
+            raise RuntimeError("no GL context")
+        return super().open()
+
+
+def test_renderers_opened_waits_until_every_started_renderer_is_made_or_failed(
+    tiny: tuple[mujoco.MjModel, mujoco.MjData],
+) -> None:
+    made, failing = SlowOpening(tiny, fail=False), SlowOpening(tiny, fail=True)
+    renderers = [FrameRenderer(made, Published()), FrameRenderer(failing, Published())]
+    for renderer in renderers:
+        renderer.start()
+    try:
+        assert not renderers_opened(0.1)
+        made.gate.set()
+        assert not renderers_opened(0.1)  # the other is still being made
+        failing.gate.set()
+        assert renderers_opened(WAIT_S)  # one that failed is no longer being made
+        assert renderers[0].running and isinstance(renderers[1].error, RuntimeError)
+    finally:
+        made.gate.set()
+        failing.gate.set()
+        assert all(renderer.stop() for renderer in renderers)

@@ -9,7 +9,7 @@ import subprocess
 import sys
 
 import pytest
-from openral_hal.realtime import BACKGROUND_NICE
+from openral_hal.realtime import BACKGROUND_NICE, IDLE_WORK_NICE
 
 SCRIPT = """
 import json, os, threading
@@ -60,3 +60,38 @@ def test_every_thread_runs_at_the_background_priority_inside_the_block_only() ->
     assert seen["started_inside"] == BACKGROUND_NICE  # inherited
     assert seen["main_after"] == 0
     assert seen["old_after"] == 0
+
+
+BEHIND = """
+import json, os, threading
+from openral_hal.realtime import ahead_of_other_programs, behind_ordinary_programs
+
+def nice():
+    return os.getpriority(os.PRIO_PROCESS, threading.get_native_id())
+
+def renderer(out):
+    out["moved"] = behind_ordinary_programs()
+    out["renderer"] = nice()
+    child = threading.Thread(target=lambda: out.update(gl_thread=nice()))  # llvmpipe's
+    child.start(); child.join()
+
+seen = {"inside": {}, "outside": {}}
+with ahead_of_other_programs():
+    t = threading.Thread(target=renderer, args=(seen["inside"],)); t.start(); t.join()
+    seen["timekeeper"] = nice()
+t = threading.Thread(target=renderer, args=(seen["outside"],)); t.start(); t.join()
+print(json.dumps(seen))
+"""
+
+
+def test_a_renderer_of_a_timekeeping_program_steps_behind_ordinary_programs() -> None:
+    if not _granted():
+        pytest.fail("this test needs CAP_SYS_NICE (root has it, as CI does)")
+    run = subprocess.run(
+        [sys.executable, "-c", BEHIND], capture_output=True, text=True, timeout=60, check=True
+    )
+    seen = json.loads(run.stdout)
+    inside, outside = seen["inside"], seen["outside"]
+    assert inside == {"moved": True, "renderer": IDLE_WORK_NICE, "gl_thread": IDLE_WORK_NICE}
+    assert seen["timekeeper"] == BACKGROUND_NICE  # the program's other threads keep their place
+    assert outside == {"moved": False, "renderer": 0, "gl_thread": 0}  # an ordinary program

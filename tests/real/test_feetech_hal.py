@@ -139,11 +139,12 @@ def test_an_estop_holds_within_a_period_and_release_resumes_slowly(rig: Rig) -> 
         time.sleep(0.3)
         latched = time.time()
         hal.estop()
-        assert wait_for(lambda: bool(rig.bus.written("Goal_Position", latched)), 0.5)
-        hold = rig.bus.written("Goal_Position", latched)
-        assert float(hold[0].split()[0]) - latched < hal.control_period_s  # one period
         time.sleep(0.2)
-        assert len(rig.bus.written("Goal_Position", latched)) == 1  # then nothing
+        writes = rig.bus.written("Goal_Position", latched)
+        assert 1 <= len(writes) <= 2  # the hold, after the one write already under way if any
+        assert float(writes[-1].split()[0]) - latched < hal.control_period_s  # one period
+        time.sleep(0.2)
+        assert rig.bus.written("Goal_Position", latched) == writes  # then nothing
         with pytest.raises(EStopLatched):
             hal.send_action(target)
         measured = hal.read_state().positions[0]

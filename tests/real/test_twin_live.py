@@ -13,14 +13,13 @@ import pytest
 from control_msgs.action import FollowJointTrajectory
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import String
-from std_srvs.srv import Trigger
 
 from tests.conftest import ROBOTS
 from tests.real.deploy_helpers import openral, remote_graph, stop
-from tests.real.stand_in import RELEASE, ROBOT_STATES, arm_joints
+from tests.real.stand_in import ROBOT_STATES, arm_joints
 from tests.ros.action_client import PANDA_ARM, _AtomicActionClient, goal
 from tests.ros.lifecycle_client import deploy_sim
-from tests.ros.ros_helpers import call_trigger, wait_until
+from tests.ros.ros_helpers import wait_until
 
 pytestmark = pytest.mark.exclusive  # two live graphs on a real-time link
 
@@ -59,9 +58,7 @@ def test_a_goal_into_the_table_is_refused_and_the_twin_shows_the_measured_pose(
             )  # fmt: skip
             try:
                 remote.probe.wait_count(TWIN_CAMERA, 1, timeout_s=90.0)
-                time.sleep(2.0)  # every camera's renderer made (each holds Python's lock)
-                release = remote.probe.node.create_client(Trigger, RELEASE)
-                call_trigger(release, RELEASE)  # a latch while they were made: released
+                time.sleep(2.0)  # the cameras' renderers were made before the loop started
                 before = np.array(arm_joints(remote.probe.latest(ROBOT_STATES)))
                 into_table = before.copy()
                 into_table[1], into_table[3] = 1.5, -1.0  # the hand reaches down, far
@@ -70,7 +67,7 @@ def test_a_goal_into_the_table_is_refused_and_the_twin_shows_the_measured_pose(
                 assert not sent.result().accepted
                 remote.probe.wait_count(REFUSED, 1, timeout_s=10.0)
                 line = remote.probe.latest(REFUSED).data
-                assert "scene_table" in line and "\n" not in line, line
+                assert "scene_table" in line and "\n" not in line, line  # not the E-stop's
                 time.sleep(2.0)
                 after = np.array(arm_joints(remote.probe.latest(ROBOT_STATES)))
                 assert np.abs(after - before).max() < 0.005  # the robot never moved
@@ -82,6 +79,7 @@ def test_a_goal_into_the_table_is_refused_and_the_twin_shows_the_measured_pose(
             finally:
                 _, err = stop(real)
     latches = [line for line in err.splitlines() if "E-stop latched" in line]
+    print(f"E-stop latches while it ran: {len(latches)}")
     assert all("joint_states stopped" in line for line in latches), err  # only the stream rule
     assert robot_frame.shape == twin_frame.shape
     difference = np.abs(robot_frame.astype(int) - twin_frame.astype(int)).mean()

@@ -54,6 +54,7 @@ from typing import Any
 import numpy as np
 from openral_bridge import ros_messages
 from openral_bridge.control_loop import ControlLoop
+from openral_bridge.frame_renderer import renderers_opened
 from openral_bridge.joint_state_publisher import sim_stamp
 from openral_bridge.pacer import PacedJob, Pacer
 from openral_bridge.ros_messages import LATCHED
@@ -80,6 +81,8 @@ from openral_nodes.scene_bridges import SceneBridges
 
 NODE_NAME = "openral_manifest_node"
 WARN_EVERY_S = 2.0
+RENDERERS_OPEN_S = 30.0
+"""Longest wait for the cameras' renderers before a real driver's loop starts [s]."""
 """At most one warning per this many seconds for a stream of refused actions or
 lifecycle transitions [s]."""
 
@@ -209,6 +212,7 @@ class ManifestLifecycleNode(NamespacedEntities, LifecycleNode):
         pacer.start()
         self.heap.freeze()
         if hal.is_real and isinstance(hal, CycledHal):
+            renderers_opened(RENDERERS_OPEN_S)  # each stalls the process: before the loop
             hal.start_cycle()
         super().on_activate(state)
         return Result.SUCCESS

@@ -36,12 +36,13 @@ from collections.abc import Callable
 from contextlib import AbstractContextManager
 from typing import Generic, TypeVar
 
+from openral_hal.realtime import behind_ordinary_programs
 from openral_sim.observation import ImageArray
 from openral_sim.sensor_sources import FrameCapture, FrameDeveloper
 
 from openral_bridge.os_thread import name_os_thread
 
-__all__ = ["FrameRenderer", "ImageArray", "SnapshotGate"]
+__all__ = ["FrameRenderer", "ImageArray", "SnapshotGate", "renderers_opened"]
 
 FrameT = TypeVar("FrameT")
 """What one render makes: an RGB image, a depth frame with its cloud."""
@@ -57,6 +58,23 @@ RETRY_S = 0.01
 still in flight [s] (see :mod:`openral_bridge.pacer`: never past the next due time)."""
 STOP_TIMEOUT_S = 5.0
 """Longest wait for the render thread to finish its frame when stopping [s]."""
+
+_OPENING: set[int] = set()
+"""The render threads started whose renderer is still being made (by ``id``)."""
+_OPENED = threading.Condition()
+
+
+def renderers_opened(timeout_s: float) -> bool:
+    """Wait until every started render thread has made its renderer (or failed to).
+
+    Making one holds Python's lock for about 80 ms (MuJoCo 3.8, llvmpipe): a real driver's
+    loop starts after it, so that no loop is stalled past its deadline by one (issue 41).
+
+    Returns:
+        True when none is still being made; False after ``timeout_s`` [s].
+    """
+    with _OPENED:
+        return _OPENED.wait_for(lambda: not _OPENING, timeout_s)
 
 
 class _Slot:
@@ -126,7 +144,10 @@ class FrameRenderer(Generic[FrameT]):
         return {name: slot.skipped for name, slot in self._slots.items()}
 
     def start(self) -> None:
-        """Start the render thread (it creates its renderer first)."""
+        """Start the render thread (it creates its renderer first: see
+        :func:`renderers_opened`)."""
+        with _OPENED:
+            _OPENING.add(id(self))
         self._thread.start()
 
     def request(self, sensor: str, *, wait_s: float = 0.0) -> bool:
@@ -205,11 +226,16 @@ class FrameRenderer(Generic[FrameT]):
 
     def _run(self) -> None:
         name_os_thread(self._thread.name)
+        behind_ordinary_programs()  # before the renderer: its GL threads inherit the place
         try:
             developer = self._capture.open()
         except Exception as error:  # no GL context: the sensors stop, the robot does not
             self.error = error
             return
+        finally:
+            with _OPENED:
+                _OPENING.discard(id(self))
+                _OPENED.notify_all()
         try:
             while (slot := self._jobs.get()) is not None and not self._stopping:
                 self._frame(developer, slot)

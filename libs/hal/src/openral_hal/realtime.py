@@ -18,7 +18,9 @@ robot's time (``deploy real``, the bus emulator) therefore runs inside
 :func:`ahead_of_other_programs`: all its threads, and those they start, at nice
 :data:`BACKGROUND_NICE`, ahead of every ordinary program and behind its own real-time
 threads. Ten ``openral`` starts next to it then latched nothing. It is the program's
-choice, not a library's: a HAL never changes its process's scheduling.
+choice, not a library's: a HAL never changes its process's scheduling. A thread of such a
+program that keeps no time and may keep both cores busy (a camera's renderer) steps back
+behind ordinary programs (:func:`behind_ordinary_programs`).
 """
 
 from __future__ import annotations
@@ -35,6 +37,25 @@ BACKGROUND_NICE = -20
 """Nice value of every thread of a program that keeps a robot's time (the highest share of
 the cores an ordinary thread can have; real-time round-robin at one priority would let
 its threads keep a core from each other for a whole 100 ms time slice)."""
+IDLE_WORK_NICE = 10
+"""Nice value of a thread of such a program that keeps no time (see
+:func:`behind_ordinary_programs`)."""
+
+
+def behind_ordinary_programs() -> bool:
+    """Move the calling thread behind ordinary programs (nice :data:`IDLE_WORK_NICE`) when
+    it inherited a place ahead of them (:func:`ahead_of_other_programs`); else leave it.
+
+    For a thread that keeps no robot's time but may keep the cores busy: a camera's renderer
+    in ``deploy real --twin`` (llvmpipe's threads, made by it, inherit its nice value), which
+    at nice -20 kept a robot driver on the same machine from its deadline (measured: 2 of
+    6 runs latched). Returns True when it moved."""
+    with contextlib.suppress(OSError):
+        tid = threading.get_native_id()
+        if os.getpriority(os.PRIO_PROCESS, tid) < 0:
+            os.setpriority(os.PRIO_PROCESS, tid, IDLE_WORK_NICE)
+            return True
+    return False
 
 
 def answer_first(priority: int = PRIORITY) -> bool:

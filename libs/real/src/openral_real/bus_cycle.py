@@ -14,7 +14,9 @@ over-temperature, voltage), the port failing (unplugged), and a reading older th
 control periods (the loop fell behind). A latch from a fault is noticed by the read that
 meets it, within two periods of the fault. The E-stop's effect (``estop``: ``hold`` writes
 the measured positions as goals, ``torque_off`` turns torque off) is applied by the next
-cycle, which :meth:`BusCycle.wake` starts at once.
+cycle, which :meth:`BusCycle.wake` starts at once. A write already past its check of the
+latch finishes before ``estop()`` returns (:meth:`BusCycle.settle_latch`): once it has
+returned, no goal but the effect reaches the bus.
 """
 
 from __future__ import annotations
@@ -92,6 +94,7 @@ class BusCycle:
         self.realtime = False
         """True when the loop's thread got real-time scheduling (see :func:`answer_first`)."""
         self._lock = threading.Lock()
+        self._write_gate = threading.Lock()
         self._readings: list[ServoReading] | None = None
         self._sample: JointStateSample | None = None
         self._last_ok = 0.0
@@ -143,6 +146,12 @@ class BusCycle:
     def running(self) -> bool:
         """True while the thread cycles."""
         return self._thread is not None and self._thread.is_alive()
+
+    def settle_latch(self) -> None:
+        """Return once no write that began before the latch is still under way: a caller
+        that latched and then calls this knows the next goal on the bus is the effect."""
+        with self._write_gate:
+            pass
 
     def wake(self) -> None:
         """Run the next cycle now (an E-stop's effect waits for no period)."""
@@ -214,6 +223,10 @@ class BusCycle:
             self.last_hook_error = f"{type(error).__name__}: {error}"
 
     def _write(self, readings: list[ServoReading]) -> None:
+        with self._write_gate:  # the latch is read and the goals written as one step
+            self._write_unless_latched(readings)
+
+    def _write_unless_latched(self, readings: list[ServoReading]) -> None:
         if self.latch.estopped:
             if self.effect_pending:
                 self.effect_pending = False

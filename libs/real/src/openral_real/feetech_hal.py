@@ -241,6 +241,7 @@ class FeetechHal(ManifestArm):
         self.estop_at = self.estop_at or time.time()
         if self._session is not None:
             self._session.cycle.effect_pending = True
+            self._session.cycle.settle_latch()
             self._session.cycle.wake()
 
     def _on_release(self) -> None:

@@ -41,9 +41,9 @@ from openral_hal.errors import ConfigurationError, EStopLatched, NotConnected
 from openral_hal.factory import RealOptions
 from openral_hal.realtime import answer_first
 from openral_mujoco.action import validated_action
-from openral_mujoco.gripper import SlotMap, slot_map, units_mismatch
 from openral_mujoco.state import FloatArray, JointStateSample
 
+from openral_real.driver_gripper import gripper_map
 from openral_real.kinematic_twin import twin_for
 from openral_real.manifest_arm import ManifestArm
 from openral_real.ros2_control_link import JointReading, Ros2ControlLink, driver_namespace
@@ -91,16 +91,14 @@ class Ros2ControlHal(ManifestArm):
         self.estop_reason: str | None = None
         self.sent = 0
         """Trajectories sent to the driver."""
-        self._gripper = _gripper_map(robot, self.wiring)
+        self._gripper = gripper_map(robot, self.wiring)
         self.attach_twin(twin_for(robot, twin_scene))
         self._link: Ros2ControlLink | None = None
         self._envelope = self.manifest_envelope()
         self._speeds = np.array([float(j.velocity_limit) for j in robot.description.joints])
-        self._lock = threading.Lock()
+        self._lock, self._write_gate = threading.Lock(), threading.RLock()
         self._latest: JointStateSample | None = None
-        self._last_stamp_s = -1.0
-        self._received_s = 0.0
-        self._readings = 0
+        self._last_stamp_s, self._received_s, self._readings = -1.0, 0.0, 0
         self._running = False
         self._gripper_sent: float | None = None
         self._watchdog: threading.Thread | None = None
@@ -135,12 +133,18 @@ class Ros2ControlHal(ManifestArm):
         self.quicker_switches(True)
         self._estopped, self.estop_reason = False, None
         self._envelope.start(self._measured())
-        self._running = not self.defer_cycle
-        self._start_watchdog()
+        if not self.defer_cycle:
+            self.start_cycle()
 
     def start_cycle(self) -> None:
-        """Start writing after a :attr:`defer_cycle` connect (idempotent)."""
+        """Start writing, and latching on a stream that stops, judged from now: until then
+        (a :attr:`defer_cycle` connect) the graph's build may stall the process (idempotent)."""
+        if self._running or self._link is None:
+            return
+        with self._lock:
+            self._received_s = max(self._received_s, time.monotonic())
         self._running = True
+        self._start_watchdog()
 
     def disconnect(self) -> None:
         """Hold the measured pose, then close the link (idempotent)."""
@@ -213,9 +217,10 @@ class Ros2ControlHal(ManifestArm):
         """Hold at the measured pose, cancel the gripper's goal; nothing more is sent."""
         self.estop_reason = self.estop_reason or "requested"
         link = self._link
-        if link is not None and self._latest is not None:
-            self._send_hold(link)
-            link.cancel_gripper()
+        with self._write_gate:  # a goal already under way goes out before the hold
+            if link is not None and self._latest is not None:
+                self._send_hold(link)
+                link.cancel_gripper()
 
     def _on_release(self) -> None:
         """Start again from the measured pose, slowly (a stale stream stays latched)."""
@@ -281,8 +286,9 @@ class Ros2ControlHal(ManifestArm):
     def write_cycle(self) -> None:
         """Send this cycle's goal (nothing while the E-stop is latched or unconnected)."""
         link = self._link
-        if link is not None and self._running and not self._estopped:
-            self._write(link)
+        with self._write_gate:  # the latch is read and the goal sent as one step
+            if link is not None and self._running and not self._estopped:
+                self._write(link)
 
     def _write(self, link: Ros2ControlLink) -> None:
         """Send the next goal, reached no sooner than the velocity limits allow from the
@@ -376,25 +382,3 @@ class Ros2ControlHal(ManifestArm):
         """When the newest reading arrived [s, ``time.monotonic()``]."""
         with self._lock:
             return self._received_s
-
-
-def _gripper_map(robot: LoadedRobot, wiring: Ros2ControlWiring) -> tuple[int, SlotMap] | None:
-    """The first gripper's slot and its map to the driver's joint units (None: no gripper).
-
-    Raises:
-        ConfigurationError: A gripper action for a gripper whose commands do not share its
-            readings' units (no one map converts both).
-    """
-    hal = robot.tables.hal_wiring
-    if hal is None or not hal.grippers:
-        return None
-    gripper = hal.grippers[0]
-    names = [joint.name for joint in robot.description.joints]
-    if gripper.joint not in names:
-        return None
-    mismatch = units_mismatch(gripper.read_mode, gripper.write_mode)
-    if mismatch is not None and wiring.gripper_action is not None:
-        raise ConfigurationError(f"{robot.name}: no gripper_action for {gripper.joint}: {mismatch}")
-    fingers = len(gripper.qpos_addrs)
-    axis = slot_map(gripper.read_mode, fingers, gripper.ctrl_range, gripper.qpos_scale)
-    return names.index(gripper.joint), axis
