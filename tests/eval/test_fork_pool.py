@@ -70,8 +70,8 @@ def _hostile(spec: EpisodeSpec) -> EpisodeResult:
     return EpisodeResult.unfinished(spec, "")  # a stand-in for a finished episode
 
 
-def _gave_up(why: str) -> Callable[[EpisodeSpec], EpisodeResult]:
-    return lambda spec: EpisodeResult.unfinished(spec, why)
+def _gave_up(why: str) -> Callable[[EpisodeSpec, int, float], EpisodeResult]:
+    return lambda spec, steps, wall_s: EpisodeResult.unfinished(spec, why, steps, wall_s)
 
 
 @pytest.mark.parametrize("workers", [1, 2])
@@ -89,6 +89,8 @@ def test_a_hung_an_exiting_and_a_crashing_policy_each_cost_only_their_episode(
     by_seed = {result.seed: result.error for result in results}
     assert len(results) == 5
     assert by_seed == {0: "", 1: "timeout", 2: "died", 3: "died", 4: ""}, by_seed
+    hung = next(result for result in results if result.seed == 1)
+    assert TIMEOUT_S <= hung.wall_time_s < TIMEOUT_S + 10.0  # how long it ran is kept
     assert time.monotonic() - started < TIMEOUT_S + 20.0  # the hung one is not waited twice
 
 
@@ -97,11 +99,11 @@ def test_a_time_limit_must_be_positive() -> None:
         ForkPool(_hostile, 1, retries=0, timeout_s=0.0)
 
 
-def _dies_at_start(run: object, pipe: object, inherited: object) -> None:
+def _dies_at_start(run: object, pipe: object, inherited: object, steps: object) -> None:
     os._exit(7)
 
 
-def _silent_at_start(run: object, pipe: object, inherited: object) -> None:
+def _silent_at_start(run: object, pipe: object, inherited: object, steps: object) -> None:
     time.sleep(30)
 
 

@@ -3,7 +3,8 @@ namespace /robot) and deploy real's own graph under /real, one domain: what a us
 franka_ros2 would run, in simulation (not on hardware).
 
 - ``rskill run --policy wave`` through deploy real moves the robot's joints as the same
-  policy moves deploy sim directly, within 0.02 rad;
+  policy moves deploy sim directly, within 0.02 rad (a run in which the stand-in robot
+  paused and deploy real latched, as it must, is run once more);
 - deploy real's ``/joint_states`` are the robot's (the gripper in metres, its mimic finger
   too); a GripperCommand to deploy real moves the robot's fingers; an ``ee_delta_pose``
   policy through deploy real lifts the robot's TCP;
@@ -61,11 +62,22 @@ def _deploy_real(remote: Remote) -> subprocess.Popen[str]:
 
 
 def _runner(remote: Remote, namespace: str, *args: str) -> subprocess.Popen[str]:
-    """``rskill run`` started now; it waits up to a minute for the graph it acts on."""
-    return openral(
+    """``rskill run`` started now, returned once its node has joined the domain (its
+    imports take seconds; a participant that joins later stalls the others' streams); it
+    waits up to a minute for the graph it acts on."""
+    runner = openral(
         "rskill", "run", "--robot", "franka_panda", "--domain-id", str(remote.domain),
         "--namespace", namespace, "--frame-timeout", "60", *args,
     )  # fmt: skip
+    where = "/" + namespace if namespace else "/"
+    node = remote.probe.node
+
+    def joined() -> bool:
+        return ("rskill_runner", where) in node.get_node_names_and_namespaces()
+
+    wait_until(lambda: joined() or runner.poll() is not None, 90.0, "the runner's node")
+    time.sleep(1.0)  # its discovery settles before the next participant starts
+    return runner
 
 
 def _finished(runner: subprocess.Popen[str]) -> None:
@@ -118,6 +130,12 @@ def _longest_gaps(remote: Remote) -> list[tuple[float, float]]:
     return [(float(times[i + 1]), float(gaps[i] * 1000)) for i in worst]
 
 
+class _StandInPaused(Exception):
+    """The stand-in robot (a Python simulator on two shared cores) missed its 20 ms
+    deadline and deploy real latched, as it must: the run is tried once more (measured:
+    about 1 run in 5 on this machine; a C++ ros2_control driver keeps its stream)."""
+
+
 def _recorded(topics: dict[str, object], run: Callable[[Remote], None], action: str, states: str):  # type: ignore[no-untyped-def]
     with remote_graph(topics) as remote:
         run(remote)
@@ -127,6 +145,8 @@ def _recorded(topics: dict[str, object], run: Callable[[Remote], None], action: 
 def test_a_wave_through_deploy_real_moves_the_robot_as_it_moves_deploy_sim_alone(
     tmp_path: Path,
 ) -> None:
+    tries: list[str] = []
+
     def through_deploy_real(remote: Remote) -> None:
         with deploy_sim(SCENE, remote.domain, tmp_path, ("--namespace", "robot"), robot=True):
             remote.probe.wait_count("/robot/joint_states", 1, timeout_s=90.0)
@@ -136,7 +156,13 @@ def test_a_wave_through_deploy_real_moves_the_robot_as_it_moves_deploy_sim_alone
                 _finished(runner)
             finally:
                 _, err = stop(real)
-            assert "E-stop latched" not in err, (err, _longest_gaps(remote))
+        latches = [line for line in err.splitlines() if "E-stop latched" in line]
+        tries.append(err)
+        assert all("joint_states stopped" in line for line in latches), err  # the stream rule
+        if latches and len(tries) == 1:  # the stand-in missed its deadline: once more
+            print("the stand-in robot's stream paused:", latches[0], _longest_gaps(remote))
+            raise _StandInPaused()
+        assert not latches, (err, _longest_gaps(remote))
 
     def direct(remote: Remote) -> None:
         with deploy_sim(SCENE, remote.domain, tmp_path):
@@ -148,9 +174,15 @@ def test_a_wave_through_deploy_real_moves_the_robot_as_it_moves_deploy_sim_alone
         "/real/joint_states": JointState,
         "/real/openral/safe_action": Float64MultiArray,
     }
-    through = _path(
-        *_recorded(topics, through_deploy_real, "/real/openral/safe_action", "/robot/joint_states")
-    )
+    try:
+        recorded = _recorded(
+            topics, through_deploy_real, "/real/openral/safe_action", "/robot/joint_states"
+        )
+    except _StandInPaused:
+        recorded = _recorded(
+            topics, through_deploy_real, "/real/openral/safe_action", "/robot/joint_states"
+        )
+    through = _path(*recorded)
     alone = _path(
         *_recorded(
             {"/joint_states": JointState, "/openral/safe_action": Float64MultiArray},

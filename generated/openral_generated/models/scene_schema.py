@@ -135,7 +135,7 @@ class SceneOptions(OpenralModel):
     """
     horizon: Annotated[StrictInt | None, Field(ge=1, le=100000000)] = None
     """
-    Steps after which an episode is truncated (robosuite); native scenes never end on their own.
+    Control steps after which an episode is truncated: gymnasium's `truncated` and the `max_episode_steps` of the scene's registered env id, and a sweep's step limit unless `--steps` sets one (left out: 300). `deploy sim` runs on past it (its world never resets by itself). robosuite: its own default of 1000 when left out.
     """
     controller: Annotated[
         StrictStr | None, Field(pattern="^[A-Za-z][A-Za-z0-9_]{0,62}$")
@@ -373,6 +373,131 @@ class GripperHolds(OpenralModel):
     """
 
 
+class ReachReward(OpenralModel):
+    """
+    The tool centre point (`sim.tcp`) near the object: 1 - tanh(scale_per_m x the distance from the TCP to the object's centre).
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    kind: Literal["reach"]
+    """
+    `reach`.
+    """
+    object: Annotated[StrictStr, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
+    """
+    An object of `scene.options.objects`, by its `name`.
+    """
+    weight: Annotated[StrictFloat, Field(gt=0.0, le=100.0)] = 1.0
+    """
+    The term's share of the dense reward (terms are summed with these weights, then divided by their sum).
+    """
+    scale_per_m: Annotated[StrictFloat, Field(gt=0.0, le=1000.0)] = 10.0
+    """
+    How fast the term falls off with distance [1/m]: the term is 1 - tanh(scale_per_m x distance) (robosuite's Lift uses 10).
+    """
+
+
+class GraspReward(OpenralModel):
+    """
+    The object held: 1 while every finger of the robot's gripper touches it (as `gripper_holds`), else 0.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    kind: Literal["grasp"]
+    """
+    `grasp`.
+    """
+    object: Annotated[StrictStr, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
+    """
+    An object of `scene.options.objects`, by its `name`.
+    """
+    weight: Annotated[StrictFloat, Field(gt=0.0, le=100.0)] = 1.0
+    """
+    The term's share of the dense reward (terms are summed with these weights, then divided by their sum).
+    """
+
+
+class LiftReward(OpenralModel):
+    """
+    The object raised while held: the fraction of the way from its height at reset to `z_m` (0 to 1), counted only while every finger touches it.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    kind: Literal["lift"]
+    """
+    `lift`.
+    """
+    object: Annotated[StrictStr, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
+    """
+    An object of `scene.options.objects`, by its `name`.
+    """
+    weight: Annotated[StrictFloat, Field(gt=0.0, le=100.0)] = 1.0
+    """
+    The term's share of the dense reward (terms are summed with these weights, then divided by their sum).
+    """
+    z_m: Annotated[StrictFloat, Field(ge=-100.0, le=100.0)]
+    """
+    The height in the world frame [m] at which the term is 1 (the height `object_above` asks for).
+    """
+
+
+class PlaceReward(OpenralModel):
+    """
+    The object brought into a box while held: 1 - tanh(scale_per_m x its centre's distance to the box) (1 inside), counted only while every finger touches it.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    kind: Literal["place"]
+    """
+    `place`.
+    """
+    object: Annotated[StrictStr, Field(pattern="^[a-z][a-z0-9_]{0,62}$")]
+    """
+    An object of `scene.options.objects`, by its `name`.
+    """
+    weight: Annotated[StrictFloat, Field(gt=0.0, le=100.0)] = 1.0
+    """
+    The term's share of the dense reward (terms are summed with these weights, then divided by their sum).
+    """
+    min_m: Annotated[list[MinMItem], Field(max_length=3, min_length=3)]
+    """
+    The box's lowest corner x, y, z [m], world frame.
+    """
+    max_m: Annotated[list[MaxMItem], Field(max_length=3, min_length=3)]
+    """
+    The box's highest corner x, y, z [m], world frame.
+    """
+    scale_per_m: Annotated[StrictFloat, Field(gt=0.0, le=1000.0)] = 10.0
+    """
+    How fast the term falls off with distance [1/m]: the term is 1 - tanh(scale_per_m x distance) (robosuite's Lift uses 10).
+    """
+
+
+class TaskReward(OpenralModel):
+    """
+    The scene's reward for training. Sparse: 1 at a control step where `success` holds, else 0 (nothing to declare). Dense: the weighted mean of `dense`'s terms, each between 0 and 1, and 1 at a step where `success` holds, so success is always worth the most (as robosuite's Lift and ManiSkill's PickCube stage reach, grasp and lift). A gymnasium env picks one with `reward_mode`.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+    )
+    dense: Annotated[
+        list[ReachReward | GraspReward | LiftReward | PlaceReward],
+        Field(max_length=16, min_length=1),
+    ]
+    """
+    The dense reward's terms, in the order a task meets them (reach, grasp, then lift or place).
+    """
+
+
 class SceneSpec(OpenralModel):
     """
     Scene identity, backend, assets, image size and cameras.
@@ -448,6 +573,7 @@ class DeployScene(OpenralModel):
     """
     What success means in this scene: every predicate holds (AND). An episode ends on success or at its step limit.
     """
+    reward: TaskReward | None = None
     task: Annotated[
         StrictStr | None,
         Field(examples=["lift the red cube"], max_length=300, min_length=1),

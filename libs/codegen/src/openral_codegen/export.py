@@ -38,6 +38,9 @@ regeneration would change a byte, add a file or remove one.
   `openral_core.tables`: HAL wiring kwargs, VLA camera slots, joint-name map, and the
   manifest they came from with its `manifest_sha256`. They are the runtime input of each
   robot: `openral_core.open_robot` reads them and refuses a stale one.
+- `openral_generated/tables/scenes.json` — every `robots/*/scenes/*.yaml`: its gymnasium id,
+  task, horizon, and whether it declares success and a dense reward
+  (`openral_core.scene_index`).
 """
 
 ExportFiles = dict[str, bytes]
@@ -71,6 +74,7 @@ def derived_files(root: Path) -> ExportFiles:
     from openral_core.errors import ManifestError
     from openral_core.loader import load_robot, load_scene
     from openral_core.registry import manifest_path, robot_ids
+    from openral_core.scene_index import SCENE_INDEX, index_text, scene_entry
     from openral_core.tables import robot_tables
 
     from openral_codegen.manifest_examples import collect_examples
@@ -109,6 +113,8 @@ def derived_files(root: Path) -> ExportFiles:
         )
     if problems:
         raise CodegenError("cannot export tables of invalid manifests:\n" + "\n".join(problems))
+    entries = [scene_entry(f, s) for source in sources for f, s in source.scenes.items()]
+    files[f"generated/{SCENE_INDEX}"] = index_text(entries).encode()
     schemas = read_schemas(root / "schema")
     examples = collect_examples(root, schemas)
     for page, text in render_reference(schemas, examples, rule_examples(root)).items():

@@ -1,8 +1,9 @@
 """Rules of a scene's ``randomization`` and ``success`` that the schema cannot state.
 
-Every object they name must be one of ``scene.options.objects`` (with the closest names
-when it is not), a range's low end must not exceed its high end, and a region's lowest
-corner must lie below its highest on every axis.
+Every object they name (and ``reward``'s terms name) must be one of
+``scene.options.objects`` (with the closest names when it is not), a range's low end must
+not exceed its high end, and a region's lowest corner must lie below its highest on every
+axis. A ``reward`` needs ``success``: the dense reward is 1 where success holds.
 """
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 
 from openral_core.errors import did_you_mean
-from openral_core.models import DeployScene, ObjectInRegion
+from openral_core.models import DeployScene, ObjectInRegion, PlaceReward
 from openral_core.yaml_source import PathKey
 
 Finding = tuple[PathKey, str]
@@ -20,7 +21,7 @@ def episode_findings(scene: DeployScene) -> list[Finding]:
     """Every violation of the module doc's rules in ``scene``."""
     options = scene.scene.options
     names = [o.name for o in options.objects] if options is not None and options.objects else []
-    return [*_randomization(scene, names), *_success(scene, names)]
+    return [*_randomization(scene, names), *_success(scene, names), *_reward(scene, names)]
 
 
 def _known(path: PathKey, name: str, names: list[str]) -> Iterator[Finding]:
@@ -61,5 +62,19 @@ def _success(scene: DeployScene, names: list[str]) -> Iterator[Finding]:
         yield from _known((*at, "object"), predicate.object, names)
         if isinstance(predicate, ObjectInRegion) and any(
             lo > hi for lo, hi in zip(predicate.min_m, predicate.max_m, strict=True)
+        ):
+            yield (*at, "max_m"), "each value must be at least min_m's"
+
+
+def _reward(scene: DeployScene, names: list[str]) -> Iterator[Finding]:
+    if scene.reward is None:
+        return
+    if not scene.success:
+        yield ("reward",), "a reward needs success: the dense reward is 1 where success holds"
+    for index, term in enumerate(scene.reward.dense):
+        at: PathKey = ("reward", "dense", index)
+        yield from _known((*at, "object"), term.object, names)
+        if isinstance(term, PlaceReward) and any(
+            lo > hi for lo, hi in zip(term.min_m, term.max_m, strict=True)
         ):
             yield (*at, "max_m"), "each value must be at least min_m's"

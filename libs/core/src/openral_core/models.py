@@ -35,17 +35,22 @@ from openral_generated.models.scene_schema import (
     Backend,
     BasePose,
     DeployScene,
+    GraspReward,
     GripperHolds,
+    LiftReward,
     NativeAssets,
     ObjectAbove,
     ObjectInRegion,
     ObjectRandomization,
     Observation,
+    PlaceReward,
     Randomization,
+    ReachReward,
     SceneObject,
     SceneOptions,
     SceneSpec,
     Shape,
+    TaskReward,
 )
 from openral_generated.models.sim_schema import (
     GripperReadMode,
@@ -67,6 +72,8 @@ SiteSensor = LidarSensor | ImuSensor | ForceTorqueSensor | PoseSensor
 """A sensor that sits at an MJCF site (one of the model's, or one the scene creates)."""
 SuccessPredicate = ObjectAbove | ObjectInRegion | GripperHolds
 """Any success predicate of a scene, discriminated by ``kind``."""
+RewardTerm = ReachReward | GraspReward | LiftReward | PlaceReward
+"""Any term of a scene's dense reward, discriminated by ``kind``."""
 SimControl = PositionControl | TorquePdControl
 """Any control law, discriminated by ``mode``."""
 
@@ -85,12 +92,14 @@ __all__ = [
     "FeetechSettings",
     "ForceTorqueSensor",
     "Frames",
+    "GraspReward",
     "GripperHolds",
     "GripperReadMode",
     "GripperWriteMode",
     "ImuSensor",
     "Joint",
     "LidarSensor",
+    "LiftReward",
     "LimitedJoint",
     "MobileBase",
     "NativeAssets",
@@ -98,10 +107,13 @@ __all__ = [
     "ObjectInRegion",
     "ObjectRandomization",
     "Observation",
+    "PlaceReward",
     "PoseSensor",
     "PositionControl",
     "Randomization",
+    "ReachReward",
     "RealDescription",
+    "RewardTerm",
     "RgbSensor",
     "RobotDescription",
     "Ros2ControlDriver",
@@ -116,6 +128,7 @@ __all__ = [
     "SiteSensor",
     "StateSensor",
     "SuccessPredicate",
+    "TaskReward",
     "ToolCentrePoint",
     "TorquePdControl",
     "TrajectoryRules",

@@ -4,7 +4,8 @@ robot (every mode ends in a joint action through the HAL: the manifest's limits,
 - ``joint_position``: one target per action slot (see :mod:`openral_sim.action_bounds`);
   sent as it is.
 - ``ee_delta_pose`` and ``ee_pose`` (:mod:`openral_sim.ee_modes`): the tool centre point's
-  motion or pose in the base frame and the gripper; the one IK
+  motion or pose in the base frame and the gripper (an ``ee_pose`` position is bounded by
+  the box the arm can reach, :meth:`~openral_sim.ee_modes.EeCommand.reach_box`); the one IK
   (:mod:`openral_sim.end_effector`) gives the arm's targets, and the set point glides to
   them over the period with its speed fed forward, as a trajectory's samples do.
 
@@ -69,14 +70,20 @@ class ActionContract:
         names = hal.action_names
         self._gripper = names.index(gripper) if gripper in names else None
         self._joint_bounds = action_bounds(hal.env, robot, hal.action_dim)
+        handles = hal.mujoco_handles()
+        self._reach = (
+            ee.reach_box(*handles)
+            if ee is not None and handles is not None
+            else (np.full(3, -np.inf), np.full(3, np.inf))
+        )
 
     def bounds(self) -> Bounds:
         """(low, high) of every action value."""
         if self.mode is ActionMode.EE_DELTA_POSE:
             low, high = np.full(7, -1.0), np.full(7, 1.0)
-        elif self.mode is ActionMode.EE_POSE:
-            low = np.array([-np.inf] * 3 + [-1.0] * 4 + [0.0])
-            high = np.array([np.inf] * 3 + [1.0] * 5)
+        elif self.mode is ActionMode.EE_POSE:  # the position within the arm's reach
+            low = np.concatenate([self._reach[0], [-1.0] * 4 + [0.0]])
+            high = np.concatenate([self._reach[1], [1.0] * 5])
         else:
             low, high = (bound.copy() for bound in self._joint_bounds)
         base = self.robot.tables.mobile_base

@@ -31,6 +31,7 @@ import traceback
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Protocol
 
 import mujoco
 import numpy as np
@@ -96,10 +97,22 @@ class EpisodeResult:
     those the policy and the video read)."""
 
     @classmethod
-    def unfinished(cls, spec: EpisodeSpec, why: str) -> EpisodeResult:
-        """The result of an episode that never finished (its worker died)."""
+    def unfinished(
+        cls, spec: EpisodeSpec, why: str, steps: int = 0, wall_time_s: float = 0.0
+    ) -> EpisodeResult:
+        """The result of an episode that never finished (its worker died or was stopped
+        after ``steps`` steps and ``wall_time_s`` [s])."""
         return cls(
-            spec.scene, spec.seed, spec.policy, dict(spec.params), False, 0, 0.0, 0.0, why, ""
+            spec.scene,
+            spec.seed,
+            spec.policy,
+            dict(spec.params),
+            False,
+            steps,
+            0.0,
+            round(wall_time_s, 4),
+            why,
+            "",
         )
 
 
@@ -129,6 +142,16 @@ def close_scenes() -> None:
         hal.disconnect()
 
 
+class StepCount(Protocol):
+    """Where a worker process tells its pool how far its episode got (a shared value)."""
+
+    value: int
+
+
+step_count: StepCount | None = None
+"""Set in a sweep's worker process: each step of its episode is counted here, so an
+episode that is stopped (it hung) or kills its process is recorded with its steps."""
+
 StepWatch = Callable[[Mapping[str, float] | None], None]
 """Called after the reset (None) and after each step (its action, by the env's slot
 names): a browser view's feed."""
@@ -141,7 +164,7 @@ def run_episode(spec: EpisodeSpec, watch: StepWatch | None = None) -> EpisodeRes
     digest = hashlib.sha256()
     run, error = _Run(), None
     try:
-        run = _drive(spec, digest, watch)
+        _drive(spec, digest, watch, run)
     except Exception as failure:  # the sweep goes on; the result says what happened
         frame = traceback.extract_tb(failure.__traceback__)[-1]
         error = f"{type(failure).__name__}: {failure} ({Path(frame.filename).name}:{frame.lineno})"
@@ -171,8 +194,9 @@ class _Run:
     frames: int = 0
 
 
-def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None) -> _Run:
-    """Steps, success, simulated time [s] and frames of one episode; may raise."""
+def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None, run: _Run) -> None:
+    """Count the steps, success, simulated time [s] and frames of one episode into ``run``
+    as it goes (an episode that raises keeps what it counted); may raise."""
     hal, robot = scene_for(spec.scene)
     policy = make_policy(spec.policy, dict(spec.params))
     inputs = _Inputs(hal, robot, policy)
@@ -185,7 +209,7 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None) ->
     env.reset(seed=spec.seed)
     if watch is not None:
         watch(None)
-    run, started = _Run(frames=len(hal.last_observation().images)), hal.read_state().sim_time_s
+    run.frames, started = len(hal.last_observation().images), hal.read_state().sim_time_s
     try:
         done = False
         while not done:
@@ -201,6 +225,8 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None) ->
             if watch is not None:
                 watch(dict(zip(env.action_names, action.tolist(), strict=True)))
             run.steps += 1
+            if step_count is not None:
+                step_count.value = run.steps
             run.frames += len(hal.last_observation().images)
             run.success = bool(info["success"])
             if keep is not None:
@@ -213,7 +239,6 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None) ->
         video.close()
     digest.update(hal.read_state().positions.tobytes())
     run.sim_time_s = float(hal.read_state().sim_time_s or 0.0) - float(started or 0.0)
-    return run
 
 
 def _kept(spec: EpisodeSpec, robot: LoadedRobot, rendered: tuple[str, ...]) -> EpisodeFrames | None:

@@ -38,7 +38,8 @@ from typing import Literal
 
 from openral_core.errors import OpenralError
 
-from openral_eval.episode import EpisodeResult, EpisodeSpec
+from openral_eval import episode
+from openral_eval.episode import EpisodeResult, EpisodeSpec, StepCount
 
 Run = Callable[[EpisodeSpec], EpisodeResult]
 StartMethod = Literal["fork", "forkserver"]
@@ -53,22 +54,27 @@ class WorkerStartError(OpenralError):
     """A worker process of the pool could not start."""
 
 
-GiveUp = Callable[[EpisodeSpec], EpisodeResult]
-"""The result recorded for an episode given up (its worker died too often, or hung)."""
+GiveUp = Callable[[EpisodeSpec, int, float], EpisodeResult]
+"""The result recorded for an episode given up (its worker died too often, or hung), from
+its spec, the steps it got through and its wall time [s] on its last try."""
 
 
 @dataclass
 class _Worker:
     process: BaseProcess
     pipe: Connection
+    steps: StepCount
+    """Steps of its episode so far (shared with the worker: :data:`episode.step_count`)."""
     spec: EpisodeSpec | None = None
     started: float = 0.0
     """When it was handed its episode (``time.monotonic``) [s]."""
 
 
-def _serve(run: Run, pipe: Connection, inherited: Sequence[Connection]) -> None:
-    """A worker's loop: receive a spec, send its result; stop at ``None`` or a closed pipe."""
+def _serve(run: Run, pipe: Connection, inherited: Sequence[Connection], steps: StepCount) -> None:
+    """A worker's loop: receive a spec, send its result; stop at ``None`` or a closed pipe.
+    Its episodes count their steps into ``steps``."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    episode.step_count = steps
     with suppress(AttributeError, OSError):  # Linux: die with the parent, not finish an
         ctypes.CDLL(None).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)  # episode nobody reads
     for other in inherited:  # the parent's ends, so that a parent's death closes our pipe
@@ -104,6 +110,7 @@ def _hand_out(worker: _Worker, queue: deque[EpisodeSpec]) -> None:
     """Give an idle worker the next episode, if there is one."""
     if worker.spec is None and queue:
         worker.spec, worker.started = queue.popleft(), time.monotonic()
+        worker.steps.value = 0
         with suppress(OSError):  # it died idle: its death is found when its pipe is read
             worker.pipe.send(worker.spec)
 
@@ -143,12 +150,13 @@ class ForkPool:
         inherited = [mine, *(worker.pipe for worker in self._workers)]
         if self._start != "fork":  # nothing is inherited; sending our ends would copy them
             inherited = []
+        steps = self._context.RawValue("q", 0)
         process = self._context.Process(
-            target=_serve, args=(self._run, theirs, inherited), daemon=True
+            target=_serve, args=(self._run, theirs, inherited, steps), daemon=True
         )
         process.start()
         theirs.close()
-        return _Worker(process, mine)
+        return _Worker(process, mine, steps)
 
     def run(
         self,
@@ -158,8 +166,8 @@ class ForkPool:
         timed_out: GiveUp | None = None,
     ) -> None:
         """Every spec, each result to ``on_result`` as it arrives; a spec whose worker died
-        more than ``retries`` times gets ``died(spec)`` instead, and one that ran over the
-        time limit ``timed_out(spec)`` (``died`` when not given)."""
+        more than ``retries`` times gets ``died(spec, steps, wall_s)`` instead, and one that
+        ran over the time limit ``timed_out(...)`` (``died`` when not given)."""
         queue, attempts = deque(specs), dict.fromkeys(specs, 0)
         while queue or any(worker.spec for worker in self._workers):
             for worker in self._workers:
@@ -204,13 +212,14 @@ class ForkPool:
         ``retries`` times, never when ``retry`` is False) or give it up."""
         spec = worker.spec
         assert spec is not None
+        progress = (int(worker.steps.value), time.monotonic() - worker.started)
         worker.pipe.close()
         worker.process.join()
         self._workers[self._workers.index(worker)] = replacement = self._fork()
         _await_ready(replacement)
         attempts[spec] += 1
         if not retry or attempts[spec] > self._retries:
-            on_result(give_up(spec))
+            on_result(give_up(spec, *progress))
         else:
             queue.appendleft(spec)
 

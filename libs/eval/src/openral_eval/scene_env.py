@@ -14,9 +14,16 @@ wraps it:
   base, the base twist ``vx, vy, wz`` within the manifest's velocity limits;
 - ``reset(seed=s)`` draws the scene's randomisation from ``s`` (no seed: one drawn from the
   env's generator, so a seeded env's episodes are reproducible);
-- ``step`` returns the scene's reward; ``terminated`` when the scene's own success check
-  holds or the task ends it, ``truncated`` at the scene's horizon or ``max_steps``; ``info``
-  carries ``success`` (and, from ``reset``, the scene's ``seed``).
+- ``step`` returns the scene's reward in ``reward_mode`` (:mod:`openral_sim.task_reward`:
+  ``sparse``, 1 at a success step, or ``dense``, the scene's staged terms; robosuite's dense
+  is its own reward); ``terminated`` when the scene's own success check holds or the task
+  ends it, ``truncated`` at the scene's horizon or ``max_steps``; ``info`` carries
+  ``success`` and ``is_success`` (and, from ``reset``, the scene's ``seed``).
+
+Every shipped scene is registered too, as ``openral/<robot>-<scene>-v0`` with its horizon
+as ``max_episode_steps`` (:mod:`openral_core.scene_index`); keyword arguments of
+:func:`gymnasium.make` are :class:`EnvConfig` fields:
+``gymnasium.make("openral/franka_panda-tabletop-v0", reward_mode="dense")``.
 
 An action outside the space (wrong shape, NaN, a value past its slot's bounds) raises
 :class:`~openral_mujoco.errors.ActionRejected` naming the slot, before anything moves.
@@ -24,8 +31,8 @@ An action outside the space (wrong shape, NaN, a value past its slot's bounds) r
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Mapping
-from dataclasses import dataclass, fields, replace
 from functools import partial
 from pathlib import Path
 from typing import Any, SupportsFloat, cast
@@ -37,6 +44,8 @@ from gymnasium import spaces
 from openral_core.loaded import LoadedRobot
 from openral_core.loader import load_scene
 from openral_core.models import Backend
+from openral_core.paths import repo_root
+from openral_core.scene_index import read_scene_index
 from openral_hal.factory import HalMode, build_hal
 from openral_hal.sim_attached import SimAttachedHAL
 from openral_hal.tool_centre import ee_command
@@ -45,61 +54,31 @@ from openral_mujoco.errors import ActionRejected
 from openral_sim.rollout import SceneRollout
 from openral_sim.scene import scene_robot
 from openral_sim.state_sensors import state_sensors_of
+from openral_sim.task_reward import sparse_reward
 
-from openral_eval.env_actions import BASE_SLOTS, ActionContract, ActionMode
+from openral_eval.env_actions import BASE_SLOTS, ActionContract
+from openral_eval.env_config import EnvConfig, RewardMode, merged_config
 from openral_eval.env_observation import EnvObservation, ObservationLayout
 
+__all__ = [
+    "ENV_ID",
+    "EnvConfig",
+    "RewardMode",
+    "SceneEnv",
+    "attached_hal",
+    "has_dense_reward",
+    "make_env",
+    "make_vector_env",
+    "scene_horizon",
+]
+
 EnvInfo = dict[str, bool | int]
-"""gymnasium's ``info``: ``success`` every step, and the scene's ``seed`` at reset."""
+"""gymnasium's ``info``: ``success`` and ``is_success`` every step, and the scene's ``seed``
+at reset."""
+
 
 ENV_ID = "openral/Scene-v0"
 """The id :func:`gymnasium.make` knows the scene env by once this module is imported."""
-
-
-@dataclass(frozen=True)
-class EnvConfig:
-    """Everything a scene env is built from."""
-
-    scene: str
-    """The scene file (``robots/<id>/scenes/<name>.yaml``)."""
-    action_mode: ActionMode = ActionMode.JOINT_POSITION
-    seed: int | None = None
-    """Seeds the env's generator (the seeds of resets without one); None: from the OS."""
-    privileged: bool = False
-    """Add the scene's task state (object poses) under ``privileged``."""
-    sensors: bool | tuple[str, ...] = True
-    """Which cameras, depth sensors and lidars the observation carries: True all, False
-    none, or these by manifest name (state sensors, joints and the base are always in)."""
-    max_steps: int | None = None
-    """Truncate after this many steps (None: the scene's horizon, if any)."""
-    ee_preset: str = "robosuite"
-    """The scale and gripper sign of ``ee_delta_pose``: ``robosuite`` or ``maniskill``."""
-
-    @classmethod
-    def parse(cls, config: EnvConfig | Mapping[str, object]) -> EnvConfig:
-        """``config`` as an :class:`EnvConfig` (a mapping: by field name).
-
-        Raises:
-            ValueError: An unknown key, an unknown action mode, or a missing scene.
-        """
-        if isinstance(config, EnvConfig):
-            return replace(config, action_mode=_mode(config.action_mode))
-        known = {f.name for f in fields(cls)}
-        unknown = sorted(set(config) - known)
-        if unknown:
-            raise ValueError(f"unknown env config keys {unknown}; valid: {sorted(known)}")
-        if "scene" not in config:
-            raise ValueError("env config needs 'scene': a scene file")
-        built = cls(**config)  # type: ignore[arg-type]
-        return replace(built, action_mode=_mode(built.action_mode))
-
-
-def _mode(value: object) -> ActionMode:
-    try:
-        return ActionMode(str(value) if isinstance(value, str) else repr(value))
-    except ValueError:
-        valid = ", ".join(m.value for m in ActionMode)
-        raise ValueError(f"unknown action mode {value!r}; valid: {valid}") from None
 
 
 class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
@@ -109,23 +88,37 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
 
     def __init__(
         self,
-        config: EnvConfig | Mapping[str, object],
+        config: EnvConfig | Mapping[str, object] | None = None,
         *,
         render_mode: str | None = None,
         hal: tuple[SimAttachedHAL, LoadedRobot] | None = None,
+        **settings: object,
     ) -> None:
         """Build the scene's HAL (or use ``hal``, which the env then does not close) and
-        lay out the spaces from its first observation.
+        lay out the spaces from its first observation. ``settings``: :class:`EnvConfig`
+        fields, over ``config``'s (``gymnasium.make``'s keyword arguments).
 
         Raises:
-            ValueError: A bad config or render mode. ManifestError: A bad scene file.
+            ValueError: A bad config, render mode or reward mode. ManifestError: A bad scene
+                file.
         """
-        self.config = EnvConfig.parse(config)
+        self.config = EnvConfig.parse(merged_config(config, settings))
         if render_mode not in (None, "rgb_array"):
             raise ValueError(f"unknown render mode {render_mode!r}; valid: rgb_array")
         self.render_mode = render_mode
         self._owns_hal = hal is None
         self.hal, self.robot = hal if hal is not None else attached_hal(self.config.scene)
+        self._closer = weakref.finalize(self, self.hal.disconnect) if self._owns_hal else None
+        """Closes the scene when the env is closed, collected, or left open at exit (its GL
+        contexts freed while the display still exists)."""
+        try:
+            self._build()
+        except BaseException:
+            self.close()  # a refused config leaves nothing open
+            raise
+
+    def _build(self) -> None:
+        """Connect the HAL and lay out the spaces (see :meth:`__init__`)."""
         self._observed = self._chosen_sensors()
         self._choose_sensors()
         self.hal.env_reset_seed = 0
@@ -156,6 +149,12 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         self._bounded = bool(np.isfinite(low).all() and np.isfinite(high).all())
         self.steps = 0
         self._limit = self.config.max_steps or scene_horizon(self.hal)
+        self._dense = self.config.reward_mode is RewardMode.DENSE
+        if self._dense and not has_dense_reward(self.hal):
+            raise ValueError(
+                f"{self.config.scene} declares no dense reward (reward.dense); valid reward "
+                "mode: sparse"
+            )
         if self.config.seed is not None:
             self.action_space.seed(self.config.seed)
             super().reset(seed=self.config.seed)
@@ -194,7 +193,8 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         )
         obs = self._observe()
         info = self._info(success=outcome.success)
-        return obs, float(outcome.reward), terminated, truncated, info
+        reward = outcome.dense_reward if self._dense else sparse_reward(outcome.success)
+        return obs, reward, terminated, truncated, info
 
     def checked(self, action: object) -> npt.NDArray[np.float64]:
         """``action`` as float64 values inside the action space, or :class:`ActionRejected`
@@ -229,16 +229,22 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         return np.clip(values, self.box.low, self.box.high)
 
     def render(self) -> npt.NDArray[np.uint8] | None:
-        """The latest frame of the scene's first camera (None: no camera, or no render mode)."""
-        if self.render_mode is None:
+        """A frame of the scene's first camera as the scene is now, rendered on demand
+        whatever ``sensors`` chose (robosuite: its latest frame); None without a render
+        mode or a camera."""
+        if self.render_mode is None or not self.hal.env.camera_names:
             return None
-        frames = self.hal.read_images()
-        return next(iter(frames.values()), None)
+        camera = self.hal.env.camera_names[0]
+        scene = self.hal.env
+        handles = scene.mujoco_handles()
+        if isinstance(scene, SceneRollout) and handles is not None:
+            return scene.render_cameras(handles[1], [camera])[camera]
+        return self.hal.read_images().get(camera)
 
     def close(self) -> None:
         """Close the scene (an env given a HAL leaves it open for its owner)."""
-        if self._owns_hal:
-            self.hal.disconnect()
+        if self._closer is not None:
+            self._closer()
 
     def _observe(self) -> EnvObservation:
         obs = self.hal.last_observation()  # a native scene's carries the HAL's joint sample
@@ -255,7 +261,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
     def _info(*, success: bool) -> EnvInfo:
         """Only what a trainer needs each step (a vector env merges every key of every env
         on every step: each costs its share of the step)."""
-        return {"success": success}
+        return {"success": success, "is_success": success}
 
     def _chosen_sensors(self) -> frozenset[str] | None:
         """The sensors the config asks for (None: all); unknown names are refused.
@@ -297,6 +303,11 @@ def attached_hal(scene_file: str) -> tuple[SimAttachedHAL, LoadedRobot]:
     return hal, robot
 
 
+def has_dense_reward(hal: SimAttachedHAL) -> bool:
+    """True when the scene ``hal`` is attached to has a dense reward (robosuite: its own)."""
+    return not isinstance(hal.env, SceneRollout) or hal.env.task.dense is not None
+
+
 def scene_horizon(hal: SimAttachedHAL) -> int | None:
     """Steps per episode of the scene ``hal`` is attached to (None: it sets none)."""
     return hal.env.horizon if isinstance(hal.env, SceneRollout) else None
@@ -334,3 +345,10 @@ def make_vector_env(
 
 
 gymnasium.register(id=ENV_ID, entry_point=f"{__name__}:SceneEnv")
+for _entry in read_scene_index():
+    gymnasium.register(
+        id=_entry.env_id,
+        entry_point=f"{__name__}:SceneEnv",
+        max_episode_steps=_entry.horizon,
+        kwargs={"config": {"scene": str(repo_root() / _entry.file)}},
+    )

@@ -85,13 +85,14 @@ def _inheritable(path: str) -> bool:
         return False
 
 
-def _died(spec: EpisodeSpec) -> EpisodeResult:
-    return EpisodeResult.unfinished(spec, "its worker process died, every time it ran")
+def _died(spec: EpisodeSpec, steps: int, wall_s: float) -> EpisodeResult:
+    why = "its worker process died, every time it ran"
+    return EpisodeResult.unfinished(spec, why, steps, wall_s)
 
 
-def _timed_out(timeout_s: float, spec: EpisodeSpec) -> EpisodeResult:
+def _timed_out(timeout_s: float, spec: EpisodeSpec, steps: int, wall_s: float) -> EpisodeResult:
     why = f"timeout: still running after {timeout_s:g} s of wall time; its worker was stopped"
-    return EpisodeResult.unfinished(spec, why)
+    return EpisodeResult.unfinished(spec, why, steps, wall_s)
 
 
 def run_ray(
@@ -130,10 +131,10 @@ class _RayTasks:
         self.ray, self.timeout_s = ray, timeout_s
         self.task = ray.remote(num_cpus=1, max_retries=RETRIES)(run_episode)
         self.running: dict[object, tuple[EpisodeSpec, float]] = {}
-        """Task reference → (its spec, its deadline on the monotonic clock [s])."""
+        """Task reference → (its spec, when it was submitted on the monotonic clock [s])."""
 
     def start(self, spec: EpisodeSpec) -> None:
-        self.running[self.task.remote(spec)] = (spec, time.monotonic() + self.timeout_s)
+        self.running[self.task.remote(spec)] = (spec, time.monotonic())
 
     def next_results(self) -> list[EpisodeResult]:
         """Wait for the next episode to end or the next deadline to pass; the results of
@@ -141,23 +142,23 @@ class _RayTasks:
         its worker process killed)."""
         from ray.exceptions import RayError
 
-        deadline = min(end for _, end in self.running.values())
+        deadline = min(start for _, start in self.running.values()) + self.timeout_s
         wait_s = None if math.isinf(deadline) else max(0.0, deadline - time.monotonic())
         finished, _ = self.ray.wait(list(self.running), num_returns=1, timeout=wait_s)
         results = []
         for ref in finished:
-            spec, _ = self.running.pop(ref)
+            spec, start = self.running.pop(ref)
             try:
                 results.append(self.ray.get(ref))
             except RayError as error:
                 why = f"Ray gave up on it: {type(error).__name__}"
-                results.append(EpisodeResult.unfinished(spec, why))
+                results.append(EpisodeResult.unfinished(spec, why, 0, time.monotonic() - start))
         now = time.monotonic()
-        for ref, (spec, end) in list(self.running.items()):
-            if now >= end:
+        for ref, (spec, start) in list(self.running.items()):
+            if now >= start + self.timeout_s:
                 self.ray.cancel(ref, force=True)
                 del self.running[ref]
-                results.append(_timed_out(self.timeout_s, spec))
+                results.append(_timed_out(self.timeout_s, spec, 0, now - start))
         return results
 
 

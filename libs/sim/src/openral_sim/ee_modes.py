@@ -17,6 +17,7 @@ whole joint action passes the manifest's limits and the E-stop like any other.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import mink
@@ -110,6 +111,26 @@ class EeCommand:
         mujoco.mju_mulPose(a, a_quat, *self.frames.root_in_base, b, b_quat)
         mujoco.mju_mulPose(out[:3], out[3:], a, a_quat, self.ee.offset, self.ee.flange_quat)
         return out
+
+    def reach_box(
+        self, model: mujoco.MjModel, data: mujoco.MjData
+    ) -> tuple[FloatArray, FloatArray]:
+        """The lowest and highest TCP position the arm can reach, in the base frame [m]: a
+        box around its first joint as wide as the chain from joint to joint to the TCP is
+        long in ``data``'s pose (the triangle inequality makes it an upper bound)."""
+        arm_qpos = set(self.ee._arm_qpos.tolist())
+        joints = [j for j in range(model.njnt) if int(model.jnt_qposadr[j]) in arm_qpos]
+        points = [*(data.xanchor[j] for j in joints), self.tcp_world(data)]
+        reach = sum(float(np.linalg.norm(b - a)) for a, b in itertools.pairwise(points))
+        centre = self.base(data).inverse().apply(points[0])
+        return centre - reach, centre + reach
+
+    def tcp_world(self, data: mujoco.MjData) -> FloatArray:
+        """The TCP's world position [m]."""
+        frame, frame_quat = self.ee.frame_pose(data)
+        moved = np.empty(3)
+        mujoco.mju_rotVecQuat(moved, self.ee.offset, np.asarray(frame_quat, dtype=np.float64))
+        return np.asarray(frame, dtype=np.float64) + moved
 
     def _bind(self, data: mujoco.MjData) -> _Rows:
         """The rows of ``data`` the TCP pose reads (views: they follow ``data``)."""

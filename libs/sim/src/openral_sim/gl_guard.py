@@ -31,8 +31,11 @@ fresh clone); the camera benchmarks were not re-run with it.
 
 from __future__ import annotations
 
+import atexit
+import contextlib
 import os
 import threading
+import weakref
 from collections.abc import Iterator
 from contextlib import contextmanager
 
@@ -52,6 +55,11 @@ GL_LOCK = threading.Lock()
 """Held around every OpenGL call this package makes (never while waiting on anything
 else, so it cannot deadlock with the HAL's lock)."""
 
+
+_open: weakref.WeakSet[mujoco.Renderer] = weakref.WeakSet()
+"""Renderers made by :func:`open_renderer` and not yet closed."""
+_closes_at_exit = False
+"""Whether :func:`_close_open_renderers` is registered to run at exit."""
 
 _opened_in: int | None = None
 """The process that opened this module's first GL context (a forked child inherits it)."""
@@ -117,12 +125,27 @@ def open_renderer(model: mujoco.MjModel, height: int, width: int) -> mujoco.Rend
     Raises:
         InheritedGlError: This process was forked after its parent had opened a context.
     """
+    global _closes_at_exit
     claim_gl()
     with gl_turn():
-        return mujoco.Renderer(model, height, width)
+        renderer = mujoco.Renderer(model, height, width)
+    _open.add(renderer)
+    if not _closes_at_exit:  # after MuJoCo's own exit hook (the display's end): before it
+        atexit.register(_close_open_renderers)
+        _closes_at_exit = True
+    return renderer
 
 
 def close_renderer(renderer: mujoco.Renderer) -> None:
     """Free ``renderer``'s context holding :data:`GL_LOCK` (idempotent)."""
     with gl_turn():
         renderer.close()
+    _open.discard(renderer)
+
+
+def _close_open_renderers() -> None:
+    """At exit, free every renderer still open while the EGL display still exists (MuJoCo
+    ends the display in an exit hook of its own; a context freed after it raises)."""
+    for renderer in list(_open):
+        with contextlib.suppress(Exception):  # the process is ending: free what frees
+            close_renderer(renderer)

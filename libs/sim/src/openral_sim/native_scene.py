@@ -53,7 +53,7 @@ from openral_sim.scene_geometry import (
     place_floating_base,
 )
 from openral_sim.scene_sensors import SceneSensors
-from openral_sim.success import SuccessCheck
+from openral_sim.task_judge import TaskJudge
 
 
 class NativeScene:
@@ -103,13 +103,11 @@ class NativeScene:
         self._root_qpos = int(self.model.jnt_qposadr[self.model.body_jntadr[self._root_body]])
         self._width = scene.scene.observation.width
         self._height = scene.scene.observation.height
-        options = scene.scene.options
         self.substeps = physics_steps_per_control(scene, self.model.opt.timestep)
         self.parts = state_parts_per_control(scene, self.substeps, self.model.opt.timestep)
         """Parts of a control period :meth:`step_part` steps (``options.state_rate_hz``)."""
         self._part = self.parts  # parts of the current period stepped (all: it has ended)
         self._outcome = Outcome()
-        self.horizon = options.horizon if options and options.horizon else None
         self.render_observations = render_observations
         """Whether observations carry sensor frames; may be changed at any time."""
         self.observed: frozenset[str] | None = None
@@ -166,13 +164,14 @@ class NativeScene:
         """The scene's seeded randomisation (:mod:`openral_sim.randomization`)."""
         self._arm_qpos = addresses.qpos[addresses.arm_slots]
         fingers = [int(a) for g in addresses.grippers for a in g.finger_qpos]
-        self.success = SuccessCheck(scene.success or [], self.model, fingers)
+        self.task = TaskJudge(scene, self.model, fingers, self.wiring.tcp)
+        """Success, rewards and horizon (:mod:`openral_sim.task_judge`)."""
+        self.horizon = self.task.horizon
         options = scene.scene.options
         self._objects = {
             obj.name: mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, f"scene_{obj.name}")
             for obj in (options.objects if options and options.objects else [])
         }
-        """The scene's success predicates (:mod:`openral_sim.success`)."""
 
     # -- SimRollout ------------------------------------------------------------------------
 
@@ -255,7 +254,6 @@ class NativeScene:
         if self.wiring.keyframe_index is not None and self.wiring.floating_base:
             self._place_floating_base()
         self.randomizer.apply(self.data, seed, self._arm_qpos)
-        self.success.reset()
         hold_base_where_it_is(self.model, self.data, self._root_body)
         self.driver.start(self.model, self.data)
         if self.base is not None:
@@ -263,6 +261,7 @@ class NativeScene:
         self._advance(self.wiring.settle_steps_default)
         if self.base is not None:  # the odometry frame: where the base settled, exactly
             self.base.reset()
+        self.task.reset(self.data)
         self._steps, self._part, self._outcome = 0, self.parts, Outcome()
         self.sensors.schedule.restart()
         return self._observe()
@@ -308,11 +307,9 @@ class NativeScene:
         return StepResult(self._observe(), self._period_ended() if ended else self._outcome)
 
     def _period_ended(self) -> Outcome:
-        """Count a control period and judge the episode (success, horizon)."""
+        """Count a control period and judge the episode (success, rewards)."""
         self._steps += 1
-        success = self.success.update(self.data, self.control_period_s)
-        truncated = self.horizon is not None and self._steps >= self.horizon
-        self._outcome = Outcome(success=success, truncated=truncated, steps=self._steps)
+        self._outcome = self.task.judge(self.data, self.control_period_s, self._steps)
         return self._outcome
 
     def joint_state(self) -> JointStateSample:

@@ -71,6 +71,7 @@ class Outcome:
     """How one step ended (gymnasium's reward/terminated/truncated, plus success)."""
 
     reward: float = 0.0
+    """The sparse reward: 1 where success holds (robosuite: its own reward)."""
     success: bool = False
     """The scene's own success check holds at this step."""
     terminated: bool = False
@@ -79,6 +80,9 @@ class Outcome:
     """The scene's horizon ended the episode."""
     steps: int = 0
     """Steps since the last reset."""
+    dense_reward: float = 0.0
+    """The scene's dense reward (:mod:`openral_sim.task_reward`; robosuite: its own reward;
+    0 for a scene that declares none)."""
 
     @property
     def done(self) -> bool:

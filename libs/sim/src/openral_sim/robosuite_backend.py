@@ -165,6 +165,7 @@ class RobosuiteRollout:
             terminated=bool(done) and not at_horizon,
             truncated=at_horizon,
             steps=int(self.env.timestep),
+            dense_reward=float(reward),  # robosuite's own, shaped or not as it was made
         )
         return StepResult(self._observe(raw), outcome)
 

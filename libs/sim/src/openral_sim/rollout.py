@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from typing import Any, Protocol, runtime_checkable
 
 import mujoco
@@ -15,6 +15,7 @@ from openral_sim.base_drive import BaseDrive
 from openral_sim.frame_tree import FrameTree
 from openral_sim.observation import Observation, StepResult
 from openral_sim.sensor_sources import CameraSource, DepthSource, LidarSource, StateSensorSource
+from openral_sim.task_judge import TaskJudge
 
 __all__ = [
     "HoldingRollout",
@@ -133,11 +134,23 @@ class SceneRollout(ManifestRollout, Protocol):
     base: BaseDrive | None
     """The mobile base's drive (None: none)."""
     horizon: int | None
-    """Steps per episode (None: none)."""
+    """Steps per episode (None: none): the env and sweeps truncate there."""
     addresses: RobotAddresses
     """Where the robot's joints are in the scene's model, per manifest joint."""
     parts: int
     """Parts of a control period ``step_part`` steps (the scene's state rate)."""
+    task: TaskJudge
+    """Success and rewards of each control period (:mod:`openral_sim.task_judge`)."""
+
+    def render_cameras(
+        self,
+        data: mujoco.MjData,
+        sensors: Iterable[str] | None = None,
+        renderer: mujoco.Renderer | None = None,
+    ) -> dict[str, npt.NDArray[np.uint8]]:
+        """Fresh frames of the cameras of ``sensors`` (default: all) as ``data`` places
+        them, by sensor name."""
+        ...
 
     def step_part(
         self, action: npt.NDArray[np.floating[Any]] | None, *, glide: bool = False

@@ -15,6 +15,7 @@ from collections.abc import Sequence
 
 import mujoco
 import numpy as np
+import numpy.typing as npt
 from openral_core.models import GripperHolds, ObjectAbove, ObjectInRegion, SuccessPredicate
 
 
@@ -33,8 +34,7 @@ class SuccessCheck:
             mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"scene_{p.object}")
             for p in self.predicates
         ]
-        by_qpos = {int(model.jnt_qposadr[j]): int(model.jnt_bodyid[j]) for j in range(model.njnt)}
-        self._fingers = frozenset(by_qpos[a] for a in finger_qpos if a in by_qpos)
+        self._fingers = finger_bodies(model, finger_qpos)
         self._geom_body = model.geom_bodyid.copy()
         self._held_s = np.zeros(len(self.predicates))
 
@@ -69,18 +69,28 @@ class SuccessCheck:
             low, high = np.asarray(predicate.min_m), np.asarray(predicate.max_m)
             return bool(np.all((centre >= low) & (centre <= high)))
         assert isinstance(predicate, GripperHolds)
-        return self._fingers_touch(body, data)
+        return fingers_touch(body, data, self._fingers, self._geom_body)
 
-    def _fingers_touch(self, body: int, data: mujoco.MjData) -> bool:
-        if not self._fingers:
-            return False
-        touching: set[int] = set()
-        count = data.ncon
-        pairs = zip(
-            data.contact.geom1[:count].tolist(), data.contact.geom2[:count].tolist(), strict=True
-        )
-        for geom1, geom2 in pairs:
-            bodies = {int(self._geom_body[geom1]), int(self._geom_body[geom2])}
-            if body in bodies:
-                touching |= bodies & self._fingers
-        return touching == set(self._fingers)
+
+def finger_bodies(model: mujoco.MjModel, finger_qpos: Sequence[int]) -> frozenset[int]:
+    """The bodies of the gripper fingers' joints at qpos addresses ``finger_qpos``."""
+    by_qpos = {int(model.jnt_qposadr[j]): int(model.jnt_bodyid[j]) for j in range(model.njnt)}
+    return frozenset(by_qpos[a] for a in finger_qpos if a in by_qpos)
+
+
+def fingers_touch(
+    body: int, data: mujoco.MjData, fingers: frozenset[int], geom_body: npt.NDArray[np.int32]
+) -> bool:
+    """True when every finger body touches one of ``body``'s geoms (``gripper_holds``)."""
+    if not fingers:
+        return False
+    touching: set[int] = set()
+    count = data.ncon
+    pairs = zip(
+        data.contact.geom1[:count].tolist(), data.contact.geom2[:count].tolist(), strict=True
+    )
+    for geom1, geom2 in pairs:
+        bodies = {int(geom_body[geom1]), int(geom_body[geom2])}
+        if body in bodies:
+            touching |= bodies & fingers
+    return touching == set(fingers)
