@@ -43,3 +43,20 @@ def test_a_bad_action_or_a_robot_without_a_tcp_is_one_line() -> None:
             ee.joint_action(bad, {})
     with pytest.raises(OpenralError, match="ur5e has no tool centre point"):
         GraphEeActions(open_robot_by_id("ur5e"), 0.1)
+
+
+def test_an_ee_pose_puts_the_tcp_where_asked() -> None:
+    ee = GraphEeActions(open_robot_by_id("franka_panda"), 0.1, mode="ee_pose")
+    ee.start(HOLD, _measured(HOLD, ee.names))
+    start = ee.command.tcp_vector(ee.twin.data)
+    target = np.concatenate([start[:3] + np.array([0.05, 0.0, 0.10]), start[3:], [0.0]])
+    action = HOLD
+    for _ in range(20):
+        action = ee.joint_action(target, _measured(action, ee.names))
+    ee.start(action, _measured(action, ee.names))
+    end = ee.command.tcp_vector(ee.twin.data)
+    np.testing.assert_allclose(end[:3], target[:3], atol=5e-3)
+    assert action[7] == 0.0
+    for bad in (np.zeros(7), np.array([0.3, 0, 0.5, 0, 0, 0, 0, 1.0])):  # short; no turn
+        with pytest.raises(OpenralError, match="ee_pose"):
+            ee.joint_action(bad, {})

@@ -6,15 +6,14 @@ derived slot table of the loaded robot (``LoadedRobot.tables.vla_slots``: the ta
 ``openral robot show`` prints and ``just schema-export`` writes under ``generated/``), so
 the rule lives in one place.
 
-Each tick (``rate_hz``) the node builds an :class:`~openral_eval.policies.Observation`
-from the latest frames, ``/joint_states`` and the latched ``/openral/action_spec``, calls
-the policy and publishes its action on ``/openral/safe_action`` (an ``ee_delta_pose``
-policy's action first becomes joint targets: :mod:`openral_nodes.graph_ee_actions`). With a
-namespace, every name lands under it, as deploy's do. Until ``frame_timeout_s``
-after start it waits for missing inputs; after that a missing input (or a camera slot
-whose frames stopped for ``frame_timeout_s``) aborts the runner: ``abort_error`` is set,
-the timer stops, and nothing more is published.
-"""
+Each tick (``rate_hz``) the node builds an :class:`~openral_eval.policies.Observation` from
+the latest frames, ``/joint_states`` and the latched ``/openral/action_spec``, calls the
+policy and publishes its action on ``/openral/safe_action`` (an ``ee_delta_pose`` or
+``ee_pose`` policy's action first becomes joint targets:
+:mod:`openral_nodes.graph_ee_actions`). With a namespace, every name lands under it, as
+deploy's do. Until ``frame_timeout_s`` after start it waits for missing inputs; after that a
+missing input (or a camera slot whose frames stopped for ``frame_timeout_s``) aborts the
+runner: ``abort_error`` is set, the timer stops, and nothing more is published."""
 
 from __future__ import annotations
 
@@ -128,10 +127,10 @@ def _refuse_off_graph(policy: PolicyAdapter, name: str) -> None:
             f"policy {name} reads the simulation itself (privileged state); "
             "it runs in `openral sim sweep`, not on a ROS graph"
         )
-    if action_mode(policy) not in ("joint_position", "ee_delta_pose"):
+    if action_mode(policy) not in ("joint_position", "ee_delta_pose", "ee_pose"):
         raise RunnerAborted(
             f"policy {name} acts in {action_mode(policy)}; on a ROS graph a policy acts in "
-            "joint_position or ee_delta_pose; run it with `openral sim sweep`"
+            "joint_position, ee_delta_pose or ee_pose; run it with `openral sim sweep`"
         )
 
 
@@ -185,8 +184,9 @@ class RskillRunnerNode(NamespacedEntities, Node):
             )
         self._joint_names = [joint.name for joint in robot.description.joints]
         self._ee = None
-        if action_mode(self.policy) == "ee_delta_pose":  # the runner's own IK: module doc
-            self._ee = GraphEeActions(robot, 1.0 / rate_hz)
+        mode = action_mode(self.policy)
+        if mode != "joint_position":  # the runner's own IK: module doc
+            self._ee = GraphEeActions(robot, 1.0 / rate_hz, mode=mode)
         self._frames: dict[str, tuple[float, Any]] = {}
         self._joints: dict[str, float] = {}
         self._spec: tuple[tuple[str, ...], npt.NDArray[np.float64]] | None = None

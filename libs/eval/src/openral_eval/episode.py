@@ -95,6 +95,8 @@ class EpisodeResult:
     frames: int = 0
     """Camera frames the scene rendered for the episode (each camera at its own rate, only
     those the policy and the video read)."""
+    clamped_steps: int = 0
+    """Steps whose action the policy gave outside the action space (clamped onto it)."""
 
     @classmethod
     def unfinished(
@@ -181,6 +183,7 @@ def run_episode(spec: EpisodeSpec, watch: StepWatch | None = None) -> EpisodeRes
         trajectory_sha256=digest.hexdigest(),
         video=spec.video,
         frames=run.frames,
+        clamped_steps=run.clamped_steps,
     )
 
 
@@ -192,6 +195,7 @@ class _Run:
     success: bool = False
     sim_time_s: float = 0.0
     frames: int = 0
+    clamped_steps: int = 0
 
 
 def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None, run: _Run) -> None:
@@ -219,7 +223,10 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None, ru
             obs = inputs.observation(state.positions, run.steps, env.tcp_pose())
             # float32, as a dataset stores it, in every episode: a sweep with --dataset, one
             # without and `sim export`'s rerun of it apply the same values (same digest)
-            action = as_stored(env.clipped(policy.act(obs)), env.box.low, env.box.high)
+            asked = policy.act(obs)
+            clipped = env.clipped(asked)
+            run.clamped_steps += _clamped(asked, clipped)
+            action = as_stored(clipped, env.box.low, env.box.high)
             seen = hal.read_images() if keep is not None else {}
             _, _, terminated, truncated, info = env.step(action)
             if watch is not None:
@@ -239,6 +246,12 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None, ru
         video.close()
     digest.update(hal.read_state().positions.tobytes())
     run.sim_time_s = float(hal.read_state().sim_time_s or 0.0) - float(started or 0.0)
+
+
+def _clamped(wanted: object, clipped: np.ndarray) -> bool:
+    """True when ``clipped`` (the env's clamp of ``wanted``, base slots appended) differs."""
+    values = np.asarray(wanted, dtype=np.float64).ravel()
+    return bool(np.any(values != clipped[: values.size]))
 
 
 def _kept(spec: EpisodeSpec, robot: LoadedRobot, rendered: tuple[str, ...]) -> EpisodeFrames | None:

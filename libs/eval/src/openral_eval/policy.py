@@ -68,7 +68,7 @@ class PolicyConfigError(OpenralError):
     """An unknown policy, parameter or parameter value."""
 
 
-ACTION_MODES = ("joint_position", "ee_delta_pose")
+ACTION_MODES = ("joint_position", "ee_delta_pose", "ee_pose")
 """What a policy's actions may be: joint targets (every path), or end-effector deltas in
 the robosuite preset (episodes on a native scene)."""
 

@@ -146,13 +146,19 @@ def sweep(
     success rate with its 95 % Wilson interval. Exits 1 when every episode failed with an
     error."""
     from openral_eval.policies import make_policy, parse_params
+    from openral_eval.policy import PolicyConfigError
+    from openral_eval.policy_fit import check_policy_fits
     from openral_eval.ray_session import check_ray_address
 
     _check_arguments(config, out_dir, video)
     pairs = tuple(sorted(parse_params(params or []).items()))
-    make_policy(policy, dict(pairs))  # a bad name or parameter stops here, before any episode
-    for path in config:
-        _build_scene(path)
+    try:  # a bad name, parameter, mode or need stops here, before any episode (exit 2)
+        built = make_policy(policy, dict(pairs))
+        for path in config:
+            _build_scene(path)
+            check_policy_fits(built, policy, str(path))
+    except PolicyConfigError as error:
+        raise typer.BadParameter(str(error), param_hint="--policy") from None
     if ray not in (None, "local"):
         check_ray_address(ray)  # before the results file is touched
     staging = None if dataset is None else dataset_staging(config, dataset, (out_dir, resume, ray))
