@@ -59,6 +59,7 @@ from openral_sim.task_reward import sparse_reward
 from openral_eval.env_actions import BASE_SLOTS, ActionContract
 from openral_eval.env_config import EnvConfig, RewardMode, merged_config
 from openral_eval.env_observation import EnvObservation, ObservationLayout
+from openral_eval.thread_vector_env import ThreadVectorEnv
 
 __all__ = [
     "ENV_ID",
@@ -68,6 +69,7 @@ __all__ = [
     "attached_hal",
     "has_dense_reward",
     "make_env",
+    "make_thread_vector_env",
     "make_vector_env",
     "scene_horizon",
 ]
@@ -342,6 +344,18 @@ def make_vector_env(
     return gymnasium.vector.AsyncVectorEnv(
         [build] * num_envs, context="forkserver" if renders else "fork"
     )
+
+
+def make_thread_vector_env(scene: str | Path, num_envs: int, **config: object) -> ThreadVectorEnv:
+    """``num_envs`` envs of ``scene`` (``config``: as :func:`make_env`) in this process,
+    stepped at once on threads of their own (:mod:`openral_eval.thread_vector_env`).
+
+    Raises:
+        ValueError: ``num_envs`` below 1.
+    """
+    if num_envs < 1:
+        raise ValueError(f"num_envs is {num_envs}; expected at least 1")
+    return ThreadVectorEnv([partial(make_env, str(scene), **config)] * num_envs)
 
 
 gymnasium.register(id=ENV_ID, entry_point=f"{__name__}:SceneEnv")
