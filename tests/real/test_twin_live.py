@@ -13,13 +13,14 @@ import pytest
 from control_msgs.action import FollowJointTrajectory
 from sensor_msgs.msg import Image, JointState
 from std_msgs.msg import String
+from std_srvs.srv import Trigger
 
 from tests.conftest import ROBOTS
 from tests.real.deploy_helpers import openral, remote_graph, stop
-from tests.real.stand_in import ROBOT_STATES, arm_joints
+from tests.real.stand_in import RELEASE, ROBOT_STATES, arm_joints
 from tests.ros.action_client import PANDA_ARM, _AtomicActionClient, goal
 from tests.ros.lifecycle_client import deploy_sim
-from tests.ros.ros_helpers import wait_until
+from tests.ros.ros_helpers import call_trigger, wait_until
 
 pytestmark = pytest.mark.exclusive  # two live graphs on a real-time link
 
@@ -59,6 +60,8 @@ def test_a_goal_into_the_table_is_refused_and_the_twin_shows_the_measured_pose(
             try:
                 remote.probe.wait_count(TWIN_CAMERA, 1, timeout_s=90.0)
                 time.sleep(2.0)  # the cameras' renderers were made before the loop started
+                release = remote.probe.node.create_client(Trigger, RELEASE)
+                call_trigger(release, RELEASE)  # the stand-in may have paused at start (rare)
                 before = np.array(arm_joints(remote.probe.latest(ROBOT_STATES)))
                 into_table = before.copy()
                 into_table[1], into_table[3] = 1.5, -1.0  # the hand reaches down, far

@@ -226,9 +226,9 @@ class FrameRenderer(Generic[FrameT]):
 
     def _run(self) -> None:
         name_os_thread(self._thread.name)
-        behind_ordinary_programs()  # before the renderer: its GL threads inherit the place
         try:
-            developer = self._capture.open()
+            with behind_ordinary_programs():  # the renderer's GL threads inherit the place
+                developer = self._capture.open()
         except Exception as error:  # no GL context: the sensors stop, the robot does not
             self.error = error
             return

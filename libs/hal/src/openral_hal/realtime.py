@@ -42,20 +42,37 @@ IDLE_WORK_NICE = 10
 :func:`behind_ordinary_programs`)."""
 
 
-def behind_ordinary_programs() -> bool:
-    """Move the calling thread behind ordinary programs (nice :data:`IDLE_WORK_NICE`) when
-    it inherited a place ahead of them (:func:`ahead_of_other_programs`); else leave it.
+@contextlib.contextmanager
+def behind_ordinary_programs() -> Iterator[bool]:
+    """Inside the block, the calling thread runs behind ordinary programs (nice
+    :data:`IDLE_WORK_NICE`) when it inherited a place ahead of them
+    (:func:`ahead_of_other_programs`), so threads it starts meanwhile inherit that; after
+    the block it is back where it was. Yields True when it moved.
 
-    For a thread that keeps no robot's time but may keep the cores busy: a camera's renderer
-    in ``deploy real --twin`` (llvmpipe's threads, made by it, inherit its nice value), which
-    at nice -20 kept a robot driver on the same machine from its deadline (measured: 2 of
-    6 runs latched). Returns True when it moved."""
-    with contextlib.suppress(OSError):
-        tid = threading.get_native_id()
-        if os.getpriority(os.PRIO_PROCESS, tid) < 0:
+    For making a camera's renderer in a program that keeps a robot's time: llvmpipe's
+    rasterising threads, made with the renderer, then stay behind ordinary programs, while
+    the render thread itself (it holds Python's lock between draws) keeps its place. At
+    nice -20 those threads kept a robot driver on the same cores from its deadline
+    (measured: 4 of 14 ``deploy real --twin`` starts latched); with the render thread
+    itself behind, a stand-in driver's own loop waited for Python's lock that thread held
+    while set aside (3 goals in a row latched)."""
+    tid = threading.get_native_id()
+    try:
+        before = os.getpriority(os.PRIO_PROCESS, tid)
+    except OSError:
+        yield False
+        return
+    moved = False
+    if before < 0:
+        with contextlib.suppress(OSError):
             os.setpriority(os.PRIO_PROCESS, tid, IDLE_WORK_NICE)
-            return True
-    return False
+            moved = True
+    try:
+        yield moved
+    finally:
+        if moved:
+            with contextlib.suppress(OSError):
+                os.setpriority(os.PRIO_PROCESS, tid, before)
 
 
 def answer_first(priority: int = PRIORITY) -> bool:
