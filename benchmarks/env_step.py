@@ -17,7 +17,6 @@ from __future__ import annotations
 import argparse
 import os
 import time
-from collections.abc import Callable
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
@@ -30,6 +29,7 @@ from rich.console import Console
 from rich.table import Table
 
 from benchmarks.results_file import write_results
+from benchmarks.step_rate import best_rates, rate
 from benchmarks.thread_vector import (
     MIN_SHARE_OF_CEILING,
     add_thread_rows,
@@ -42,14 +42,6 @@ MAX_OVERHEAD = 0.05
 """Env step time over the scene's own step time, minus 1, at most."""
 MIN_VECTOR_SPEEDUP = 1.7
 """Env steps/s of a vector env of 2 over one env, at least."""
-
-
-def rate(step: Callable[[], object], steps: int) -> float:
-    """Calls of ``step`` per second."""
-    start = time.perf_counter()
-    for _ in range(steps):
-        step()
-    return steps / (time.perf_counter() - start)
 
 
 def step_rates(env: SceneEnv, steps: int, pairs: int) -> tuple[float, float]:
@@ -120,21 +112,15 @@ def ceiling(cost_s: float, steps: int, repeats: int) -> float:
 
 
 def vector_speedup(steps: int, repeats: int) -> tuple[float, float]:
-    """(one env's steps/s, an AsyncVectorEnv of 2's env steps/s), cameras off, best of
-    ``repeats`` runs of each, interleaved (the machine's load changes both alike)."""
+    """(one env's steps/s, an AsyncVectorEnv of 2's env steps/s), cameras off
+    (:func:`~benchmarks.step_rate.best_rates`)."""
     config = {"scene": SCENE, "sensors": False}
     vector = gymnasium.vector.AsyncVectorEnv([lambda: gymnasium.make(ENV_ID, config=config)] * 2)
     single = make_env(SCENE, sensors=False)
     try:
         vector.reset(seed=[0, 1])
         single.reset(seed=0)
-        hold = single.hal.hold_action()
-        both = np.stack([hold] * 2)
-        best_one = best_two = 0.0
-        for _ in range(repeats):
-            best_one = max(best_one, rate(lambda: single.step(hold), steps))
-            best_two = max(best_two, 2 * rate(lambda: vector.step(both), steps))
-        return best_one, best_two
+        return best_rates(single, vector, single.hal.hold_action(), steps, repeats)
     finally:
         vector.close()
         single.close()

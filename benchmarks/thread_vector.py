@@ -9,9 +9,10 @@ import threading
 import time
 
 import mujoco
-import numpy as np
 from openral_eval.scene_env import make_env, make_thread_vector_env
 from rich.table import Table
+
+from benchmarks.step_rate import best_rates
 
 MIN_SHARE_OF_CEILING = 0.9
 """The threaded vector env's gain over one env, as a share of the bare threads' gain."""
@@ -52,26 +53,14 @@ def bare_ceiling(scene: str, steps: int, repeats: int) -> float:
 
 
 def thread_speedup(scene: str, steps: int, repeats: int) -> tuple[float, float]:
-    """(one env's steps/s, the threaded vector env of 2's env steps/s), best of ``repeats``
-    interleaved runs, holding the arm."""
+    """(one env's steps/s, the threaded vector env of 2's env steps/s), cameras off
+    (:func:`~benchmarks.step_rate.best_rates`)."""
     vector = make_thread_vector_env(scene, 2, sensors=False, max_steps=LONG)
     single = make_env(scene, sensors=False, max_steps=LONG)
     try:
         vector.reset(seed=[0, 1])
         single.reset(seed=0)
-        hold = single.hal.hold_action()
-        both = np.stack([hold] * 2)
-        best_one = best_two = 0.0
-        for _ in range(repeats):
-            began = time.perf_counter()
-            for _ in range(steps):
-                single.step(hold)
-            best_one = max(best_one, steps / (time.perf_counter() - began))
-            began = time.perf_counter()
-            for _ in range(steps):
-                vector.step(both)
-            best_two = max(best_two, 2 * steps / (time.perf_counter() - began))
-        return best_one, best_two
+        return best_rates(single, vector, single.hal.hold_action(), steps, repeats)
     finally:
         vector.close()
         single.close()
