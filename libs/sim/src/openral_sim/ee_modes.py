@@ -120,17 +120,10 @@ class EeCommand:
         long in ``data``'s pose (the triangle inequality makes it an upper bound)."""
         arm_qpos = set(self.ee._arm_qpos.tolist())
         joints = [j for j in range(model.njnt) if int(model.jnt_qposadr[j]) in arm_qpos]
-        points = [*(data.xanchor[j] for j in joints), self.tcp_world(data)]
+        points = [*(data.xanchor[j] for j in joints), self.ee.tcp.position(data)]
         reach = sum(float(np.linalg.norm(b - a)) for a, b in itertools.pairwise(points))
         centre = self.base(data).inverse().apply(points[0])
         return centre - reach, centre + reach
-
-    def tcp_world(self, data: mujoco.MjData) -> FloatArray:
-        """The TCP's world position [m]."""
-        frame, frame_quat = self.ee.frame_pose(data)
-        moved = np.empty(3)
-        mujoco.mju_rotVecQuat(moved, self.ee.offset, np.asarray(frame_quat, dtype=np.float64))
-        return np.asarray(frame, dtype=np.float64) + moved
 
     def _bind(self, data: mujoco.MjData) -> _Rows:
         """The rows of ``data`` the TCP pose reads (views: they follow ``data``)."""

@@ -45,6 +45,7 @@ from openral_mujoco.state import FloatArray
 
 from openral_sim.scene_geometry import start_pose
 from openral_sim.self_collision import collision_limit
+from openral_sim.tcp_frame import TcpFrame
 
 _HALVINGS = 5
 """Halvings of a step that would bring the robot's own links too close (then it holds)."""
@@ -98,11 +99,9 @@ class EndEffector:
                 f"{robot.name} has no tool centre point: end-effector actions need sim.tcp "
                 "(a body or site, and an offset) in its manifest"
             )
-        kind = mujoco.mjtObj.mjOBJ_SITE if tcp.kind == "site" else mujoco.mjtObj.mjOBJ_BODY
-        self.kind, self.frame = tcp.kind, mujoco.mj_name2id(model, kind, tcp.frame)
-        if self.frame < 0:
-            raise HalError(f"the scene's model has no {tcp.kind} {tcp.frame!r} (sim.tcp)")
-        self.offset = np.asarray(tcp.offset_m, dtype=np.float64)
+        self.tcp = TcpFrame.locate(model, tcp)
+        """The TCP's body or site and its offset there."""
+        self.kind, self.frame, self.offset = self.tcp.kind, self.tcp.frame, self.tcp.offset
         self.flange_quat = np.asarray(tcp.quat_wxyz, dtype=np.float64)
         turn = mink.SO3(self.flange_quat)
         self.flange = mink.SE3.from_rotation_and_translation(turn, self.offset)

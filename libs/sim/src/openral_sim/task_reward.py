@@ -34,9 +34,9 @@ from openral_core.models import (
 )
 from openral_core.tcp_wiring import TcpWiring
 from openral_mujoco.errors import HalError
-from openral_mujoco.state import FloatArray
 
 from openral_sim.success import finger_bodies, fingers_touch
+from openral_sim.tcp_frame import TcpFrame
 
 
 def dense_reward_of(
@@ -135,28 +135,10 @@ def _closeness(distance_m: float, scale_per_m: float | None) -> float:
     return 1.0 - float(np.tanh((scale_per_m or 10.0) * distance_m))
 
 
-class _TcpFrame:
-    """The tool centre point's world position in a model's ``data``."""
-
-    def __init__(self, kind: str, frame: int, offset: FloatArray) -> None:
-        self.kind, self.frame, self.offset = kind, frame, offset
-
-    def position(self, data: mujoco.MjData) -> FloatArray:
-        """The TCP's world position [m]."""
-        site = self.kind == "site"
-        origin: FloatArray = (data.site_xpos if site else data.xpos)[self.frame]
-        axes: FloatArray = (data.site_xmat if site else data.xmat)[self.frame].reshape(3, 3)
-        return origin + axes @ self.offset
-
-
-def _tcp_frame(model: mujoco.MjModel, tcp: TcpWiring | None) -> _TcpFrame:
+def _tcp_frame(model: mujoco.MjModel, tcp: TcpWiring | None) -> TcpFrame:
     if tcp is None:
         raise HalError(
             "reward.dense has a reach term, which needs the robot's tool centre point "
             "(sim.tcp in its manifest)"
         )
-    kind = mujoco.mjtObj.mjOBJ_SITE if tcp.kind == "site" else mujoco.mjtObj.mjOBJ_BODY
-    frame = mujoco.mj_name2id(model, kind, tcp.frame)
-    if frame < 0:
-        raise HalError(f"the scene's model has no {tcp.kind} {tcp.frame!r} (sim.tcp)")
-    return _TcpFrame(tcp.kind, frame, np.asarray(tcp.offset_m, dtype=np.float64))
+    return TcpFrame.locate(model, tcp)
