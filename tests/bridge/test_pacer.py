@@ -224,3 +224,62 @@ def test_a_retry_never_runs_past_the_next_grid_time(pacers: list[Pacer]) -> None
     slots = _grid_slots(pacer, period, calls)
     assert all(b > a for a, b in itertools.pairwise(slots)), slots  # no faster than its rate
     assert late.runs == len(calls) and tuple_job.runs == len(odd)
+
+
+def _on_pacer_thread(pacer: Pacer) -> tuple[int, int, float]:
+    """(scheduling policy, priority, switch interval [s]) seen from a job of ``pacer``."""
+    seen: list[tuple[int, int, float]] = []
+
+    def look() -> None:
+        import os
+        import sys
+
+        tid = threading.get_native_id()
+        policy = os.sched_getscheduler(tid)
+        seen.append((policy, os.sched_getparam(tid).sched_priority, sys.getswitchinterval()))
+
+    job = pacer.every(0.01, look, "look")
+    wait_until(lambda: bool(seen), "a job's look at its thread")
+    pacer.cancel(job)
+    return seen[0]
+
+
+def test_a_priority_the_system_refuses_is_told_in_one_line_and_changes_nothing(
+    pacers: list[Pacer],
+) -> None:
+    import os
+    import sys
+
+    told: list[str] = []
+    before = sys.getswitchinterval()
+    pacer = Pacer(priority=100, on_refused=told.append)  # beyond 1-99: refused everywhere
+    pacers.append(pacer)
+    pacer.start()
+    policy, _, switch_s = _on_pacer_thread(pacer)
+    assert policy == os.SCHED_OTHER and switch_s == before and not pacer.real_time
+    assert len(told) == 1 and "real-time priority 100 refused" in told[0], told
+
+
+def test_a_granted_priority_holds_while_the_pacer_runs_and_the_switch_interval_comes_back(
+    pacers: list[Pacer],
+) -> None:
+    """As root (CI, this machine) the priority is granted; elsewhere the refusal must be
+    told instead, and the thread left ordinary."""
+    import os
+    import sys
+
+    from openral_hal.realtime import SWITCH_INTERVAL_S
+
+    told: list[str] = []
+    before = sys.getswitchinterval()
+    pacer = Pacer(priority=7, on_refused=told.append)
+    pacers.append(pacer)
+    pacer.start()
+    policy, priority, switch_s = _on_pacer_thread(pacer)
+    if pacer.real_time:
+        assert (policy, priority, switch_s) == (os.SCHED_RR, 7, min(before, SWITCH_INTERVAL_S))
+        assert not told
+    else:
+        assert policy == os.SCHED_OTHER and switch_s == before and len(told) == 1
+    assert pacer.stop()
+    assert sys.getswitchinterval() == before

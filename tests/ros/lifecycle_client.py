@@ -79,6 +79,9 @@ OPENRAL = Path(sys.executable).parent / "openral"
 DEPLOY_ENV = {**os.environ, "MUJOCO_GL": "egl", "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
 DEPLOY_NODE = "openral_manifest_node"
 """Name of the node ``openral deploy sim`` runs."""
+DRIVER_PRIORITY = 50
+"""Real-time priority of a stand-in driver's loop: ros2_control_node's default
+``thread_priority``, above ``deploy real``'s reader (:data:`openral_hal.realtime.PRIORITY`)."""
 STOP_WAIT_S = 30.0
 """Longest wait for a deploy process to end after SIGTERM before it is killed [s]."""
 
@@ -158,8 +161,9 @@ def deploy_sim(
 ) -> Iterator[subprocess.Popen[str]]:
     """``openral deploy sim --config CONFIG --no-viewer [EXTRA…]`` in ``domain_id`` as a
     subprocess; ``robot``: standing in for a robot's driver, ahead of ordinary programs
-    (``nice -n -20``), as a ros2_control driver's loop runs (its 100 Hz stream then keeps
-    time while other programs start beside it).
+    (``nice -n -20``) and its control loop at real-time priority :data:`DRIVER_PRIORITY`,
+    as a ros2_control driver's loop runs (its 100 Hz stream then keeps time while other
+    programs start beside it, and ahead of ``deploy real``'s reader).
 
     Its stdout and stderr go to ``logs/deploy.out`` and ``logs/deploy.err`` (files, not
     pipes, so a chatty process never blocks on a full pipe). Still alive on exit, it gets
@@ -168,8 +172,8 @@ def deploy_sim(
     command = ["nice", "-n", "-20"] if robot else []
     command += [str(OPENRAL), "deploy", "sim", "--config", str(config), "--no-viewer"]
     command += ["--domain-id", str(domain_id), *extra]
-    if robot:  # a driver renders no cameras: a frame drawn on the CPU holds Python's lock
-        command += ["--camera-rate", "0.1"]
+    if robot:  # a driver renders no cameras (a frame drawn on the CPU holds Python's lock)
+        command += ["--camera-rate", "0.1", "--loop-priority", str(DRIVER_PRIORITY)]
     with (logs / "deploy.out").open("w") as out, (logs / "deploy.err").open("w") as err:
         process = subprocess.Popen(command, stdout=out, stderr=err, text=True, env=DEPLOY_ENV)
         try:

@@ -137,6 +137,8 @@ def test_a_shutdown_by_label_ends_finalized_from_every_state(
         ("joint_state_rate_hz", 0.0, "0.1-1000 Hz"),
         ("joint_state_rate_hz", 1e9, "0.1-1000 Hz"),
         ("joint_state_rate_hz", math.nan, "0.1-1000 Hz"),
+        ("loop_priority", 100, "0-99 (real-time priority; 0: ordinary scheduling)"),
+        ("loop_priority", -1, "0-99 (real-time priority; 0: ordinary scheduling)"),
     ],
 )
 def test_a_rate_out_of_bounds_is_refused_at_configure_with_the_range(

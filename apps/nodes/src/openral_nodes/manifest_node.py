@@ -182,16 +182,13 @@ class ManifestLifecycleNode(NamespacedEntities, LifecycleNode):
             if not hal.connected:
                 hal.connect()
         except Exception as error:  # a HAL or renderer failure; report it, stay inactive
-            text = (
-                str(error)
-                if isinstance(error, OpenralError)
-                else f"{type(error).__name__}: {error}"
-            )
-            self.boot_error = text
+            name = "" if isinstance(error, OpenralError) else f"{type(error).__name__}: "
+            self.boot_error = text = f"{name}{error}"
             if self.log_boot_errors:
                 self._log().error(f"activate failed: {text}")
             return Result.FAILURE
-        self.pacer = pacer = Pacer(on_error=self._job_failed)
+        priority, warn = int(self._param("loop_priority")), self._log().warning
+        self.pacer = pacer = Pacer(on_error=self._job_failed, priority=priority, on_refused=warn)
         self._start_loop(hal, pacer)
         self._create_entities(pacer)
         self.bridge = SceneBridges(
@@ -207,12 +204,14 @@ class ManifestLifecycleNode(NamespacedEntities, LifecycleNode):
             view_port=int(self._param("view_port")),
         )
         self.bridge.setup()
+        # Making a renderer and a full collection each hold Python's lock for 60-370 ms:
+        # both happen before the first tick, so the loop keeps its period from the start.
+        renderers_opened(RENDERERS_OPEN_S)
+        self.heap.freeze()
         if self.loop is not None:  # the pace is judged from here on, not over the start-up
             self.loop.watch.restart()
         pacer.start()
-        self.heap.freeze()
         if hal.is_real and isinstance(hal, CycledHal):
-            renderers_opened(RENDERERS_OPEN_S)  # each stalls the process: before the loop
             hal.start_cycle()
         super().on_activate(state)
         return Result.SUCCESS

@@ -31,17 +31,21 @@ PARAMETERS: dict[str, Any] = {
     "arm_id": "",
     "cameras": [""],
     "twin_scene": "",
+    "loop_priority": 0,
 }
 """Every parameter and its default. A real robot's: ``transport`` (its bus or address),
 ``calibration_file`` and ``arm_id`` (which calibration), ``cameras`` (``NAME=DEVICE``
 strings over the manifest's devices; ``[""]`` for none, as ROS has no empty list type),
-``twin_scene`` (a scene file the real robot is posed in: ``deploy real --twin``)."""
+``twin_scene`` (a scene file the real robot is posed in: ``deploy real --twin``).
+``loop_priority``: the control loop thread's real-time priority (1-99; 0: ordinary), as a
+ros2_control driver's ``thread_priority`` (``deploy sim --loop-priority``)."""
 
 RATE_RANGE_HZ = (0.1, 1000.0)
 """Accepted ``camera_publish_rate_hz`` (or 0) and ``joint_state_rate_hz``, inclusive [Hz]."""
 BOUNDS: dict[str, tuple[tuple[float, float], str]] = {
     "camera_publish_rate_hz": (RATE_RANGE_HZ, "Hz"),
     "joint_state_rate_hz": (RATE_RANGE_HZ, "Hz"),
+    "loop_priority": ((0.0, 99.0), "(real-time priority; 0: ordinary scheduling)"),
 }
 """Range and unit of each bounded parameter, checked at configure."""
 UNSET = {"camera_publish_rate_hz": 0.0}

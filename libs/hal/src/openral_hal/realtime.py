@@ -37,6 +37,9 @@ BACKGROUND_NICE = -20
 """Nice value of every thread of a program that keeps a robot's time (the highest share of
 the cores an ordinary thread can have; real-time round-robin at one priority would let
 its threads keep a core from each other for a whole 100 ms time slice)."""
+SWITCH_INTERVAL_S = 0.001
+"""Python's thread switch interval while a thread keeps a robot's time [s]: that thread
+waits at most this long for Python's lock (the default, 5 ms, is half a 100 Hz period)."""
 IDLE_WORK_NICE = 10
 """Nice value of a thread of such a program that keeps no time (see
 :func:`behind_ordinary_programs`)."""

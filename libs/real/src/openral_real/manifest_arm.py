@@ -16,6 +16,7 @@ from openral_core.real_wiring import RealWiring
 from openral_hal.attached_sensors import AttachedSensors
 from openral_hal.errors import ActionRejected
 from openral_hal.protocol import EStopLatch
+from openral_hal.realtime import SWITCH_INTERVAL_S
 from openral_mujoco.state import FloatArray
 from openral_sim.frame_tree import FrameTree
 from openral_sim.sensor_sources import StateSpec
@@ -24,11 +25,6 @@ from openral_real.kinematic_twin import KinematicTwin
 from openral_real.motion_envelope import MotionEnvelope
 
 __all__ = ["SWITCH_INTERVAL_S", "ManifestArm"]
-
-SWITCH_INTERVAL_S = 0.001
-"""Python's thread switch interval while a real arm is connected [s]: the driver's thread
-waits at most this long for Python's lock after a reading arrives (the default, 5 ms, is
-half a 100 Hz period). Restored at disconnect."""
 
 
 class ManifestArm(AttachedSensors, EStopLatch):

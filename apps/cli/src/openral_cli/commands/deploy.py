@@ -119,10 +119,22 @@ def sim(
     overwrite: Overwrite = False,
     view: View = False,
     view_port: ViewPort = DEFAULT_VIEW_PORT,
+    loop_priority: Annotated[
+        int,
+        typer.Option(
+            "--loop-priority",
+            min=0,
+            max=99,
+            help="Run the control loop's thread at this real-time priority (1-99, as a "
+            "ros2_control driver's thread_priority; needs root or CAP_SYS_NICE), e.g. standing "
+            "in for an arm's driver beside deploy real. 0: ordinary scheduling.",
+        ),
+    ] = 0,
 ) -> None:
     """Bring SCENE's robot up as a ROS 2 graph: joint states, cameras, actions, E-stop."""
     parameters = _node_parameters(config, manifest, not no_viewer, camera_rate, joint_state_rate)
     parameters.update(_tf_parameters(no_tf, no_static_tf))
+    parameters["loop_priority"] = loop_priority
     parameters["view_port"] = view_port if view else 0
     require_ros()
     from openral_nodes.runtime import ros_session
