@@ -46,6 +46,7 @@ from openral_eval.episode_frames import EpisodeFrames, as_stored, dataset_camera
 from openral_eval.policies import make_policy
 from openral_eval.policy import Observation, PolicyAdapter, action_mode
 from openral_eval.privileged import Pose, Privileged, PrivilegedGripper
+from openral_eval.remote_policy import RemotePolicy
 from openral_eval.scene_env import EnvConfig, SceneEnv, attached_hal, scene_horizon
 from openral_eval.video import VideoWriter
 
@@ -244,6 +245,8 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None, ru
             keep.save()
     finally:
         video.close()
+        if isinstance(policy, RemotePolicy):  # its connection ends with the episode
+            policy.close()
     digest.update(hal.read_state().positions.tobytes())
     run.sim_time_s = float(hal.read_state().sim_time_s or 0.0) - float(started or 0.0)
 

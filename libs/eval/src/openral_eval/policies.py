@@ -20,6 +20,7 @@ from openral_eval.osc_lift import OscLift
 from openral_eval.policy import Observation, PolicyAdapter, PolicyConfigError
 from openral_eval.policy_config import config_fields, parse_config, parse_params
 from openral_eval.policy_source import build, is_reference, load_class
+from openral_eval.remote_policy import RemoteConfig, RemotePolicy, is_address
 from openral_eval.scripted_lift import ScriptedLift
 from openral_eval.wave import WaveConfig, WavePolicy
 
@@ -64,8 +65,9 @@ loads a :class:`PolicyEntry`."""
 
 
 def make_policy(name: str, params: Mapping[str, str] | None = None) -> PolicyAdapter:
-    """Build policy ``name`` from string parameters (its config's fields): a built-in one,
-    a class named by ``file.py:Class`` or ``package.module:Class``
+    """Build policy ``name`` from string parameters (its config's fields): a policy server's
+    address (``ws://HOST:PORT``, :mod:`openral_eval.remote_policy`), a built-in one, a class
+    named by ``file.py:Class`` or ``package.module:Class``
     (:mod:`openral_eval.policy_source`), else one an installed package registers under
     :data:`ENTRY_POINT_GROUP`.
 
@@ -74,6 +76,8 @@ def make_policy(name: str, params: Mapping[str, str] | None = None) -> PolicyAda
             entry point that does not load a PolicyEntry, a bad parameter, or a policy that
             does not declare what it needs (``required_slots``, ``needs_privileged``).
     """
+    if is_address(name):  # a policy server (openral_eval.remote_policy)
+        return RemotePolicy(name, parse_config(RemoteConfig, params or {}, name))
     entry = POLICIES.get(name) or (_referenced(name) if is_reference(name) else _registered(name))
     policy: object = entry.build(parse_config(entry.config_type, params or {}, name))
     if not isinstance(policy, PolicyAdapter):

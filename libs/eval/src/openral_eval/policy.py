@@ -80,7 +80,7 @@ def action_mode(policy: object) -> str:
     Raises:
         PolicyConfigError: A mode policies cannot use.
     """
-    mode = getattr(type(policy), "action_mode", ACTION_MODES[0])  # a subclass inherits it
+    mode = getattr(policy, "action_mode", ACTION_MODES[0])  # a class's, or a served one's
     if mode not in ACTION_MODES:
         raise PolicyConfigError(
             f"policy {type(policy).__name__} declares action_mode {mode!r}; valid: "

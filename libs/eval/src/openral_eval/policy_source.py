@@ -6,7 +6,10 @@ The class is built from a config the same way a registered policy is: when it ha
 fills that config's fields (:mod:`openral_eval.policy_config`) and the class is called with
 it; without one, it takes no parameters and is called with none. A file is executed once
 per process (a sweep's worker builds a policy per episode) under a module name derived
-from its absolute path.
+from its absolute path; a forked process (a sweep's worker) executes it again, so what a
+file opens at import is opened after the fork, in the process that reads it. A
+``module:Class`` is imported as any module is, once: a module that opens files at import
+shares them with the forked workers, so open them in ``__init__`` or ``act`` instead.
 
 Example::
 
@@ -20,6 +23,7 @@ import dataclasses
 import hashlib
 import importlib
 import importlib.util
+import os
 import sys
 from pathlib import Path
 from types import ModuleType
@@ -30,6 +34,18 @@ from openral_eval.policy_config import is_config_type
 
 _LOADED: dict[Path, ModuleType] = {}
 """Files executed in this process, by absolute path."""
+
+
+def _forget_loaded() -> None:
+    """In a forked child: forget the files the parent executed, so the child executes each
+    again and whatever a file opens at import (a ``np.load`` archive, a socket) is its own
+    (one handle shared across the fork broke every worker's reads: "Bad CRC-32")."""
+    for module in _LOADED.values():
+        sys.modules.pop(module.__name__, None)
+    _LOADED.clear()
+
+
+os.register_at_fork(after_in_child=_forget_loaded)
 
 
 @dataclasses.dataclass(frozen=True)

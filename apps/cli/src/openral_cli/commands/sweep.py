@@ -145,20 +145,12 @@ def sweep(
     sim, in parallel; write ``episodes.jsonl`` and ``summary.json`` and print each scene's
     success rate with its 95 % Wilson interval. Exits 1 when every episode failed with an
     error."""
-    from openral_eval.policies import make_policy, parse_params
-    from openral_eval.policy import PolicyConfigError
-    from openral_eval.policy_fit import check_policy_fits
+    from openral_eval.policies import parse_params
     from openral_eval.ray_session import check_ray_address
 
     _check_arguments(config, out_dir, video)
     pairs = tuple(sorted(parse_params(params or []).items()))
-    try:  # a bad name, parameter, mode or need stops here, before any episode (exit 2)
-        built = make_policy(policy, dict(pairs))
-        for path in config:
-            _build_scene(path)
-            check_policy_fits(built, policy, str(path))
-    except PolicyConfigError as error:
-        raise typer.BadParameter(str(error), param_hint="--policy") from None
+    _check_policy(policy, pairs, config)
     if ray not in (None, "local"):
         check_ray_address(ray)  # before the results file is touched
     staging = None if dataset is None else dataset_staging(config, dataset, (out_dir, resume, ray))
@@ -171,6 +163,30 @@ def sweep(
     _report(lines, policy, out_dir, clock)
     if dataset is not None:
         export(dataset, plan, out_dir, lines)
+
+
+def _check_policy(policy: str, pairs: tuple[tuple[str, str], ...], config: list[Path]) -> None:
+    """Build the policy once and check it fits every scene: a bad name, parameter, mode or
+    need stops the sweep here, before any episode (exit 2). A policy server that is down
+    now is said in one line; each episode then says so too, and the sweep goes on."""
+    from openral_eval.policies import make_policy
+    from openral_eval.policy import PolicyConfigError
+    from openral_eval.policy_fit import check_policy_fits
+    from openral_eval.remote_policy import PolicyServerError, RemotePolicy
+
+    built: object = None
+    try:
+        built = make_policy(policy, dict(pairs))
+        for path in config:
+            _build_scene(path)
+            check_policy_fits(built, policy, str(path))
+    except PolicyConfigError as error:
+        raise typer.BadParameter(str(error), param_hint="--policy") from None
+    except PolicyServerError as error:  # down now: each episode says so, the sweep goes on
+        err.print(f"[yellow]{error}: its fit to the scenes is not checked[/yellow]")
+    finally:  # a served policy's connection (each episode opens its own)
+        if isinstance(built, RemotePolicy):
+            built.close()
 
 
 def _check_arguments(config: list[Path], out_dir: Path, video: str) -> None:
