@@ -1,15 +1,17 @@
-"""The threaded vector env of 2 against its ceiling, measured in the same run: two threads
-of bare ``mj_step`` (each on a scene of its own, a control period of physics steps per
-call) against one thread, on franka_panda's tabletop with cameras off. Used by
-``just bench-env`` (:mod:`benchmarks.env_step`)."""
+"""The threaded and the process vector envs of 2 against their ceiling, measured in the
+same run: two threads of bare ``mj_step`` (each on a scene of its own, a control period of
+physics steps per call) against one thread, on franka_panda's tabletop with cameras off.
+Used by ``just bench-env`` (:mod:`benchmarks.env_step`)."""
 
 from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Callable
+from typing import Any
 
 import mujoco
-from openral_eval.scene_env import make_env, make_thread_vector_env
+from openral_eval.scene_env import make_env, make_process_vector_env, make_thread_vector_env
 from rich.table import Table
 
 from benchmarks.step_rate import best_rates
@@ -52,10 +54,11 @@ def bare_ceiling(scene: str, steps: int, repeats: int) -> float:
             env.close()
 
 
-def thread_speedup(scene: str, steps: int, repeats: int) -> tuple[float, float]:
-    """(one env's steps/s, the threaded vector env of 2's env steps/s), cameras off
-    (:func:`~benchmarks.step_rate.best_rates`)."""
-    vector = make_thread_vector_env(scene, 2, sensors=False, max_steps=LONG)
+def speedup(scene: str, steps: int, repeats: int, *, processes: bool) -> tuple[float, float]:
+    """(one env's steps/s, a vector env of 2's env steps/s), cameras off: the threaded one,
+    or with ``processes`` the process one (:func:`~benchmarks.step_rate.best_rates`)."""
+    make: Callable[..., Any] = make_process_vector_env if processes else make_thread_vector_env
+    vector = make(scene, 2, sensors=False, max_steps=LONG)
     single = make_env(scene, sensors=False, max_steps=LONG)
     try:
         vector.reset(seed=[0, 1])
@@ -66,14 +69,13 @@ def thread_speedup(scene: str, steps: int, repeats: int) -> tuple[float, float]:
         single.close()
 
 
-def add_thread_rows(table: Table, one: float, two: float, bare: float) -> float:
-    """Add the threaded vector env's rows to ``table``; its share of the ceiling."""
+def add_vector_row(table: Table, label: str, one: float, two: float, bare: float) -> float:
+    """Add a vector env's row (its gain over one env, measured in its own run) to
+    ``table``; its share of the ceiling."""
     share = (two / one) / bare
     colour = "green" if share >= MIN_SHARE_OF_CEILING else "red"
-    table.add_row("one env (threads run), cameras off", "", f"{one:.0f}", "1.00x")
     table.add_row(
-        "ThreadVectorEnv x2, cameras off", "", f"{two:.0f}",
+        f"{label} x2, cameras off", "", f"{two:.0f}",
         f"[{colour}]{two / one:.2f}x ({share:.0%} of the ceiling)[/]",
     )  # fmt: skip
-    table.add_row("ceiling: 2 threads of bare mj_step", "", "", f"{bare:.2f}x")
     return share

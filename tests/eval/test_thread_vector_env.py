@@ -7,13 +7,13 @@ import threading
 from functools import partial
 
 import gymnasium
-import numpy as np
 import pytest
 from openral_eval import make_thread_vector_env
 from openral_eval.scene_env import make_env
 from openral_eval.thread_vector_env import ThreadVectorEnv
 
 from tests.conftest import ROBOTS
+from tests.eval.vector_checks import steps_like_sync_vector_env
 
 FRANKA = str(ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml")
 
@@ -23,21 +23,7 @@ def test_it_steps_as_sync_vector_env_does_autoreset_included() -> None:
     threaded = make_thread_vector_env(FRANKA, 2, **config)
     plain = gymnasium.vector.SyncVectorEnv([partial(make_env, FRANKA, **config)] * 2)
     try:
-        a, a_info = threaded.reset(seed=[3, 4])
-        b, b_info = plain.reset(seed=[3, 4])
-        np.testing.assert_array_equal(a["joint_positions"], b["joint_positions"])
-        assert list(a_info["seed"]) == list(b_info["seed"]) == [3, 4]
-        threaded.action_space.seed(0)
-        ends = []
-        for _ in range(9):  # past the 6-step limit: both envs reset on the 7th step
-            action = threaded.action_space.sample()
-            a, ra, ta, ua, _ = threaded.step(action)
-            b, rb, tb, ub, _ = plain.step(action)
-            np.testing.assert_array_equal(a["joint_positions"], b["joint_positions"])
-            np.testing.assert_array_equal(ra, rb)
-            assert (ta == tb).all() and (ua == ub).all()
-            ends.append(bool(ua.all()))
-        assert ends == [False] * 5 + [True] + [False] * 3
+        steps_like_sync_vector_env(threaded, plain)
     finally:
         threaded.close()
         plain.close()

@@ -3,7 +3,8 @@ gymnasium env of a scene file.
 
 Between the HAL and the apps: an episode drives a scene through the same HAL contract as
 ``deploy sim`` (:class:`~openral_hal.sim_attached.SimAttachedHAL`), without ROS.
-``make_env``, ``make_vector_env``, ``make_thread_vector_env`` and ``SceneEnv`` are imported
+``make_env``, ``make_vector_env``, ``make_thread_vector_env``, ``make_process_vector_env``
+and ``SceneEnv`` are imported
 on first use (gymnasium is not loaded by the CLI's other commands).
 """
 
@@ -16,11 +17,19 @@ if TYPE_CHECKING:
         EnvConfig,
         SceneEnv,
         make_env,
+        make_process_vector_env,
         make_thread_vector_env,
         make_vector_env,
     )
 
-__all__ = ["EnvConfig", "SceneEnv", "make_env", "make_thread_vector_env", "make_vector_env"]
+__all__ = [
+    "EnvConfig",
+    "SceneEnv",
+    "make_env",
+    "make_process_vector_env",
+    "make_thread_vector_env",
+    "make_vector_env",
+]
 
 
 def __getattr__(name: str) -> object:

@@ -59,6 +59,7 @@ from openral_sim.task_reward import sparse_reward
 from openral_eval.env_actions import BASE_SLOTS, ActionContract
 from openral_eval.env_config import EnvConfig, RewardMode, merged_config
 from openral_eval.env_observation import EnvObservation, ObservationLayout
+from openral_eval.process_vector_env import ProcessVectorEnv
 from openral_eval.thread_vector_env import ThreadVectorEnv
 
 __all__ = [
@@ -356,6 +357,17 @@ def make_thread_vector_env(scene: str | Path, num_envs: int, **config: object) -
     if num_envs < 1:
         raise ValueError(f"num_envs is {num_envs}; expected at least 1")
     return ThreadVectorEnv([partial(make_env, str(scene), **config)] * num_envs)
+
+
+def make_process_vector_env(scene: str | Path, num_envs: int, **config: object) -> ProcessVectorEnv:
+    """``num_envs`` envs of ``scene`` (``config``: as :func:`make_env`): the first in this
+    process, each other in a worker process, all stepped at once
+    (:mod:`openral_eval.process_vector_env`; it scales with cores).
+
+    Raises:
+        ValueError: ``num_envs`` below 1.
+    """
+    return ProcessVectorEnv(partial(make_env, str(scene), **config), num_envs)
 
 
 gymnasium.register(id=ENV_ID, entry_point=f"{__name__}:SceneEnv")

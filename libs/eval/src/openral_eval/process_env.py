@@ -1,0 +1,213 @@
+"""An env that lives in a process of its own, driven through shared memory.
+
+:class:`ProcessEnv` is a gymnasium env whose ``step`` and ``reset`` run in a worker
+process: the action and the observation travel through shared memory (gymnasium's own
+layout for the space), the reward and the ends through shared numbers, the info (and the
+reset's seed and options) pickled into a shared buffer, and two semaphores say "go" and
+"done". No pipe carries a step: a round trip costs the caller a few microseconds of
+Python and one wake-up of each process.
+
+The worker builds its env itself, from a picklable factory, in a process started by
+``forkserver`` (nothing of the caller's GL contexts or threads is inherited). A step that
+raises in the worker raises :class:`WorkerError` here with the worker's one line; a
+worker that dies raises it too (never a hang: the wait checks the process).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import pickle
+import time
+from collections.abc import Callable
+from typing import Any, SupportsFloat
+
+import gymnasium
+import numpy as np
+from gymnasium.vector.utils import (
+    create_shared_memory,
+    read_from_shared_memory,
+)
+
+EnvFn = Callable[[], gymnasium.Env[Any, Any]]
+INFO_BYTES = 1 << 20
+"""Room for one pickled info (or a reset's seed and options, or an error) [bytes]."""
+POLL_S = 1.0
+"""How often a wait for the worker checks that it still lives [s]."""
+SPIN_S = 0.002
+"""How long a wait polls before it sleeps [s]: a step's answer (or the next step) usually
+comes within it, and a sleeping process takes tens of microseconds to wake."""
+STEP, RESET, CLOSE = 1, 2, 3
+FAILED = -1
+
+
+class WorkerError(RuntimeError):
+    """The worker's env raised, or the worker died (one line)."""
+
+
+class _Shared:
+    """What caller and worker share for one env."""
+
+    def __init__(self, context: Any, spaces: tuple[gymnasium.Space[Any], gymnasium.Space[Any]]):
+        observation_space, action_space = spaces
+        self.spaces = spaces
+        self.observation = create_shared_memory(observation_space, n=1, ctx=context)
+        self.action = create_shared_memory(action_space, n=1, ctx=context)
+        self.numbers = context.RawArray("d", 4)  # reward, terminated, truncated, status
+        self.buffer = context.RawArray("B", INFO_BYTES)
+        self.length: Any = context.RawValue("q", 0)
+        self.command: Any = context.RawValue("i", 0)
+        self.go = context.Semaphore(0)
+        self.done = context.Semaphore(0)
+
+    def put(self, value: object) -> None:
+        data = pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
+        if len(data) > INFO_BYTES:
+            raise WorkerError(f"{len(data)} bytes to pass; at most {INFO_BYTES}")
+        memoryview(self.buffer).cast("B")[: len(data)] = data
+        self.length.value = len(data)
+
+    def take(self) -> Any:
+        return pickle.loads(bytes(memoryview(self.buffer).cast("B")[: self.length.value]))
+
+
+def _serve(make: EnvFn, shared: _Shared) -> None:
+    """The worker: build the env, then run each command until CLOSE."""
+    env = make()
+    observation_space, action_space = shared.spaces
+    actions = read_from_shared_memory(action_space, shared.action, n=1)  # views, made once
+    observations = read_from_shared_memory(observation_space, shared.observation, n=1)
+    while True:
+        if not _polled(shared.go):
+            shared.go.acquire()
+        command = shared.command.value
+        try:
+            if command == CLOSE:
+                env.close()
+                shared.done.release()
+                return
+            if command == RESET:
+                seed, options = shared.take()
+                observation, info = env.reset(seed=seed, options=options)
+                reward: SupportsFloat = 0.0
+                terminated, truncated = False, False
+            else:
+                action = _first(actions)
+                observation, reward, terminated, truncated, info = env.step(action)
+            _put_first(observations, observation)
+            shared.numbers[:] = [float(reward), float(terminated), float(truncated), 0.0]
+            shared.put(dict(info))
+        except Exception as error:  # told to the caller in one line
+            shared.numbers[3] = FAILED
+            shared.put(f"{type(error).__name__}: {error}")
+        shared.done.release()
+
+
+class ProcessEnv(gymnasium.Env[Any, Any]):
+    """The env ``make`` builds, in a worker process (see the module doc)."""
+
+    def __init__(
+        self,
+        make: EnvFn,
+        spaces: tuple[gymnasium.Space[Any], gymnasium.Space[Any]],
+        start_method: str = "forkserver",
+    ) -> None:
+        """``make``: a picklable factory; ``spaces``: its env's (observation, action)
+        spaces, as the caller knows them (a probe env built once)."""
+        context: Any = multiprocessing.get_context(start_method)
+        self.observation_space, self.action_space = spaces
+        self._shared = _Shared(context, spaces)
+        self._observations = read_from_shared_memory(
+            self.observation_space, self._shared.observation, n=1
+        )
+        self._actions = read_from_shared_memory(self.action_space, self._shared.action, n=1)
+        self._process = context.Process(target=_serve, args=(make, self._shared), daemon=True)
+        self._process.start()
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        self.post_reset(seed, options)
+        observation, _, _, _, info = self.collect()
+        return observation, info
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        self.post_step(action)
+        return self.collect()
+
+    def post_step(self, action: Any) -> None:
+        """Start a step with ``action`` in the worker; :meth:`collect` its result."""
+        _put_first(self._actions, action)
+        self._post(STEP)
+
+    def post_reset(self, seed: int | None, options: dict[str, Any] | None) -> None:
+        """Start a reset in the worker; :meth:`collect` its result (no reward, no end)."""
+        self._shared.put((seed, options))
+        self._post(RESET)
+
+    def collect(self) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        """Wait for the command posted last; (observation, reward, terminated, truncated,
+        info).
+
+        Raises:
+            WorkerError: The env raised, or its process died.
+        """
+        shared = self._shared
+        self._wait()
+        if shared.numbers[3] == FAILED:
+            raise WorkerError(f"the env in process {self._process.pid} raised {shared.take()}")
+        reward, terminated, truncated, _ = shared.numbers
+        return _first(self._observations), reward, bool(terminated), bool(truncated), shared.take()
+
+    def close(self) -> None:
+        if self._process.is_alive():
+            self._shared.command.value = CLOSE
+            self._shared.go.release()
+            self._wait()
+        self._process.join(5.0)
+        if self._process.is_alive():
+            self._process.kill()
+
+    def _post(self, command: int) -> None:
+        self._shared.command.value = command
+        self._shared.go.release()
+
+    def _wait(self) -> None:
+        if _polled(self._shared.done):
+            return
+        while not self._shared.done.acquire(timeout=POLL_S):
+            if not self._process.is_alive():
+                raise WorkerError(
+                    f"the env's process {self._process.pid} died "
+                    f"(exit code {self._process.exitcode})"
+                )
+
+
+def _polled(semaphore: Any) -> bool:
+    """Take ``semaphore`` if it is released within :data:`SPIN_S` (polling)."""
+    deadline = time.perf_counter() + SPIN_S
+    while time.perf_counter() < deadline:
+        if semaphore.acquire(False):
+            return True
+    return False
+
+
+def _put_first(batch: Any, value: Any) -> None:
+    """Write ``value`` into the one slot of a batch of views into shared memory."""
+    if isinstance(batch, dict):
+        for key, part in batch.items():
+            _put_first(part, value[key])
+    elif isinstance(batch, tuple):
+        for part, item in zip(batch, value, strict=True):
+            _put_first(part, item)
+    else:
+        batch[0] = value
+
+
+def _first(batch: Any) -> Any:
+    """A copy of the one value in a batch of one read from shared memory (the next step
+    overwrites the memory)."""
+    if isinstance(batch, dict):
+        return {key: _first(value) for key, value in batch.items()}
+    if isinstance(batch, tuple):
+        return tuple(_first(value) for value in batch)
+    return np.array(batch[0], copy=True)

@@ -1,0 +1,142 @@
+"""A vector env that scales with cores: one env in this process, each other in a process
+of its own (:class:`~openral_eval.process_env.ProcessEnv`), all stepping at once.
+
+A step posts every worker's action (shared memory, a semaphore), steps the first env here
+meanwhile, then collects the workers' results; one thread does it all, so Python's lock
+never holds a worker back and no thread waits for it. Measured on the franka tabletop,
+cameras off, on 2 cores: 1.86x one env's steps per second, where two bare ``mj_step``
+threads reach 1.94-1.97x (``just bench-env``); gymnasium's ``AsyncVectorEnv`` (pipes)
+1.33x, the threaded :class:`~openral_eval.thread_vector_env.ThreadVectorEnv` 1.00x.
+
+It is gymnasium's ``SyncVectorEnv`` otherwise (spaces, seeding, info batching), with the
+``next_step`` (default) and ``disabled`` autoreset modes, and gives the same results for the
+same seeds and actions. A worker polls for its next step for
+:data:`~openral_eval.process_env.SPIN_S` before it sleeps, so it keeps a core busy while
+the vector env is stepped.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import gymnasium
+import numpy as np
+from gymnasium.vector import AutoresetMode
+from gymnasium.vector.utils import concatenate, iterate
+
+from openral_eval.process_env import ProcessEnv
+from openral_eval.thread_vector_env import Info, StepBatch, ThreadVectorEnv, _seeds
+
+
+class ProcessVectorEnv(ThreadVectorEnv):
+    """Env 0 here, the others in worker processes (see the module doc)."""
+
+    def __init__(
+        self, make: Callable[[], gymnasium.Env[Any, Any]], num_envs: int, **kwargs: Any
+    ) -> None:
+        """``num_envs`` envs of ``make`` (a picklable factory, e.g. a ``functools.partial``
+        of :func:`~openral_eval.scene_env.make_env`); ``kwargs`` as ``SyncVectorEnv`` takes
+        them.
+
+        Raises:
+            ValueError: ``num_envs`` below 1, or the ``same_step`` autoreset mode.
+        """
+        if num_envs < 1:
+            raise ValueError(f"num_envs is {num_envs}; expected at least 1")
+        mode = AutoresetMode(kwargs.get("autoreset_mode", AutoresetMode.NEXT_STEP))
+        if mode == AutoresetMode.SAME_STEP:
+            raise ValueError("ProcessVectorEnv takes the next_step or disabled autoreset mode")
+        local = make()
+        spaces = (local.observation_space, local.action_space)
+        envs = [local, *(ProcessEnv(make, spaces) for _ in range(num_envs - 1))]
+        super().__init__([_given(env) for env in envs], **kwargs)
+
+    def reset(
+        self, *, seed: int | list[int | None] | None = None, options: Info | None = None
+    ) -> tuple[Any, Info]:
+        """Reset every env at once (``seed``: as ``SyncVectorEnv`` takes it)."""
+        if options is not None and "reset_mask" in options:
+            return super().reset(seed=seed, options=options)
+        seeds = _seeds(seed, self.num_envs)
+        for i, env in self._workers():
+            env.post_reset(seeds[i], options)
+        self._env_obs[0], first = self.envs[0].reset(seed=seeds[0], options=options)
+        infos = self._add_info({}, dict(first), 0)
+        for i, env in self._workers():
+            self._env_obs[i], _, _, _, info = env.collect()
+            infos = self._add_info(infos, info, i)
+        self._terminations = np.zeros((self.num_envs,), dtype=np.bool_)
+        self._truncations = np.zeros((self.num_envs,), dtype=np.bool_)
+        self._autoreset_envs = np.zeros((self.num_envs,), dtype=np.bool_)
+        self._observations = concatenate(
+            self.single_observation_space, self._env_obs, self._observations
+        )
+        return self._observations_out(), infos
+
+    def step(self, actions: Any) -> StepBatch:
+        """Step every env at once with its action (autoreset as ``SyncVectorEnv``)."""
+        batch = list(iterate(self.action_space, actions))
+        resetting = {i: self._posted(i, env, batch[i]) for i, env in self._workers()}
+        infos: Info = {}
+        for part in self._step_one(0, batch[0]):
+            infos = self._add_info(infos, part, 0)
+        for i, env in self._workers():
+            obs, reward, terminated, truncated, info = env.collect()
+            self._env_obs[i] = obs
+            self._rewards[i] = 0.0 if resetting[i] else reward
+            self._terminations[i], self._truncations[i] = terminated, truncated
+            infos = self._add_info(infos, info, i)
+        for i, obs in enumerate(self._env_obs):  # as concatenate does, for a few 10 us less
+            _place(self._observations, i, obs)
+        self._autoreset_envs = np.logical_or(self._terminations, self._truncations)
+        return (
+            self._observations_out(),
+            np.copy(self._rewards),
+            np.copy(self._terminations),
+            np.copy(self._truncations),
+            infos,
+        )
+
+    def _posted(self, i: int, env: ProcessEnv, action: Any) -> bool:
+        """Start env ``i``'s share of a step; True when it is an autoreset."""
+        if self._autoreset_envs[i]:
+            if self.autoreset_mode == AutoresetMode.DISABLED:
+                raise AssertionError(f"env {i} needs a reset first")
+            env.post_reset(None, None)
+            return True
+        env.post_step(action)
+        return False
+
+    def _workers(self) -> list[tuple[int, ProcessEnv]]:
+        """(index, env) of every env in a worker process."""
+        return [(i, env) for i, env in enumerate(self.envs) if isinstance(env, ProcessEnv)]
+
+    def _observations_out(self) -> Any:
+        return _copied(self._observations) if self.copy else self._observations
+
+
+def _given(env: gymnasium.Env[Any, Any]) -> Callable[[], gymnasium.Env[Any, Any]]:
+    """A factory that returns ``env`` (``SyncVectorEnv`` takes factories)."""
+    return lambda: env
+
+
+def _place(batch: Any, i: int, value: Any) -> None:
+    """Write one env's observation into slot ``i`` of the batch (dicts, tuples, arrays)."""
+    if isinstance(batch, dict):
+        for key, part in batch.items():
+            _place(part, i, value[key])
+    elif isinstance(batch, tuple):
+        for part, item in zip(batch, value, strict=True):
+            _place(part, i, item)
+    else:
+        batch[i] = value
+
+
+def _copied(batch: Any) -> Any:
+    """A copy of a batch of observations (what ``deepcopy`` gives, in less time)."""
+    if isinstance(batch, dict):
+        return {key: _copied(part) for key, part in batch.items()}
+    if isinstance(batch, tuple):
+        return tuple(_copied(part) for part in batch)
+    return np.array(batch, copy=True)

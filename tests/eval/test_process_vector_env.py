@@ -1,0 +1,80 @@
+"""The process vector env gives what gymnasium's SyncVectorEnv gives for the same seeds and
+actions (observations, rewards, ends, autoreset), with every env but the first in a worker
+process; a worker whose env raises, or that dies, is one line, never a hang."""
+
+from __future__ import annotations
+
+import os
+import signal
+from functools import partial
+
+import gymnasium
+import pytest
+from openral_eval import make_process_vector_env
+from openral_eval.process_env import ProcessEnv, WorkerError
+from openral_eval.scene_env import make_env
+
+from tests.conftest import ROBOTS
+from tests.eval.vector_checks import steps_like_sync_vector_env
+
+FRANKA = str(ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml")
+
+
+def test_it_steps_as_sync_vector_env_does_autoreset_included() -> None:
+    config = {"sensors": False, "max_steps": 6, "reward_mode": "dense"}
+    processes = make_process_vector_env(FRANKA, 3, **config)
+    plain = gymnasium.vector.SyncVectorEnv([partial(make_env, FRANKA, **config)] * 3)
+    try:
+        assert sum(isinstance(env, ProcessEnv) for env in processes.envs) == 2
+        steps_like_sync_vector_env(processes, plain)
+    finally:
+        processes.close()
+        plain.close()
+    assert not any(env._process.is_alive() for env in processes.envs[1:])
+
+
+class _Breaks(gymnasium.Wrapper):  # type: ignore[type-arg]
+    """Raises at its third step."""
+
+    def __init__(self, env: gymnasium.Env) -> None:  # type: ignore[type-arg]
+        super().__init__(env)
+        self.steps = 0
+
+    def step(self, action):  # type: ignore[no-untyped-def]
+        self.steps += 1
+        if self.steps == 3:
+            raise ValueError("the third step broke")
+        return super().step(action)
+
+
+def _breaking() -> gymnasium.Env:  # type: ignore[type-arg]
+    return _Breaks(make_env(FRANKA, sensors=False))
+
+
+def test_a_worker_whose_env_raises_or_dies_is_one_line() -> None:
+    local = make_env(FRANKA, sensors=False)
+    spaces = (local.observation_space, local.action_space)
+    env = ProcessEnv(_breaking, spaces)
+    try:
+        env.reset(seed=0)
+        action = local.action_space.sample()
+        env.step(action)
+        env.step(action)
+        with pytest.raises(WorkerError, match=r"raised ValueError: the third step broke"):
+            env.step(action)
+        env.step(action)  # the worker goes on after a failed step
+        os.kill(env._process.pid, signal.SIGKILL)
+        with pytest.raises(WorkerError, match=r"died \(exit code -9\)"):
+            env.step(action)
+    finally:
+        env.close()
+        local.close()
+
+
+def test_the_same_step_autoreset_mode_is_refused_in_one_line() -> None:
+    with pytest.raises(ValueError, match="takes the next_step or disabled autoreset mode"):
+        from openral_eval.process_vector_env import ProcessVectorEnv
+
+        ProcessVectorEnv(partial(make_env, FRANKA, sensors=False), 2, autoreset_mode="SameStep")
+    with pytest.raises(ValueError, match="num_envs is 0"):
+        make_process_vector_env(FRANKA, 0)

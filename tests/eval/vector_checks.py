@@ -1,0 +1,33 @@
+"""The check both of this project's vector envs pass: step for step what gymnasium's
+SyncVectorEnv gives for the same seeds and actions, past an autoreset."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium
+import numpy as np
+
+
+def steps_like_sync_vector_env(vector: Any, plain: gymnasium.vector.SyncVectorEnv) -> None:
+    """Reset both with one seed per env, then 9 steps of the same random actions (the envs'
+    limit is 6 steps: every env resets on the 7th); observations, rewards, ends and
+    successes must be equal."""
+    seeds = [3 + i for i in range(vector.num_envs)]
+    a, a_info = vector.reset(seed=seeds)
+    b, b_info = plain.reset(seed=seeds)
+    for key in ("joint_positions", "tcp_pose"):
+        np.testing.assert_array_equal(a[key], b[key])
+    assert list(a_info["seed"]) == list(b_info["seed"]) == seeds
+    vector.action_space.seed(0)
+    ends = []
+    for _ in range(9):
+        action = vector.action_space.sample()
+        a, ra, ta, ua, ia = vector.step(action)
+        b, rb, tb, ub, ib = plain.step(action)
+        np.testing.assert_array_equal(a["joint_positions"], b["joint_positions"])
+        np.testing.assert_array_equal(ra, rb)
+        assert (ta == tb).all() and (ua == ub).all()
+        assert list(ia["is_success"]) == list(ib["is_success"])
+        ends.append(bool(ua.all()))
+    assert ends == [False] * 5 + [True] + [False] * 3
