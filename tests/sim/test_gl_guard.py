@@ -147,3 +147,33 @@ def test_a_scene_rendered_on_one_thread_renders_on_another() -> None:
         scene.close()
     assert len(there) == 1 and not isinstance(there[0], Exception), there
     assert (there[0] == here).all() and (again == here).all()  # type: ignore[union-attr]
+
+
+ENDED_DISPLAY = """
+import mujoco
+from mujoco import egl
+from openral_sim.gl_guard import close_renderer, open_renderer
+
+model = mujoco.MjModel.from_xml_string("<mujoco><worldbody><geom size='1'/></worldbody></mujoco>")
+kept = open_renderer(model, 32, 32)  # left to the exit hook
+closed = open_renderer(model, 32, 32)
+egl.EGL.eglTerminate(egl.EGL_DISPLAY)  # what robosuite's exit hook does, before ours
+close_renderer(closed)
+print("closed")
+"""
+
+
+def test_renderers_close_quietly_after_another_library_ended_the_display() -> None:
+    """robosuite ends the process's EGL display in an exit hook of its own; a renderer of
+    ours closed after it (by us, the exit hook or the collector) says nothing: before, each
+    printed an EGL_NOT_INITIALIZED traceback at the end of a test run."""
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "MUJOCO_GL": "egl"}
+    done = subprocess.run(
+        [sys.executable, "-c", ENDED_DISPLAY], capture_output=True, text=True, env=env, timeout=60
+    )
+    assert done.returncode == 0 and done.stdout.strip() == "closed", done.stderr
+    assert done.stderr == ""

@@ -36,7 +36,7 @@ import contextlib
 import os
 import threading
 import weakref
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 import mujoco
@@ -106,12 +106,13 @@ def _release_current() -> None:
         from mujoco import egl
 
         if egl.EGL_DISPLAY is not None:
-            egl.EGL.eglMakeCurrent(
-                egl.EGL_DISPLAY,
-                egl.EGL.EGL_NO_SURFACE,
-                egl.EGL.EGL_NO_SURFACE,
-                egl.EGL.EGL_NO_CONTEXT,
-            )
+            with _unless_display_ended():
+                egl.EGL.eglMakeCurrent(
+                    egl.EGL_DISPLAY,
+                    egl.EGL.EGL_NO_SURFACE,
+                    egl.EGL.EGL_NO_SURFACE,
+                    egl.EGL.EGL_NO_CONTEXT,
+                )
     elif backend == "osmesa":
         from OpenGL import GL, osmesa  # type: ignore[import-untyped]
 
@@ -138,9 +139,38 @@ def open_renderer(model: mujoco.MjModel, height: int, width: int) -> mujoco.Rend
 
 def close_renderer(renderer: mujoco.Renderer) -> None:
     """Free ``renderer``'s context holding :data:`GL_LOCK` (idempotent)."""
-    with gl_turn():
+    with gl_turn(), _unless_display_ended(lambda: _forget(renderer)):
         renderer.close()
     _open.discard(renderer)
+
+
+EGL_NOT_INITIALIZED = 0x3001
+"""EGL's error for a display that was ended (``eglTerminate``)."""
+
+
+@contextmanager
+def _unless_display_ended(then: Callable[[], None] | None = None) -> Iterator[None]:
+    """Let an EGL call fail quietly when the display was ended, and run ``then``: at exit,
+    robosuite ends the process's one EGL display (its own exit hook, registered when it
+    made its context: after ours if its scene came after a native one), and every context
+    is gone with it. Any other failure is raised."""
+    try:
+        yield
+    except Exception as error:
+        if getattr(error, "err", None) != EGL_NOT_INITIALIZED:
+            raise
+        if then is not None:
+            then()
+
+
+def _forget(renderer: mujoco.Renderer) -> None:
+    """Drop a renderer's contexts without freeing them (the display that held them was
+    ended), so that neither it nor its context tries again when collected."""
+    context = getattr(renderer, "_gl_context", None)
+    if context is not None and hasattr(context, "_context"):
+        context._context = None
+    for attribute in ("_gl_context", "_mjr_context"):  # mujoco.Renderer's own (3.8)
+        setattr(renderer, attribute, None)
 
 
 def _close_open_renderers() -> None:
