@@ -78,3 +78,35 @@ def test_the_same_step_autoreset_mode_is_refused_in_one_line() -> None:
         ProcessVectorEnv(partial(make_env, FRANKA, sensors=False), 2, autoreset_mode="SameStep")
     with pytest.raises(ValueError, match="num_envs is 0"):
         make_process_vector_env(FRANKA, 0)
+
+
+ORPHAN = f"""
+import time
+from openral_eval import make_process_vector_env
+
+envs = make_process_vector_env({FRANKA!r}, 2, sensors=False)
+envs.reset(seed=0)
+print(envs.envs[1]._process.pid, flush=True)
+time.sleep(60)
+"""
+
+
+def test_a_worker_ends_when_the_process_that_made_it_is_killed() -> None:
+    import subprocess
+    import sys
+    import time
+
+    maker = subprocess.Popen([sys.executable, "-c", ORPHAN], stdout=subprocess.PIPE, text=True)
+    assert maker.stdout is not None
+    worker = int(maker.stdout.readline())
+    os.kill(worker, 0)  # alive
+    maker.kill()
+    maker.wait(10)
+    deadline = time.monotonic() + 15.0
+    while time.monotonic() < deadline:
+        try:
+            os.kill(worker, 0)
+        except ProcessLookupError:
+            return
+        time.sleep(0.1)
+    pytest.fail(f"worker {worker} outlived the process that made it")

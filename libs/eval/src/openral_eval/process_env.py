@@ -10,13 +10,16 @@ Python and one wake-up of each process.
 The worker builds its env itself, from a picklable factory, in a process started by
 ``forkserver`` (nothing of the caller's GL contexts or threads is inherited). A step that
 raises in the worker raises :class:`WorkerError` here with the worker's one line; a
-worker that dies raises it too (never a hang: the wait checks the process).
+worker that dies raises it too (never a hang: the wait checks the process). A worker
+ends itself within :data:`CALLER_POLL_S` of the caller's death, even by SIGKILL.
 """
 
 from __future__ import annotations
 
 import multiprocessing
+import os
 import pickle
+import threading
 import time
 from collections.abc import Callable
 from typing import Any, SupportsFloat
@@ -31,6 +34,8 @@ from gymnasium.vector.utils import (
 EnvFn = Callable[[], gymnasium.Env[Any, Any]]
 INFO_BYTES = 1 << 20
 """Room for one pickled info (or a reset's seed and options, or an error) [bytes]."""
+CALLER_POLL_S = 1.0
+"""How often a worker checks that the process that made it still lives [s]."""
 POLL_S = 1.0
 """How often a wait for the worker checks that it still lives [s]."""
 SPIN_S = 0.002
@@ -70,8 +75,23 @@ class _Shared:
         return pickle.loads(bytes(memoryview(self.buffer).cast("B")[: self.length.value]))
 
 
-def _serve(make: EnvFn, shared: _Shared) -> None:
+def _watch(caller: int) -> None:
+    """End this worker once process ``caller`` is gone (killed, even by SIGKILL: its
+    forkserver, this worker's parent, may outlive it)."""
+    while True:
+        time.sleep(CALLER_POLL_S)
+        try:
+            os.kill(caller, 0)
+        except ProcessLookupError:
+            os._exit(1)
+        except PermissionError:
+            pass  # alive, another user's: cannot be ours, but not gone either
+
+
+def _serve(make: EnvFn, shared: _Shared, caller: int) -> None:
     """The worker: build the env, then run each command until CLOSE."""
+    watch = threading.Thread(target=_watch, args=(caller,), name="openral-watch", daemon=True)
+    watch.start()
     env = make()
     observation_space, action_space = shared.spaces
     actions = read_from_shared_memory(action_space, shared.action, n=1)  # views, made once
@@ -120,7 +140,9 @@ class ProcessEnv(gymnasium.Env[Any, Any]):
             self.observation_space, self._shared.observation, n=1
         )
         self._actions = read_from_shared_memory(self.action_space, self._shared.action, n=1)
-        self._process = context.Process(target=_serve, args=(make, self._shared), daemon=True)
+        self._process = context.Process(
+            target=_serve, args=(make, self._shared, os.getpid()), daemon=True
+        )
         self._process.start()
 
     def reset(
