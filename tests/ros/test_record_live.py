@@ -57,6 +57,8 @@ class Counter:
 
     def __init__(self, node: Node) -> None:
         self.stamps: dict[str, list[int]] = {topic: [] for topic in TOPICS}
+        self.raws: dict[str, list[bytes]] = {topic: [] for topic in TOPICS}
+        """Each message's serialised bytes (a message's stamp makes them its own)."""
         self.lock = threading.Lock()
         self.subscriptions = [
             node.create_subscription(cls, topic, self._taker(topic), _qos(topic), raw=True)
@@ -64,9 +66,10 @@ class Counter:
         ]
 
     def _taker(self, topic: str):  # type: ignore[no-untyped-def]
-        def take(_: bytes) -> None:
+        def take(raw: bytes) -> None:
             with self.lock:
                 self.stamps[topic].append(time.time_ns())
+                self.raws[topic].append(bytes(raw))
 
         return take
 
@@ -115,6 +118,7 @@ def test_the_bag_holds_what_an_outside_subscriber_counted(
     found = _bag(bag)
     with counter.lock:
         seen = {topic: list(stamps) for topic, stamps in counter.stamps.items()}
+        raws = {topic: list(raw) for topic, raw in counter.raws.items()}
     assert all(seen.values()), {t: len(s) for t, s in seen.items()}
     assert set(seen) <= set(found), set(seen) - set(found)
     first = max(min(s) for s in seen.values() if len(s) > 1) + EDGE_S * 1e9
@@ -124,10 +128,13 @@ def test_the_bag_holds_what_an_outside_subscriber_counted(
         if len(stamps) <= 1:  # latched: one message each
             assert len(found[topic]) == 1, topic
             continue
-        ours = sum(first <= s <= last for s in stamps)
-        bagged = sum(first <= s <= last for s, _, _ in found[topic])
-        print(f"{topic}: {ours} seen outside, {bagged} in the bag")
-        assert abs(ours - bagged) <= 2, f"{topic}: {bagged} in the bag, {ours} seen outside"
+        ours = [raw for s, raw in zip(stamps, raws[topic], strict=True) if first <= s <= last]
+        bagged = {raw for _, raw, _ in found[topic]}
+        missing = sum(raw not in bagged for raw in ours)
+        print(f"{topic}: {len(ours)} seen outside in the window, {missing} of them not in the bag")
+        # by content, not by count over a time window: two processes' receive times differ by
+        # the delivery's jitter, which moved up to 8 messages across the window's edges
+        assert missing == 0, f"{topic}: {missing} of {len(ours)} seen outside not in the bag"
     _, raw, msgtype = found[f"{CAMERA}/image"][0]
     image = typestore().deserialize_cdr(raw, msgtype)
     pixels = np.asarray(image.data).reshape(image.height, image.width, 3)
