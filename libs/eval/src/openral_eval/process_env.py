@@ -111,9 +111,9 @@ def _serve(make: EnvFn, shared: _Shared, caller: int) -> None:
                 reward: SupportsFloat = 0.0
                 terminated, truncated = False, False
             else:
-                action = _first(actions)
+                action = copied(actions, 0)
                 observation, reward, terminated, truncated, info = env.step(action)
-            _put_first(observations, observation)
+            place(observations, 0, observation)
             shared.numbers[:] = [float(reward), float(terminated), float(truncated), 0.0]
             shared.put(dict(info))
         except Exception as error:  # told to the caller in one line
@@ -158,7 +158,7 @@ class ProcessEnv(gymnasium.Env[Any, Any]):
 
     def post_step(self, action: Any) -> None:
         """Start a step with ``action`` in the worker; :meth:`collect` its result."""
-        _put_first(self._actions, action)
+        place(self._actions, 0, action)
         self._post(STEP)
 
     def post_reset(self, seed: int | None, options: dict[str, Any] | None) -> None:
@@ -178,7 +178,8 @@ class ProcessEnv(gymnasium.Env[Any, Any]):
         if shared.numbers[3] == FAILED:
             raise WorkerError(f"the env in process {self._process.pid} raised {shared.take()}")
         reward, terminated, truncated, _ = shared.numbers
-        return _first(self._observations), reward, bool(terminated), bool(truncated), shared.take()
+        observation = copied(self._observations, 0)
+        return observation, reward, bool(terminated), bool(truncated), shared.take()
 
     def close(self) -> None:
         if self._process.is_alive():
@@ -213,23 +214,23 @@ def _polled(semaphore: Any) -> bool:
     return False
 
 
-def _put_first(batch: Any, value: Any) -> None:
-    """Write ``value`` into the one slot of a batch of views into shared memory."""
+def place(batch: Any, i: int, value: Any) -> None:
+    """Write one env's ``value`` into slot ``i`` of a batch (dicts, tuples, arrays)."""
     if isinstance(batch, dict):
         for key, part in batch.items():
-            _put_first(part, value[key])
+            place(part, i, value[key])
     elif isinstance(batch, tuple):
         for part, item in zip(batch, value, strict=True):
-            _put_first(part, item)
+            place(part, i, item)
     else:
-        batch[0] = value
+        batch[i] = value
 
 
-def _first(batch: Any) -> Any:
-    """A copy of the one value in a batch of one read from shared memory (the next step
-    overwrites the memory)."""
+def copied(batch: Any, i: int | None = None) -> Any:
+    """A copy of a batch (dicts, tuples, arrays), or of its slot ``i`` only (a batch read
+    from shared memory: the next step overwrites it)."""
     if isinstance(batch, dict):
-        return {key: _first(value) for key, value in batch.items()}
+        return {key: copied(part, i) for key, part in batch.items()}
     if isinstance(batch, tuple):
-        return tuple(_first(value) for value in batch)
-    return np.array(batch[0], copy=True)
+        return tuple(copied(part, i) for part in batch)
+    return np.array(batch if i is None else batch[i], copy=True)
