@@ -119,4 +119,3 @@ class ProcessVectorEnv(ThreadVectorEnv):
 def _given(env: gymnasium.Env[Any, Any]) -> Callable[[], gymnasium.Env[Any, Any]]:
     """A factory that returns ``env`` (``SyncVectorEnv`` takes factories)."""
     return lambda: env
-
