@@ -64,7 +64,11 @@ def test_one_graph_wave_a_three_point_goal_estop_and_a_clean_stop(
             _joint_states_are_fresh_at_the_read_rate(remote)
             _cameras_publish(remote)
             _wave_moves_the_servos(bus, remote)
-            _three_point_goal(remote, client)
+            try:
+                _three_point_goal(remote, client)
+            except AssertionError:
+                print("deploy real said:", stop(process)[1][-3000:])
+                raise
             _estop_release_and_reset(client)
             stopped = time.time()
             out, err = stop(process)
@@ -121,8 +125,8 @@ def _three_point_goal(remote: Remote, node: Node) -> None:
             (2.0, [start[j] - 0.2 for j in ARM]),
             (3.0, [start[j] + 0.4 for j in ARM]),
         ]
-        status, _, _ = client.run(goal(ARM, points, goal_tolerance=0.02, goal_time_s=1.0))
-        assert status == SUCCEEDED
+        status, result, _ = client.run(goal(ARM, points, goal_tolerance=0.02, goal_time_s=1.0))
+        assert status == SUCCEEDED, (result.error_code, result.error_string)
         reached = joints_now(remote)
         for joint, wanted in zip(ARM, points[-1][1], strict=True):
             assert reached[joint] == pytest.approx(wanted, abs=0.02)

@@ -58,3 +58,31 @@ def test_a_late_reply_taken_for_another_is_a_failed_try_not_a_crash(rig: Rig) ->
             bus.check_motors()
     finally:
         bus.close()
+
+
+def _single_reads(rig: Rig) -> list[int]:
+    """The motors asked for their present block on their own (the emulator's log)."""
+    reads = [line.split() for line in rig.bus.lines if " READ " in f" {line} "]
+    return [int(words[-3]) for words in reads if words[-2] == "Present_Position"]
+
+
+def test_a_garbled_reply_in_a_sync_read_is_asked_again_with_the_motors_after_it(
+    rig: Rig,
+) -> None:
+    """Motor 2's reply to the Sync Read fails its checksum: it is asked alone, and so are
+    motors 3 to 6, whose replies were flushed with it (before, the next motor seemed silent:
+    its reply had been flushed or waded through by the SDK)."""
+    bus = open_bus(rig.robot, rig.path)
+    try:
+        first = bus.read_present()
+        rig.bus.emulator.garbled[2] = 1
+        asked_before = len(_single_reads(rig))
+        again = bus.read_present()
+        assert rig.bus.emulator.garbled[2] == 0
+        assert _single_reads(rig)[asked_before:] == [2, 3, 4, 5, 6]
+        assert len(again) == 6
+        for before, after in zip(first, again, strict=True):
+            assert abs(after.position - before.position) <= 2  # the arm holds still [steps]
+        assert len(bus.read_present()) == 6 and len(_single_reads(rig)) == asked_before + 5
+    finally:
+        bus.close()

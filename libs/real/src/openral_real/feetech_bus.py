@@ -216,8 +216,9 @@ class FeetechBus:
     # -- the present block -------------------------------------------------------------------
 
     def read_present(self) -> list[ServoReading]:
-        """Every motor's present block in one Sync Read (a corrupt reply is read again once,
-        on its own).
+        """Every motor's present block in one Sync Read. A corrupt reply, or one missed while
+        this thread was held up, is asked for again on its own, and so are the motors after
+        it (their replies are flushed with it).
 
         Raises:
             BusFault: A motor did not answer, answered corrupt twice, or the port failed.
@@ -229,14 +230,12 @@ class FeetechBus:
             self._dirty = False
         result = self._call(self._packets.syncReadTx, self._port, address, length, ids, len(ids))
         self._check(None, result, 0, "sending the Sync Read")
-        readings = []
+        readings, alone = [], False
         for servo_id in ids:
-            data, result, error = self._receive(servo_id, length)
-            if result == scs.COMM_RX_CORRUPT:  # once more, on its own
-                self._port.setPacketTimeoutMillis(self._reply_ms(length) + self._byte_ms * 8)
-                data, result, error = self._call(
-                    self._packets.readTxRx, self._port, servo_id, address, length
-                )
+            if not alone:
+                data, result, error, alone = self._receive(servo_id, length)
+            if alone:  # asked again; the Sync Read's replies still to come are flushed
+                data, result, error = self._alone(servo_id, length)
             self._dirty = result != scs.COMM_SUCCESS
             self._check(servo_id, result, 0, "reading its present state")
             readings.append(self._reading(bytes(data[:length]), error))
@@ -244,22 +243,29 @@ class FeetechBus:
 
     # -- internals ---------------------------------------------------------------------------
 
-    def _receive(self, servo_id: int, length: int) -> tuple[list[int], int, int]:
-        """One motor's reply to the Sync Read. A failure that took far longer than the
-        timeout itself means this thread was held up (Python's lock, the scheduler) while
-        the reply came and went by: that motor is asked once more, on its own."""
+    def _receive(self, servo_id: int, length: int) -> tuple[list[int], int, int, bool]:
+        """One motor's reply to the Sync Read, and whether to ask it again on its own: a
+        corrupt reply, or a failure when the wait took far longer than the timeout itself
+        (this thread was held up by Python's lock or the scheduler while the reply came and
+        went by)."""
         reply_ms = self._reply_ms(length)
         began = time.monotonic()
         self._port.setPacketTimeoutMillis(reply_ms)
         data, result, error = self._call(self._packets.readRx, self._port, servo_id, length)
         held_up = (time.monotonic() - began) * 1000.0 > reply_ms + STALL_MS
-        if result != scs.COMM_SUCCESS and held_up:
-            self._call(self._port.ser.reset_input_buffer)
-            self._port.setPacketTimeoutMillis(reply_ms + self._byte_ms * 8)
-            address = self._present[0]
-            data, result, error = self._call(
-                self._packets.readTxRx, self._port, servo_id, address, length
-            )
+        again = result == scs.COMM_RX_CORRUPT or (result != scs.COMM_SUCCESS and held_up)
+        return data, result, error, again
+
+    def _alone(self, servo_id: int, length: int) -> tuple[list[int], int, int]:
+        """Ask one motor for its present block on its own, once. The port's input is
+        flushed first: the Sync Read's replies of the motors after it (the SDK would wade
+        through them, and take none as this one's) are then asked for alone as well."""
+        self._call(self._port.ser.reset_input_buffer)
+        self._port.setPacketTimeoutMillis(self._reply_ms(length) + self._byte_ms * 8)
+        address = self._present[0]
+        data, result, error = self._call(
+            self._packets.readTxRx, self._port, servo_id, address, length
+        )
         return data, result, error
 
     def _reading(self, block: bytes, error: int) -> ServoReading:

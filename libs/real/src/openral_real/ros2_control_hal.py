@@ -382,3 +382,9 @@ class Ros2ControlHal(ManifestArm):
         """When the newest reading arrived [s, ``time.monotonic()``]."""
         with self._lock:
             return self._received_s
+
+    @property
+    def readings(self) -> int:
+        """Fresh readings taken since :meth:`connect` (each one writes a goal while running)."""
+        with self._lock:
+            return self._readings

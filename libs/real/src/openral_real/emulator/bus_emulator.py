@@ -80,6 +80,8 @@ class BusEmulator:
         self.lost: dict[int, int] = {}
         """Servo id → how many of its next replies are lost on the wire (noise); the
         request itself is obeyed."""
+        self.garbled: dict[int, int] = {}
+        """Servo id → how many of its next replies arrive with a wrong checksum (noise)."""
         self._draw = random.Random(seed)
         self._registered: dict[int, tuple[int, bytes]] = {}
         self._names = {address: name for name, (address, _) in model.registers.items()}
@@ -239,7 +241,10 @@ class BusEmulator:
 
     def _status(self, servo_id: int, params: bytes) -> bytes:
         data = status_packet(servo_id, self._fault_bits(servo_id), params)
-        if self.corrupt_share and self._draw.random() < self.corrupt_share:
+        garbled = self.garbled.get(servo_id, 0) > 0
+        if garbled:
+            self.garbled[servo_id] -= 1
+        if garbled or (self.corrupt_share and self._draw.random() < self.corrupt_share):
             data = data[:-1] + bytes([data[-1] ^ 0x5A])
         return data
 
