@@ -51,7 +51,7 @@ def one_round(env: SceneEnv, timings: list[float]) -> dict[str, list[float]]:
         [j.velocity_limit for j in env.robot.description.joints if isinstance(j, LimitedJoint)][:7]
     )
     obs, _ = env.reset(seed=0)
-    start = obs["tcp_pose"]
+    start = obs["observation.tcp_pose"]
     out: dict[str, list[float]] = {"move_m": [], "turn_rad": [], "speed_ratio": []}
     previous = start[:3]
     try:
@@ -60,11 +60,11 @@ def one_round(env: SceneEnv, timings: list[float]) -> dict[str, list[float]]:
             action[axis], action[6] = 0.2 * sign, -1.0
             for _ in range(20):
                 obs, *_ = env.step(action)
-                tcp = obs["tcp_pose"]
+                tcp = obs["observation.tcp_pose"]
                 out["move_m"].append(float((tcp[axis] - previous[axis]) * sign))
                 previous = tcp[:3]
                 out["turn_rad"].append(_angle(tcp[3:], start[3:]))
-                ratio = np.abs(obs["joint_velocities"][:7]) / speeds
+                ratio = np.abs(obs["observation.velocity"][:7]) / speeds
                 out["speed_ratio"].append(float(ratio.max()))
     finally:
         ee.delta = delta  # type: ignore[method-assign]

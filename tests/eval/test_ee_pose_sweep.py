@@ -36,7 +36,7 @@ class Rise:
 
     def act(self, obs):
         if self.target is None:
-            start = np.asarray(obs["tcp_pose"], dtype=np.float64)
+            start = np.asarray(obs["observation.tcp_pose"], dtype=np.float64)
             self.target = np.concatenate([start[:3] + [0.0, 0.0, 0.08], start[3:], [1.0]])
         return self.target
 

@@ -41,7 +41,7 @@ def test_render_draws_the_scene_as_it_is_even_without_sensors() -> None:
         frame = blind.render()
         assert frame is not None and frame.shape == (128, 128, 3) and frame.dtype == np.uint8
         assert frame.std() > 5.0  # a picture, not a blank
-        np.testing.assert_array_equal(frame, obs["cameras"]["agentview"])  # the same view
+        np.testing.assert_array_equal(frame, obs["observation.images.camera1"])  # agentview
         hold = blind.clipped(blind.hal.hold_action())
         hold[0] += 0.5
         for _ in range(10):

@@ -39,7 +39,7 @@ def _limits(env: SceneEnv) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def test_deltas_move_the_tcp_a_centimetre_a_step_holding_its_orientation(panda: SceneEnv) -> None:
     obs, _ = panda.reset(seed=0)
-    start = obs["tcp_pose"]
+    start = obs["observation.tcp_pose"]
     low, high, speed = _limits(panda)
     previous, moves, turns = start[:3], [], []
     for axis, sign in ((0, 1.0), (2, -1.0)):
@@ -47,11 +47,11 @@ def test_deltas_move_the_tcp_a_centimetre_a_step_holding_its_orientation(panda: 
         action[axis], action[6] = 0.2 * sign, -1.0  # 0.2 x 0.05 m = 1 cm a step; open
         for _ in range(20):  # the issue's line: 20 of +x 0.2, then 20 of -z 0.2
             obs, *_ = panda.step(action)
-            tcp = obs["tcp_pose"]
+            tcp = obs["observation.tcp_pose"]
             moves.append((tcp[:3] - previous) @ np.eye(3)[axis] * sign)
             previous = tcp[:3]
             turns.append(_angle(tcp[3:], start[3:]))
-            q, v = obs["joint_positions"][:7], obs["joint_velocities"][:7]
+            q, v = obs["observation.state"][:7], obs["observation.velocity"][:7]
             assert np.all(q >= low) and np.all(q <= high)
             assert np.all(np.abs(v) <= speed)
     assert np.all(np.abs(np.array(moves) - 0.01) <= 0.002), np.round(moves, 4)
@@ -77,23 +77,23 @@ def test_a_pose_out_of_reach_stops_at_the_edge_and_does_not_wind_up(
     left the Panda straightened against joint 4's limit, 0.27 m from its start."""
     env = panda_pose
     obs, _ = env.reset(seed=0)
-    start = obs["tcp_pose"].copy()
+    start = obs["observation.tcp_pose"].copy()
     low, high, speed = _limits(env)
     far = np.concatenate([[x, 0.0, start[2] if z is None else z], start[3:], [1.0]])
     path = []
     for _ in range(100):  # 5 s
         obs, *_ = env.step(far)
-        q, v = obs["joint_positions"][:7], obs["joint_velocities"][:7]
+        q, v = obs["observation.state"][:7], obs["observation.velocity"][:7]
         assert np.all(q >= low) and np.all(q <= high)
         assert np.all(np.abs(v) <= speed)
-        path.append(obs["tcp_pose"][:3].copy())
+        path.append(obs["observation.tcp_pose"][:3].copy())
     assert np.linalg.norm(path[-1] - path[-5]) < 0.002  # stopped
     gone = np.linalg.norm(start[:3] - far[:3]) - np.linalg.norm(path[-1] - far[:3])
     assert gone > 0.1  # having gone towards it as far as it could
     back = np.concatenate([start, [1.0]])
     for _ in range(60):  # 3 s
         obs, *_ = env.step(back)
-    assert np.linalg.norm(obs["tcp_pose"][:3] - start[:3]) < 0.01
+    assert np.linalg.norm(obs["observation.tcp_pose"][:3] - start[:3]) < 0.01
 
 
 def test_modes_the_scene_or_robot_cannot_take_are_one_clear_error() -> None:
@@ -118,10 +118,10 @@ def test_a_five_joint_arm_puts_its_tcp_where_asked_first() -> None:
         down = np.array([0.0, 0.0, -0.1, 0.0, 0.0, 0.0, -1.0])  # 5 mm a step down
         for _ in range(3):  # the arm's servos still settle under gravity after the reset
             obs, *_ = env.step(down)
-        start = obs["tcp_pose"][:3].copy()
+        start = obs["observation.tcp_pose"][:3].copy()
         for _ in range(8):
             obs, *_ = env.step(down)
-        moved = obs["tcp_pose"][:3] - start
+        moved = obs["observation.tcp_pose"][:3] - start
         assert abs(moved[2] + 0.04) < 0.005 and np.linalg.norm(moved[:2]) < 0.005, moved
     finally:
         env.close()
@@ -146,14 +146,16 @@ def test_an_ee_pose_without_an_orientation_is_refused_and_nothing_moves() -> Non
     try:
         obs, _ = env.reset(seed=0)
         before = env.hal.read_state()
-        zero = np.concatenate([obs["tcp_pose"][:3], np.zeros(4), [1.0]])
+        zero = np.concatenate([obs["observation.tcp_pose"][:3], np.zeros(4), [1.0]])
         with pytest.raises(ActionRejected, match=r"quaternion \(qw, qx, qy, qz\) has norm 0"):
             env.step(zero)
         after = env.hal.read_state()
         assert after.sim_time_s == before.sim_time_s
         np.testing.assert_array_equal(after.positions, before.positions)
-        obs, *_ = env.step(np.concatenate([obs["tcp_pose"], [1.0]]))  # a good one still works
-        assert np.linalg.norm(obs["tcp_pose"][:3] - zero[:3]) < 0.01
+        obs, *_ = env.step(
+            np.concatenate([obs["observation.tcp_pose"], [1.0]])
+        )  # a good one still works
+        assert np.linalg.norm(obs["observation.tcp_pose"][:3] - zero[:3]) < 0.01
     finally:
         env.close()
 

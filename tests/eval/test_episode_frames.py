@@ -30,8 +30,8 @@ def _scenes_closed() -> Iterator[None]:
 
 
 class FrameLog:
-    """Answers with the hold; keeps, per step, the frames it was given (kept alive, so an
-    identical object means the same frame)."""
+    """Turns the first joint a little further each step (so each new frame differs from
+    the one before); keeps, per step, the frames it was given."""
 
     required_slots = ("camera1", "camera2")
     needs_privileged = False
@@ -41,8 +41,10 @@ class FrameLog:
         FrameLog.seen = []
 
     def act(self, obs: Observation) -> np.ndarray:
-        FrameLog.seen.append((obs["images"]["camera1"], obs["images"]["camera2"]))
-        return obs["action_spec"][1]
+        FrameLog.seen.append((obs["observation.images.camera1"], obs["observation.images.camera2"]))
+        action = np.array(obs["action_spec"][1], dtype=np.float64)
+        action[0] += 0.02 * len(FrameLog.seen)
+        return action
 
 
 def test_cameras_render_at_their_rate_and_only_when_read(monkeypatch) -> None:  # type: ignore[no-untyped-def]
@@ -51,7 +53,7 @@ def test_cameras_render_at_their_rate_and_only_when_read(monkeypatch) -> None:  
     assert watching.error is None and watching.steps == 20
     assert watching.frames == 2 + 10 * 2  # the reset's pair, then a pair every other step
     pairs = zip(FrameLog.seen, FrameLog.seen[1:], strict=False)
-    fresh = [a[0] is not b[0] and a[1] is not b[1] for a, b in pairs]
+    fresh = [not np.array_equal(a[0], b[0]) and not np.array_equal(a[1], b[1]) for a, b in pairs]
     assert fresh == [step % 2 == 0 for step in range(1, 20)]  # a new frame at even steps
     blind = run_episode(EpisodeSpec(SCENE, 0, "wave", (("required_slots", ""),), 20))
     assert blind.error is None and blind.frames == 0

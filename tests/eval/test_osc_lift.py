@@ -44,8 +44,7 @@ def test_without_task_state_it_says_what_it_needs() -> None:
     policy = make_policy("osc_lift")
     assert policy.needs_privileged is True and policy.required_slots == ()
     obs = {
-        "images": {},
-        "joint_positions": np.zeros(8),
+        "observation.state": np.zeros(8),
         "action_spec": (tuple(f"env_action[{i}]" for i in range(7)), np.zeros(7)),
         "time_s": 0.0,
         "task_state": {"robot0_eef_pos": np.zeros(3)},

@@ -21,12 +21,9 @@ FRAME = np.zeros((4, 4, 3), np.uint8)
 
 
 def observation(time_s: float, slots: tuple[str, ...] = ("camera1", "camera2")) -> Observation:
-    return Observation(
-        images={slot: FRAME for slot in slots},
-        joint_positions=np.zeros(3),
-        action_spec=(NAMES, HOLD),
-        time_s=time_s,
-    )
+    obs: Observation = {f"observation.images.{slot}": FRAME for slot in slots}
+    obs |= {"observation.state": np.zeros(3), "action_spec": (NAMES, HOLD), "time_s": time_s}
+    return obs
 
 
 def test_wave_adds_a_sinusoid_to_the_hold_on_the_chosen_slots_only() -> None:

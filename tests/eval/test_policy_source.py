@@ -59,7 +59,7 @@ def policy_file(tmp_path: Path) -> Path:
 
 def _obs() -> dict[str, object]:
     hold = np.array([1.0, 2.0])
-    return {"images": {}, "joint_positions": hold, "action_spec": (("a", "b"), hold)}
+    return {"observation.state": hold, "action_spec": (("a", "b"), hold)}
 
 
 def test_a_class_in_a_file_is_built_with_its_parameters(policy_file: Path) -> None:

@@ -36,29 +36,33 @@ def panda() -> Iterator[SceneEnv]:
 
 def _digest(env: gymnasium.Env, actions: list[np.ndarray], seed: int) -> str:  # type: ignore[type-arg]
     obs, _ = env.reset(seed=seed)
-    digest = hashlib.sha256(obs["joint_positions"].tobytes())
+    digest = hashlib.sha256(obs["observation.state"].tobytes())
     for action in actions:
         obs, *_ = env.step(action)
-        digest.update(obs["joint_positions"].tobytes())
+        digest.update(obs["observation.state"].tobytes())
     return digest.hexdigest()
 
 
 def test_spaces_follow_the_manifest(panda: SceneEnv) -> None:
     joints = [j.name for j in panda.robot.description.joints]
     space = panda.layout.space
-    assert space["joint_positions"].shape == (len(joints),)
-    assert space["joint_velocities"].shape == (len(joints),)
+    assert space["observation.state"].shape == (len(joints),)
+    assert space["observation.velocity"].shape == (len(joints),)
     assert panda.action_names == tuple(joints)
     first = panda.robot.description.joints[0]
     assert panda.box.low[0] == first.position_limits[0]
     assert panda.box.high[0] == first.position_limits[1]
-    cameras = [s.name for s in panda.robot.description.sensors if s.kind == "rgb"]
-    assert sorted(space["cameras"].keys()) == sorted(cameras)
     slots = {slot.slot for slot in panda.robot.tables.vla_slots}
-    assert set(space["camera_slots"].keys()) == slots
+    images = {key.removeprefix("observation.images.") for key in space if "images" in key}
+    assert images == slots and len(slots) == sum(
+        s.kind == "rgb" for s in panda.robot.description.sensors
+    )
+    assert all("." in key and key.startswith("observation.") for key in space)  # flat, LeRobot's
     obs, info = panda.reset(seed=3)
     assert panda.observation_space.contains(obs)
-    assert "red_cube_pos" in obs["privileged"]
+    names = panda.layout.environment_names
+    assert obs["observation.environment_state"].shape == (len(names),)
+    assert {"red_cube_pos.0", "red_cube_pos.2"} <= set(names)
     assert info["seed"] == 3 and info["success"] is False
 
 
@@ -66,12 +70,9 @@ def test_seed_draws_the_randomisation_and_repeats(panda: SceneEnv) -> None:
     first, _ = panda.reset(seed=1)
     again, _ = panda.reset(seed=1)
     other, _ = panda.reset(seed=2)
-    np.testing.assert_array_equal(
-        first["privileged"]["red_cube_pos"], again["privileged"]["red_cube_pos"]
-    )
-    assert not np.array_equal(
-        first["privileged"]["red_cube_pos"], other["privileged"]["red_cube_pos"]
-    )
+    key = "observation.environment_state"
+    np.testing.assert_array_equal(first[key], again[key])
+    assert not np.array_equal(first[key], other[key])
 
 
 @pytest.mark.parametrize(
@@ -119,7 +120,9 @@ def test_gymnasium_make_builds_it_by_id() -> None:
     env = gymnasium.make(ENV_ID, config={"scene": str(TABLETOP), "sensors": False})
     try:
         obs, _ = env.reset(seed=0)
-        assert "cameras" not in obs and obs["joint_positions"].shape == (8,)
+        assert not [key for key in obs if "images" in key] and obs["observation.state"].shape == (
+            8,
+        )
     finally:
         env.close()
 
@@ -151,11 +154,11 @@ def test_a_vector_env_matches_single_envs_step_for_step() -> None:
     )
     try:
         obs, _ = vector.reset(seed=[11, 12])
-        digests = [hashlib.sha256(obs["joint_positions"][i].tobytes()) for i in range(2)]
+        digests = [hashlib.sha256(obs["observation.state"][i].tobytes()) for i in range(2)]
         for action in actions:
             obs, *_ = vector.step(np.stack([action, action]))
             for i in range(2):
-                digests[i].update(obs["joint_positions"][i].tobytes())
+                digests[i].update(obs["observation.state"][i].tobytes())
     finally:
         vector.close()
     assert [d.hexdigest() for d in digests] == expected
@@ -167,11 +170,12 @@ def test_a_vector_env_with_cameras_runs_in_fresh_processes() -> None:
     vector = make_vector_env(TABLETOP, 2, sensors=["agentview"])
     try:
         obs, _ = vector.reset(seed=[1, 2])
-        assert obs["cameras"]["agentview"].shape == (2, 128, 128, 3)
-        assert obs["camera_slots"]["camera1"].shape == (2, 128, 128, 3)
-        first = obs["cameras"]["agentview"].copy()
+        images = [key for key in obs if key.startswith("observation.images.")]
+        assert images == ["observation.images.camera1"]  # agentview's slot, once
+        assert obs[images[0]].shape == (2, 128, 128, 3)
+        first = obs[images[0]].copy()
         obs, *_ = vector.step(np.stack([vector.single_action_space.sample()] * 2))
-        assert obs["cameras"]["agentview"].std() > 5  # a picture, not a blank buffer
+        assert obs[images[0]].std() > 5  # a picture, not a blank buffer
         assert not np.array_equal(first[0], first[1])  # two seeds, two cube placements
     finally:
         vector.close()
@@ -185,9 +189,9 @@ def test_a_robosuite_vector_env_without_cameras_observes_none_and_does_not_hang(
     vector = make_vector_env(robosuite, 2, sensors=False)
     try:
         obs, _ = vector.reset(seed=[1, 2])
-        assert sorted(obs) == ["joint_positions", "joint_velocities"]
+        assert sorted(obs) == ["observation.state", "observation.velocity"]
         obs, *_ = vector.step(np.stack([vector.single_action_space.sample()] * 2))
-        assert obs["joint_positions"].shape[0] == 2
+        assert obs["observation.state"].shape[0] == 2
     finally:
         vector.close()
 
@@ -227,11 +231,11 @@ def test_a_sweep_episode_is_the_env_stepped_with_the_same_actions(
     env = make_env(TABLETOP, sensors=False)
     try:
         obs, _ = env.reset(seed=4)
-        digest = hashlib.sha256(obs["joint_positions"].tobytes())
+        digest = hashlib.sha256(obs["observation.state"].tobytes())
         for action in _Recorder.actions:
             clipped = np.clip(action, env.box.low, env.box.high)
             obs, *_ = env.step(as_stored(clipped, env.box.low, env.box.high))  # float32, as applied
-            digest.update(obs["joint_positions"].tobytes())
+            digest.update(obs["observation.state"].tobytes())
     finally:
         env.close()
     assert digest.hexdigest() == result.trajectory_sha256

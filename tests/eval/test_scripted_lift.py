@@ -40,8 +40,7 @@ def test_it_needs_privileged_state() -> None:
     policy = make_policy("scripted_lift")
     assert policy.needs_privileged is True
     obs = {
-        "images": {},
-        "joint_positions": np.zeros(8),
+        "observation.state": np.zeros(8),
         "action_spec": (("a",), np.zeros(1)),
         "time_s": 0.0,
     }

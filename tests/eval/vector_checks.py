@@ -16,7 +16,7 @@ def steps_like_sync_vector_env(vector: Any, plain: gymnasium.vector.SyncVectorEn
     seeds = [3 + i for i in range(vector.num_envs)]
     a, a_info = vector.reset(seed=seeds)
     b, b_info = plain.reset(seed=seeds)
-    for key in ("joint_positions", "tcp_pose"):
+    for key in ("observation.state", "observation.tcp_pose"):
         np.testing.assert_array_equal(a[key], b[key])
     assert list(a_info["seed"]) == list(b_info["seed"]) == seeds
     vector.action_space.seed(0)
@@ -25,7 +25,7 @@ def steps_like_sync_vector_env(vector: Any, plain: gymnasium.vector.SyncVectorEn
         action = vector.action_space.sample()
         a, ra, ta, ua, ia = vector.step(action)
         b, rb, tb, ub, ib = plain.step(action)
-        np.testing.assert_array_equal(a["joint_positions"], b["joint_positions"])
+        np.testing.assert_array_equal(a["observation.state"], b["observation.state"])
         np.testing.assert_array_equal(ra, rb)
         assert (ta == tb).all() and (ua == ub).all()
         assert list(ia["is_success"]) == list(ib["is_success"])

@@ -15,7 +15,7 @@ class Sway:
 
     def act(self, obs):
         _, hold = obs["action_spec"]
-        phase = obs["time_s"] + 0.1 * float(np.sum(obs["joint_positions"][:2]))
+        phase = obs["time_s"] + 0.1 * float(np.sum(obs["observation.state"][:2]))
         return np.asarray(hold, dtype=np.float64) + 0.05 * np.sin(2.0 * phase)
 
 
@@ -26,7 +26,7 @@ class Swirl(Sway):
     needs_privileged = True
 
     def act(self, obs):
-        shift = sum(float(np.sum(value)) for value in obs["task_state"].values())
+        shift = float(np.sum(obs["observation.environment_state"]))
         _, hold = obs["action_spec"]
         return super().act(obs) + 0.05 * np.sin(shift) * np.ones_like(hold)
 
@@ -44,7 +44,9 @@ class Counter:
         self.number = Counter.made
 
     def act(self, obs):
-        return np.array([float(self.number), obs["time_s"], float(obs["images"]["camera1"].sum())])
+        return np.array(
+            [float(self.number), obs["time_s"], float(obs["observation.images.camera1"].sum())]
+        )
 
 
 class Slow:

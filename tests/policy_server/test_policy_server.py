@@ -22,11 +22,11 @@ from tests.policy_server import served_policies as served
 def _obs(time_s: float = 0.5) -> Observation:
     hold = np.array([0.1, -0.2, 0.3])
     return {
-        "images": {"camera1": np.full((4, 5, 3), 2, dtype=np.uint8)},
-        "joint_positions": np.array([0.1, -0.2, 0.3]),
+        "observation.images.camera1": np.full((4, 5, 3), 2, dtype=np.uint8),
+        "observation.state": np.array([0.1, -0.2, 0.3]),
         "action_spec": (("a", "b", "c"), hold),
         "time_s": time_s,
-        "tcp_pose": np.array([0.4, 0.0, 0.3, 1.0, 0.0, 0.0, 0.0]),
+        "observation.tcp_pose": np.array([0.4, 0.0, 0.3, 1.0, 0.0, 0.0, 0.0]),
     }
 
 
@@ -138,7 +138,7 @@ def test_a_server_off_protocol_is_refused_at_its_hello(serving: list[PolicyServe
     serving_module.PROTOCOL = 99  # type: ignore[misc]
     try:
         serving.append(newer := start(served.Sway))
-        with pytest.raises(PolicyServerError, match="speaks protocol 99; this openral speaks 1"):
+        with pytest.raises(PolicyServerError, match="speaks protocol 99; this openral speaks 2"):
             make_policy(_address(newer)).act(_obs())
     finally:
         serving_module.PROTOCOL = original  # type: ignore[misc]

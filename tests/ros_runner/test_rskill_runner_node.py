@@ -49,12 +49,14 @@ def test_runner_keys_frames_by_vla_slot_and_passes_joints_and_spec(ros: RosHarne
     ros.add(runner)
     assert wait_until(lambda: len(policy.observations) >= 2), runner.status
     obs = policy.observations[-1]
-    assert set(obs["images"]) == {"camera1", "camera2"}
+    images = {key for key in obs if key.startswith("observation.images.")}
+    assert images == {"observation.images.camera1", "observation.images.camera2"}
     for slot, sensor in (("camera1", "agentview"), ("camera2", "wrist")):
-        frame = obs["images"][slot]
+        frame = obs[f"observation.images.{slot}"]
         assert frame.shape == (*FRAME_SHAPE, 3) and frame.dtype == np.uint8
         assert (frame == COLOURS[sensor]).all(), f"{slot} does not show the {sensor} frame"
-    assert np.allclose(obs["joint_positions"], JOINT_POSITIONS)
+    assert np.allclose(obs["observation.state"], JOINT_POSITIONS)
+    assert obs["observation.velocity"].shape == (len(JOINT_POSITIONS),)
     names, hold = obs["action_spec"]
     assert names[0] == "panda_joint1" and np.allclose(hold, HOLD)
     assert runner.status.state == "running" and runner.abort_error is None

@@ -24,10 +24,12 @@ from typing import Any, TypeVar
 
 import numpy as np
 import numpy.typing as npt
+from geometry_msgs.msg import PoseStamped
 from openral_bridge import topics
 from openral_bridge.ros_messages import LATCHED
 from openral_core import VlaSlot, open_robot_by_id
 from openral_core.errors import OpenralError
+from openral_eval import observation_keys as keys
 from openral_eval.policies import Observation, PolicyAdapter, make_policy, parse_params
 from openral_eval.policy import action_mode
 from rclpy.context import Context
@@ -189,6 +191,9 @@ class RskillRunnerNode(NamespacedEntities, Node):
             self._ee = GraphEeActions(robot, 1.0 / rate_hz, mode=mode)
         self._frames: dict[str, tuple[float, Any]] = {}
         self._joints: dict[str, float] = {}
+        self._speeds: dict[str, float] = {}
+        self._tcp: npt.NDArray[np.float64] | None = None
+        """The latest ``/openral/tcp_pose`` (x, y, z, qw, qx, qy, qz in the base frame)."""
         self._spec: tuple[tuple[str, ...], npt.NDArray[np.float64]] | None = None
         self._started = time.monotonic()
         self._first_act: float | None = None
@@ -210,6 +215,7 @@ class RskillRunnerNode(NamespacedEntities, Node):
             JointState, topics.JOINT_STATES, self._on_joint_state, qos_profile_sensor_data
         )
         self.create_subscription(JointState, topics.ACTION_SPEC, self._on_action_spec, LATCHED)
+        self.create_subscription(PoseStamped, topics.TCP_POSE, self._on_tcp_pose, 10)
         self._publisher = self.create_publisher(Float64MultiArray, topics.SAFE_ACTION, 10)
         self._timer = self.create_timer(1.0 / rate_hz, self._tick)
 
@@ -219,8 +225,29 @@ class RskillRunnerNode(NamespacedEntities, Node):
 
         return on_frame
 
+    def _on_tcp_pose(self, msg: Any) -> None:
+        p, q = msg.pose.position, msg.pose.orientation
+        self._tcp = np.array([p.x, p.y, p.z, q.w, q.x, q.y, q.z])
+
     def _on_joint_state(self, msg: Any) -> None:
         self._joints.update(zip(msg.name, msg.position, strict=False))
+        self._speeds.update(zip(msg.name, msg.velocity, strict=False))
+
+    def _observation(self, by_slot: Mapping[str, Any], time_s: float) -> Observation:
+        """The one observation (:mod:`openral_eval.observation_keys`) of the latest
+        messages: joints in manifest order (NaN where not reported), frames by slot, and
+        the TCP's pose once ``/openral/tcp_pose`` has said it (a robot with a ``sim.tcp``)."""
+        assert self._spec is not None
+        names = self._joint_names
+        obs: Observation = {
+            keys.STATE: np.array([self._joints.get(name, np.nan) for name in names]),
+            keys.VELOCITY: np.array([self._speeds.get(name, np.nan) for name in names]),
+            **{keys.image_key(slot): image_to_rgb(msg) for slot, msg in by_slot.items()},
+        }
+        if self._tcp is not None:
+            obs[keys.TCP_POSE] = self._tcp.copy()
+        obs[keys.ACTION_SPEC], obs[keys.TIME_S] = self._spec, time_s
+        return obs
 
     def _on_action_spec(self, msg: Any) -> None:
         names, hold = tuple(msg.name), np.asarray(msg.position, dtype=np.float64)
@@ -247,14 +274,7 @@ class RskillRunnerNode(NamespacedEntities, Node):
         if self._first_act is None:
             self._first_act = now
         try:
-            obs = Observation(
-                images={slot: image_to_rgb(msg) for slot, msg in by_slot.items()},
-                joint_positions=np.array(
-                    [self._joints.get(name, np.nan) for name in self._joint_names]
-                ),
-                action_spec=self._spec,
-                time_s=now - self._first_act,
-            )
+            obs = self._observation(by_slot, now - self._first_act)
             action = np.asarray(self.policy.act(obs), dtype=np.float64)
             if self._ee is not None:
                 if not self._ee.started:

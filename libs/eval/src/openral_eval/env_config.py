@@ -28,7 +28,7 @@ class EnvConfig:
     seed: int | None = None
     """Seeds the env's generator (the seeds of resets without one); None: from the OS."""
     privileged: bool = False
-    """Add the scene's task state (object poses) under ``privileged``."""
+    """Add the scene's task state (object poses) as ``observation.environment_state``."""
     sensors: bool | tuple[str, ...] = True
     """Which cameras, depth sensors and lidars the observation carries: True all, False
     none, or these by manifest name (state sensors, joints and the base are always in)."""
@@ -38,6 +38,10 @@ class EnvConfig:
     """The scale and gripper sign of ``ee_delta_pose``: ``robosuite`` or ``maniskill``."""
     reward_mode: RewardMode = RewardMode.SPARSE
     """The reward ``step`` returns."""
+    keys: tuple[str, ...] | None = None
+    """Keep only these observation keys (None: every key the scene has)."""
+    flat: bool = False
+    """The kept keys, in key order, as one float64 vector instead of a ``Dict``."""
 
     @classmethod
     def parse(cls, config: EnvConfig | Mapping[str, object]) -> EnvConfig:
@@ -58,13 +62,17 @@ class EnvConfig:
         return replace(built, action_mode=_mode(built.action_mode)).checked()
 
     def checked(self) -> EnvConfig:
-        """This config with ``reward_mode`` as a :class:`RewardMode`.
+        """This config with ``reward_mode`` as a :class:`RewardMode` and ``keys`` a tuple
+        (one key may be given alone).
 
         Raises:
             ValueError: An unknown reward mode.
         """
+        wanted: object = self.keys
+        kept = (wanted,) if isinstance(wanted, str) else self.keys
         try:
-            return replace(self, reward_mode=RewardMode(self.reward_mode))
+            kept = None if kept is None else tuple(str(key) for key in kept)
+            return replace(self, reward_mode=RewardMode(self.reward_mode), keys=kept)
         except ValueError:
             valid = ", ".join(m.value for m in RewardMode)
             raise ValueError(f"unknown reward mode {self.reward_mode!r}; valid: {valid}") from None

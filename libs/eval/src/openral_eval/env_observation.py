@@ -1,34 +1,21 @@
 """What a scene env observes: the gymnasium ``Dict`` space and the observation in it.
 
-Built once per env from the manifest and the scene's first observation (a sensor's frame
-size is what the scene renders), so the space can never disagree with the values:
-
-========================  ========================================================  =========
-key                       value                                                     units
-========================  ========================================================  =========
-``joint_positions``       every manifest joint, manifest order (grippers per their  rad, m
-                          read mode)
-``joint_velocities``      the same joints                                           rad/s, m/s
-``tcp_pose``              the tool centre point in the base frame: x, y, z, then    m
-                          the quaternion w, x, y, z (a robot with a ``sim.tcp``,
-                          in a native scene)
-``cameras/<sensor>``      latest RGB frame, H x W x 3 uint8, top row first
-``camera_slots/<slot>``   the same frame under its VLA slot (``camera1`` ...)
-``depth/<sensor>``        latest depth image, H x W float32; 0 where no return      m
-``lidar/<sensor>``        latest scan, REP 117 ranges (±inf out of range)           m
-``state_sensors/<name>``  latest IMU / force-torque / pose reading, by field        SI
-``base``                  odometry ``pose`` (x, y, yaw) and ``twist`` (vx, vy, wz)  m, rad, /s
-``privileged/<key>``      the scene's task state (object poses), only when asked    m, wxyz
-========================  ========================================================  =========
+The observation is the one every path shares (:mod:`openral_eval.observation_keys`):
+a flat ``Dict`` by LeRobot's keys (``observation.state``, ``observation.velocity``,
+``observation.tcp_pose``, ``observation.images.<slot>`` …), each image once. It is laid
+out once per env from the manifest and the scene's first observation (a sensor's frame
+size is what the scene renders), so the space can never disagree with the values.
+``keys`` keeps only the keys named (a trainer that wants joints and the TCP only);
+``flat`` joins the kept keys, in key order, into one float64 vector, as robosuite's
+``GymWrapper`` does (:class:`FlatLayout`).
 
 Each sensor keeps its manifest rate (:mod:`openral_sim.sensor_schedule`): between two of
 its frames the observation repeats its latest one, as a real camera driver's last message
-would. A kind with no sensor has no key.
+would. A sensor that is not there has no key.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import fields
 
 import numpy as np
@@ -39,8 +26,11 @@ from openral_mujoco.state import JointStateSample
 from openral_sim.observation import Observation as SceneObservation
 from openral_sim.state_sensors import Reading
 
+from openral_eval import observation_keys as keys
+
 EnvObservation = dict[str, object]
-"""One observation in :attr:`ObservationLayout.space` (nested dicts of numpy arrays)."""
+"""One observation in :attr:`ObservationLayout.space`: key → numpy array (flat), or one
+vector (:class:`FlatLayout`)."""
 
 _INF = np.inf
 
@@ -86,25 +76,31 @@ class ObservationLayout:
         the HAL's joint sample of the same instant; ``only``: keep just these sensors (for
         a backend that renders every camera whatever the env asks; None: all it gives)."""
         self.only = only
-        slots = {slot.sensor: slot.slot for slot in robot.tables.vla_slots}
-        self.slots = {
-            sensor: slot
-            for sensor, slot in slots.items()
-            if sensor in first.images and (only is None or sensor in only)
-        }
+        self.slots = {slot.sensor: slot.slot for slot in robot.tables.vla_slots}
+        """Camera → its VLA slot (every camera has one: its feature key's, else its name)."""
         self.privileged = privileged
-        self._latest: dict[str, dict[str, object]] = {}
-        """Sensor kind → sensor → its newest frame."""
-        self.space = spaces.Dict(self._spaces(self.observe(first, joints, tcp_pose)))
+        self._latest: dict[str, object] = {}
+        """Key → the newest frame of a sensor."""
+        sample = self.observe(first, joints, tcp_pose)
+        state = first.task_state if privileged else {}
+        self.environment_names = keys.environment_names(state)
+        """A name per value of ``observation.environment_state`` (``cube_pos.0`` …)."""
+        self._entries = {key: np.shape(state[key]) for key in sorted(state)}
+        self.space = spaces.Dict(
+            {
+                key: _box(np.asarray(value), 0.0 if key.startswith(keys.DEPTH) else -_INF)
+                for key, value in sample.items()
+            }
+        )
 
-    def _spaces(self, obs: EnvObservation, low: float = -_INF) -> dict[str, spaces.Space[object]]:
-        """The space of an observation like ``obs`` (values no lower than ``low``)."""
-        out: dict[str, spaces.Space[object]] = {}
-        for key, value in obs.items():
-            if isinstance(value, dict):
-                out[key] = spaces.Dict(self._spaces(value, 0.0 if key == "depth" else low))
-            else:
-                out[key] = _box(np.asarray(value), low)
+    def task_state(self, environment_state: npt.ArrayLike) -> dict[str, npt.NDArray[np.float64]]:
+        """``observation.environment_state`` by entry again (``red_cube_pos`` → its 3
+        values), as the scene reports its task state."""
+        flat, out, at = np.asarray(environment_state, dtype=np.float64), {}, 0
+        for key, shape in self._entries.items():
+            size = int(np.prod(shape))
+            out[key] = flat[at : at + size].reshape(shape)
+            at += size
         return out
 
     def reset(self) -> None:
@@ -121,51 +117,75 @@ class ObservationLayout:
         HAL's ``joints`` (manifest order and units; a robosuite scene's read by name) and
         the TCP's pose (base frame), when the robot has one here."""
         out: EnvObservation = {
-            "joint_positions": np.array(joints.positions, dtype=np.float64),
-            "joint_velocities": np.array(joints.velocities, dtype=np.float64),
+            keys.STATE: np.array(joints.positions, dtype=np.float64),
+            keys.VELOCITY: np.array(joints.velocities, dtype=np.float64),
         }
         if tcp_pose is not None:
-            out["tcp_pose"] = tcp_pose
-        if obs.images:  # (each kind only when it has news: this runs every step)
-            self._keep("cameras", obs.images)
-        if obs.depth:
-            self._keep("depth", {n: _depth_image(f.depth_m) for n, f in obs.depth.items()})
-        if obs.scans:
-            self._keep("lidar", {n: scan.ranges for n, scan in obs.scans.items()})
-        if obs.readings:
-            self._keep("state_sensors", {n: _reading(r) for n, r in obs.readings.items()})
-        for kind, frames in self._latest.items():
-            out[kind] = _copied(frames)
-        cameras = out.get("cameras")
-        if isinstance(cameras, dict) and self.slots:
-            out["camera_slots"] = {self.slots[n]: cameras[n] for n in self.slots if n in cameras}
+            out[keys.TCP_POSE] = np.array(tcp_pose, dtype=np.float64)
+        self._keep_news(obs)
+        # fresh copies: every observation owns its arrays, as gymnasium's checker requires
+        out.update({key: np.array(frame, copy=True) for key, frame in self._latest.items()})
         if obs.odometry is not None:
             odom = obs.odometry
-            out["base"] = {
-                "pose": np.array([odom.x_m, odom.y_m, odom.yaw_rad]),
-                "twist": np.array([odom.vx_m_s, odom.vy_m_s, odom.wz_rad_s]),
-            }
+            out[keys.BASE_POSE] = np.array([odom.x_m, odom.y_m, odom.yaw_rad])
+            out[keys.BASE_TWIST] = np.array([odom.vx_m_s, odom.vy_m_s, odom.wz_rad_s])
         if self.privileged:
-            out["privileged"] = _task_state(obs.task_state)
+            out[keys.ENVIRONMENT_STATE] = keys.environment_state(obs.task_state)
         return out
 
-    def _keep(self, kind: str, frames: Mapping[str, object]) -> None:
-        """Remember the newest frame of each sensor of ``kind`` (of ``only``'s)."""
-        if self.only is not None:
-            frames = {name: frame for name, frame in frames.items() if name in self.only}
-            if not frames:
-                return
-        self._latest.setdefault(kind, {}).update(frames)
+    def _keep_news(self, obs: SceneObservation) -> None:
+        """Remember the newest frame of each sensor (of ``only``'s) that has news (this runs
+        every step: a kind without news costs nothing)."""
+        news: list[tuple[str, str, object]] = []
+        if obs.images:
+            news += [(n, keys.image_key(self.slots.get(n, n)), f) for n, f in obs.images.items()]
+        if obs.depth:
+            news += [(n, keys.depth_key(n), _depth_image(f.depth_m)) for n, f in obs.depth.items()]
+        if obs.scans:
+            news += [(n, keys.scan_key(n), scan.ranges) for n, scan in obs.scans.items()]
+        for name, reading in (obs.readings or {}).items():
+            news += [(name, keys.sensor_key(name, f), v) for f, v in _reading(reading).items()]
+        for sensor, key, frame in news:
+            if self.only is None or sensor in self.only:
+                self._latest[key] = frame
 
 
-def _copied(frames: Mapping[str, object]) -> dict[str, object]:
-    """Fresh copies of the kept frames: every observation owns its arrays (a user may keep
-    or change one), as gymnasium's checker requires."""
-    return {
-        name: _copied(value) if isinstance(value, dict) else np.array(value, copy=True)
-        for name, value in frames.items()
-    }
+class FlatLayout:
+    """The kept keys of an :class:`ObservationLayout`'s observations, in key order, as one
+    float64 vector (robosuite's ``GymWrapper``); :attr:`slices` says where each key is."""
+
+    def __init__(self, space: spaces.Dict, kept: tuple[str, ...]) -> None:
+        self.keys = tuple(sorted(kept))
+        self.slices: dict[str, slice] = {}
+        lows, highs, at = [], [], 0
+        for key in self.keys:
+            box = space[key]
+            assert isinstance(box, spaces.Box)
+            size = int(np.prod(box.shape))
+            self.slices[key] = slice(at, at + size)
+            lows.append(np.asarray(box.low, dtype=np.float64).ravel())
+            highs.append(np.asarray(box.high, dtype=np.float64).ravel())
+            at += size
+        self.space = spaces.Box(np.concatenate(lows), np.concatenate(highs), dtype=np.float64)
+
+    def flat(self, obs: EnvObservation) -> npt.NDArray[np.float64]:
+        """``obs``'s kept keys as one vector."""
+        return np.concatenate([np.asarray(obs[key], dtype=np.float64).ravel() for key in self.keys])
 
 
-def _task_state(state: Mapping[str, npt.NDArray[np.floating]]) -> dict[str, object]:
-    return {key: np.asarray(value, dtype=np.float64).copy() for key, value in state.items()}
+def kept_keys(space: spaces.Dict, wanted: tuple[str, ...] | None) -> tuple[str, ...]:
+    """The keys an env keeps: ``wanted`` (None: all of ``space``), each once.
+
+    Raises:
+        ValueError: None kept, or a key ``space`` does not have (the line lists those it has).
+    """
+    have = tuple(space.spaces)
+    if wanted is None:
+        return have
+    unknown = [key for key in wanted if key not in have]
+    if unknown or not wanted:
+        raise ValueError(
+            f"env config keys {unknown or '()'} are not in this scene's observation; "
+            f"valid: {sorted(have)}"
+        )
+    return tuple(dict.fromkeys(wanted))

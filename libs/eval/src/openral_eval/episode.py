@@ -41,6 +41,7 @@ from openral_sim.observation import Observation as SceneObservation
 from openral_sim.rollout import SceneRollout
 from openral_sim.sensor_schedule import sensor_rates
 
+from openral_eval import observation_keys as keys
 from openral_eval.env_actions import ActionMode
 from openral_eval.episode_frames import EpisodeFrames, as_stored, dataset_cameras
 from openral_eval.policies import make_policy
@@ -211,7 +212,7 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None, ru
     wanted = {*inputs.sensors(camera), *(keep.cameras.values() if keep else ())}
     sensors = tuple(sorted(wanted | (set(hal.env.camera_names) if watch else set())))
     env = env_for(spec, sensors, action_mode(policy))
-    env.reset(seed=spec.seed)
+    seen, _ = env.reset(seed=spec.seed)
     if watch is not None:
         watch(None)
     run.frames, started = len(hal.last_observation().images), hal.read_state().sim_time_s
@@ -221,15 +222,15 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None, ru
             state = hal.read_state()
             digest.update(state.positions.tobytes())
             video.add(hal.last_observation())
-            obs = inputs.observation(state.positions, run.steps, env.tcp_pose())
+            obs = inputs.observation(seen, run.steps)
             # float32, as a dataset stores it, in every episode: a sweep with --dataset, one
             # without and `sim export`'s rerun of it apply the same values (same digest)
             asked = policy.act(obs)
             clipped = env.clipped(asked)
             run.clamped_steps += _clamped(asked, clipped)
             action = as_stored(clipped, env.box.low, env.box.high)
-            seen = hal.read_images() if keep is not None else {}
-            _, _, terminated, truncated, info = env.step(action)
+            frames = hal.read_images() if keep is not None else {}
+            seen, _, terminated, truncated, info = env.step(action)
             if watch is not None:
                 watch(dict(zip(env.action_names, action.tolist(), strict=True)))
             run.steps += 1
@@ -238,7 +239,9 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None, ru
             run.frames += len(hal.last_observation().images)
             run.success = bool(info["success"])
             if keep is not None:
-                keep.add(state.positions, action, run.success, seen)
+                seen_state = obs[keys.STATE]  # a dataset row holds what the policy saw
+                assert isinstance(seen_state, np.ndarray)
+                keep.add(seen_state, action, run.success, frames)
             done = terminated or truncated
         video.add(hal.last_observation())
         if keep is not None:
@@ -297,6 +300,7 @@ class _Inputs:
         self.scene = hal.env if isinstance(hal.env, SceneRollout) else None
         slots = {slot.slot: slot.sensor for slot in robot.tables.vla_slots}
         self.slots = {slot: slots[slot] for slot in policy.required_slots if slot in slots}
+        """Slot the policy requires → its camera."""
         missing = [slot for slot in policy.required_slots if slot not in slots]
         if missing:
             raise ValueError(
@@ -315,27 +319,23 @@ class _Inputs:
         wanted = {*self.slots.values(), *([video_camera] if video_camera else [])}
         return tuple(sorted(wanted))
 
-    def observation(
-        self, positions: np.ndarray, step: int, tcp_pose: np.ndarray | None
-    ) -> Observation:
+    def observation(self, seen: Mapping[str, object], step: int) -> Observation:
+        """The policy's observation at ``step``: the env's observation ``seen`` (every
+        policy sees what a trainer on the env sees, by the same keys), the action spec and
+        the time, and what a privileged policy asks for."""
         hal = self.hal
-        frames = hal.read_images() if self.slots else {}
-        missing = [sensor for sensor in self.slots.values() if sensor not in frames]
+        missing = [cam for slot, cam in self.slots.items() if keys.image_key(slot) not in seen]
         if missing:
             raise ValueError(f"the scene renders no frame of {missing}")
-        obs: Observation = {
-            "images": {slot: frames[sensor] for slot, sensor in self.slots.items()},
-            "joint_positions": positions,
-            "action_spec": (hal.action_names, hal.hold_action()),
-            "time_s": step * hal.control_period_s,
-        }
-        if tcp_pose is not None:
-            obs["tcp_pose"] = tcp_pose
+        obs: Observation = dict(seen)
+        obs[keys.ACTION_SPEC] = (hal.action_names, hal.hold_action())
+        obs[keys.TIME_S] = step * hal.control_period_s
         if self.policy.needs_privileged:
             scene_obs = hal.last_observation()
-            obs["task_state"] = dict(scene_obs.task_state)
+            obs[keys.ENVIRONMENT_STATE] = keys.environment_state(scene_obs.task_state)
+            obs[keys.TASK_STATE] = dict(scene_obs.task_state)
             if self.scene is not None:
-                obs["privileged"] = self._privileged(self.scene, scene_obs)
+                obs[keys.PRIVILEGED] = self._privileged(self.scene, scene_obs)
         return obs
 
     def _privileged(self, scene: SceneRollout, scene_obs: SceneObservation) -> Privileged:

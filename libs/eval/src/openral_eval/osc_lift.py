@@ -17,7 +17,13 @@ from dataclasses import dataclass
 import numpy as np
 from openral_mujoco.state import FloatArray
 
-from openral_eval.policy import Observation, PolicyConfigError
+from openral_eval.policy import (
+    Observation,
+    PolicyConfigError,
+    action_spec_of,
+    task_state_of,
+    time_of,
+)
 
 PHASES = ("approach", "descend", "close", "lift")
 
@@ -61,15 +67,15 @@ class OscLift:
 
     def act(self, obs: Observation) -> FloatArray:
         """Position delta towards the phase's target, no rotation, the gripper last."""
-        state = obs.get("task_state")
+        state = task_state_of(obs)
         keys = (f"{self.config.object}_pos", f"{self.config.effector}_pos")
         if state is None or any(key not in state for key in keys):
             have = ", ".join(sorted(state or {})) or "none"
             raise PolicyConfigError(f"osc_lift needs task state {keys}; the scene reports {have}")
-        names, _ = obs["action_spec"]
+        names, _ = action_spec_of(obs)
         if len(names) < 4:
             raise PolicyConfigError(f"osc_lift needs a position delta and a gripper; got {names}")
-        target, gripper = self._phase_target(state[keys[0]], state[keys[1]], obs["time_s"])
+        target, gripper = self._phase_target(state[keys[0]], state[keys[1]], time_of(obs))
         action = np.zeros(len(names))
         action[:3] = np.clip(self.config.gain * (target - state[keys[1]]), -1.0, 1.0)
         action[-1] = gripper

@@ -13,35 +13,64 @@ anything else.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import NotRequired, Protocol, TypedDict, runtime_checkable
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 import numpy.typing as npt
 from openral_core.errors import OpenralError
 
+from openral_eval import observation_keys as keys
 from openral_eval.privileged import Privileged
 
+Observation = dict[str, object]
+"""What a policy sees on each tick: the one observation every path shares
+(:mod:`openral_eval.observation_keys`: ``observation.state``, ``observation.velocity``,
+``observation.images.<slot>`` for at least the slots it requires, ``observation.tcp_pose``
+where the robot has a TCP, the state sensors), plus ``action_spec`` (the HAL's action slot
+names and its hold action) and ``time_s`` (seconds since the first step with a complete
+observation). A policy with ``needs_privileged`` (episodes only) also gets
+``observation.environment_state``, ``task_state`` (the same by name) and, on a native
+scene, ``privileged`` (:class:`~openral_eval.privileged.Privileged`). Read the policy's own
+keys with :func:`action_spec_of`, :func:`time_of` and :func:`privileged_of`."""
 
-class Observation(TypedDict):
-    """What a policy sees on each tick."""
 
-    images: dict[str, npt.NDArray[np.uint8]]
-    """VLA slot (``camera1`` …) → latest HxWx3 uint8 RGB frame."""
-    joint_positions: npt.NDArray[np.float64]
-    """Latest measured joint positions in manifest joint order (NaN where not reported)."""
-    action_spec: tuple[tuple[str, ...], npt.NDArray[np.float64]]
-    """HAL action slot names and the hold action that keeps the robot still."""
-    time_s: float
-    """Seconds since the runner's first tick with a complete observation."""
-    tcp_pose: NotRequired[npt.NDArray[np.float64]]
-    """The tool centre point in the robot's base frame: x, y, z [m], then the quaternion
-    w, x, y, z (episodes, on a robot whose manifest declares ``sim.tcp``)."""
-    task_state: NotRequired[Mapping[str, npt.NDArray[np.float64]]]
-    """The scene's task state (object poses; robosuite's object observations), for a
-    policy with ``needs_privileged`` (episodes only)."""
-    privileged: NotRequired[Privileged]
-    """The MuJoCo simulation itself, for a policy with ``needs_privileged`` on a native
-    scene (episodes only)."""
+def action_spec_of(obs: Observation) -> tuple[tuple[str, ...], npt.NDArray[np.float64]]:
+    """``obs["action_spec"]``: the action slot names and the hold action.
+
+    Raises:
+        PolicyConfigError: ``obs`` has no action spec of that shape.
+    """
+    spec = obs.get(keys.ACTION_SPEC)
+    if not isinstance(spec, tuple) or len(spec) != 2:
+        raise PolicyConfigError("the observation has no action_spec (names, hold action)")
+    names, hold = spec
+    return tuple(str(name) for name in names), np.asarray(hold, dtype=np.float64)
+
+
+def time_of(obs: Observation) -> float:
+    """``obs["time_s"]`` [s].
+
+    Raises:
+        PolicyConfigError: ``obs`` has no time.
+    """
+    value = obs.get(keys.TIME_S)
+    if not isinstance(value, int | float):
+        raise PolicyConfigError("the observation has no time_s")
+    return float(value)
+
+
+def privileged_of(obs: Observation) -> Privileged | None:
+    """``obs["privileged"]``, the simulation (None: not given)."""
+    world = obs.get(keys.PRIVILEGED)
+    return world if isinstance(world, Privileged) else None
+
+
+def task_state_of(obs: Observation) -> Mapping[str, npt.NDArray[np.float64]] | None:
+    """``obs["task_state"]``, the task state by name (None: not given)."""
+    state = obs.get(keys.TASK_STATE)
+    if not isinstance(state, Mapping):
+        return None
+    return {str(k): np.asarray(v, dtype=np.float64) for k, v in state.items()}
 
 
 @runtime_checkable
@@ -55,7 +84,7 @@ class PolicyAdapter(Protocol):
 
     @property
     def needs_privileged(self) -> bool:
-        """True when ``act`` reads ``task_state``/``privileged`` (the simulation itself):
+        """True when ``act`` reads the environment state or ``privileged`` (the simulation):
         such a policy runs only in evaluation episodes, never on a ROS graph."""
         ...
 

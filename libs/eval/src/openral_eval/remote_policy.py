@@ -29,7 +29,15 @@ import numpy.typing as npt
 from openral_core.errors import OpenralError
 from openral_policy_server.wire import MAX_MESSAGE_BYTES, PROTOCOL, WireError, pack, unpack
 
-from openral_eval.policy import ACTION_MODES, Observation, PolicyConfigError
+from openral_eval import observation_keys as keys
+from openral_eval.policy import (
+    ACTION_MODES,
+    Observation,
+    PolicyConfigError,
+    action_spec_of,
+    task_state_of,
+    time_of,
+)
 
 SCHEMES = ("ws://", "wss://")
 """How a policy name says it is an address."""
@@ -179,16 +187,12 @@ def _checked_hello(hello: dict[str, Any], address: str) -> dict[str, Any]:
 
 def _travelling(obs: Observation) -> dict[str, Any]:
     """``obs`` as the wire carries it (the simulation itself stays here)."""
-    names, hold = obs["action_spec"]
+    names, hold = action_spec_of(obs)
     out: dict[str, Any] = {
-        "joint_positions": np.asarray(obs["joint_positions"], dtype=np.float64),
-        "action_names": list(names),
-        "hold": np.asarray(hold, dtype=np.float64),
-        "time_s": float(obs["time_s"]),
-        "images": {slot: np.asarray(image) for slot, image in obs["images"].items()},
+        key: np.asarray(value) for key, value in obs.items() if key.startswith(keys.PREFIX)
     }
-    if "tcp_pose" in obs:
-        out["tcp_pose"] = np.asarray(obs["tcp_pose"], dtype=np.float64)
-    if "task_state" in obs:
-        out["task_state"] = {k: np.asarray(v) for k, v in obs["task_state"].items()}
+    out |= {"action_names": list(names), "hold": hold, "time_s": time_of(obs)}
+    state = task_state_of(obs)
+    if state is not None:
+        out[keys.TASK_STATE] = state
     return out

@@ -6,7 +6,9 @@
 wraps it:
 
 - the observation space is :class:`~openral_eval.env_observation.ObservationLayout`'s
-  ``Dict`` (joints in manifest units, every sensor at its own rate);
+  flat ``Dict`` by the keys every path shares (:mod:`openral_eval.observation_keys`:
+  ``observation.state``, ``observation.images.<slot>`` …; joints in manifest units, every
+  sensor at its own rate), or the keys named in ``keys``, or those as one vector (``flat``);
 - the action space is the scene's action contract in the chosen mode: in
   ``joint_position``, one value per action slot (a native scene: per manifest joint, a
   target in manifest units within the manifest's limits, grippers in their write mode;
@@ -58,7 +60,12 @@ from openral_sim.task_reward import sparse_reward
 
 from openral_eval.env_actions import BASE_SLOTS, ActionContract
 from openral_eval.env_config import EnvConfig, RewardMode, merged_config
-from openral_eval.env_observation import EnvObservation, ObservationLayout
+from openral_eval.env_observation import (
+    EnvObservation,
+    FlatLayout,
+    ObservationLayout,
+    kept_keys,
+)
 from openral_eval.process_vector_env import ProcessVectorEnv
 from openral_eval.thread_vector_env import ThreadVectorEnv
 
@@ -139,7 +146,14 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
             tcp_pose=self.tcp_pose(),
             only=None if isinstance(self.hal.env, SceneRollout) else self._observed,
         )
-        self.observation_space = cast(spaces.Space[EnvObservation], self.layout.space)
+        self.kept = kept_keys(self.layout.space, self.config.keys)
+        """The observation keys this env returns (``EnvConfig.keys``, else all)."""
+        self.flat = FlatLayout(self.layout.space, self.kept) if self.config.flat else None
+        """Where each key is in the flat observation (``EnvConfig.flat``; None: a Dict)."""
+        kept_space = spaces.Dict({key: self.layout.space[key] for key in self.kept})
+        self.observation_space = cast(
+            spaces.Space[EnvObservation], kept_space if self.flat is None else self.flat.space
+        )
         self.actions = ActionContract(
             self.hal, self.robot, self.config.action_mode, self._ee, self.config.ee_preset
         )
@@ -251,7 +265,9 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
 
     def _observe(self) -> EnvObservation:
         obs = self.hal.last_observation()  # a native scene's carries the HAL's joint sample
-        return self.layout.observe(obs, obs.joints or self.hal.read_state(), self.tcp_pose())
+        full = self.layout.observe(obs, obs.joints or self.hal.read_state(), self.tcp_pose())
+        kept = full if len(self.kept) == len(full) else {key: full[key] for key in self.kept}
+        return kept if self.flat is None else self.flat.flat(kept)  # type: ignore[return-value]
 
     def tcp_pose(self) -> npt.NDArray[np.float64] | None:
         """The measured TCP pose in the base frame (None: no TCP here)."""

@@ -30,7 +30,8 @@ from openral_mujoco.state import FloatArray
 from openral_sim.ee_modes import PRESETS
 from openral_sim.frame_tree import pose_in_frame
 
-from openral_eval.policy import Observation, PolicyConfigError
+from openral_eval.observation_keys import TCP_POSE, vector_of
+from openral_eval.policy import Observation, PolicyConfigError, privileged_of, time_of
 
 PHASES = ("approach", "descend", "close", "lift")
 TURN_RATE = 1.5
@@ -88,14 +89,14 @@ class ScriptedLift:
 
     def act(self, obs: Observation) -> FloatArray:
         """The next action: the TCP's motion towards the phase's target, and the gripper."""
-        world = obs.get("privileged")
-        tcp = obs.get("tcp_pose")
+        world = privileged_of(obs)
+        tcp = vector_of(obs, TCP_POSE)
         if world is None or tcp is None or world.base is None:
             raise PolicyConfigError(
                 "scripted_lift needs privileged state and the robot's tcp_pose "
                 "(episodes on a native scene, a manifest with sim.tcp)"
             )
-        now = float(obs["time_s"])
+        now = time_of(obs)
         if self._last_time_s is not None and now > self._last_time_s:
             self._period_s = now - self._last_time_s  # the control period
         self._last_time_s = now

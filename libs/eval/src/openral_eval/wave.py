@@ -8,7 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from openral_eval.policy import Observation, PolicyConfigError
+from openral_eval.observation_keys import image_key
+from openral_eval.policy import Observation, PolicyConfigError, action_spec_of, time_of
 
 
 @dataclass(frozen=True)
@@ -53,10 +54,10 @@ class WavePolicy:
 
     def act(self, obs: Observation) -> npt.NDArray[np.float64]:
         """The hold action with the sine added on the waving slots."""
-        missing = [slot for slot in self.required_slots if slot not in obs["images"]]
+        missing = [slot for slot in self.required_slots if image_key(slot) not in obs]
         if missing:
             raise ValueError(f"wave policy called without frames for {missing}")
-        names, hold = obs["action_spec"]
+        names, hold = action_spec_of(obs)
         unknown = sorted(set(self.config.action_slots) - set(names))
         if unknown:
             raise PolicyConfigError(
@@ -65,7 +66,5 @@ class WavePolicy:
             )
         waving = self.config.action_slots or names
         mask = np.array([name in waving for name in names], dtype=np.float64)
-        offset = self.config.amplitude * math.sin(
-            2 * math.pi * obs["time_s"] / self.config.period_s
-        )
+        offset = self.config.amplitude * math.sin(2 * math.pi * time_of(obs) / self.config.period_s)
         return np.asarray(hold, dtype=np.float64) + offset * mask

@@ -14,10 +14,10 @@ Example::
 
     serve(Sway, port=8765)  # each connection (one episode) gets Sway()
 
-A policy sees the observation as openral's policies do (``images``, ``joint_positions``,
-``action_spec`` as ``(names, hold)``, ``time_s``, and ``tcp_pose``/``task_state`` where
-offered), so one policy class runs in-process (``--policy file.py:Sway``) and served
-(``--policy ws://HOST:PORT``) unchanged.
+A policy sees the observation as openral's policies do (``observation.state``,
+``observation.images.<slot>`` and the other ``observation.*`` keys, ``action_spec`` as
+``(names, hold)``, ``time_s``, and ``task_state`` where offered), so one policy class runs
+in-process (``--policy file.py:Sway``) and served (``--policy ws://HOST:PORT``) unchanged.
 """
 
 from __future__ import annotations
@@ -32,6 +32,9 @@ from websockets.sync.server import Server, ServerConnection
 from websockets.sync.server import serve as websocket_server
 
 from openral_policy_server.wire import MAX_MESSAGE_BYTES, PROTOCOL, WireError, pack, unpack
+
+OBSERVATION = "observation."
+"""The prefix of the observation's own keys (openral's one observation)."""
 
 
 class ServedPolicy(Protocol):
@@ -71,8 +74,9 @@ def observation(message: dict[str, Any]) -> dict[str, Any]:
         raise WireError("an act message without an observation map")
     try:
         obs: dict[str, Any] = {
-            "images": {str(k): np.asarray(v) for k, v in dict(raw.get("images", {})).items()},
-            "joint_positions": np.asarray(raw["joint_positions"], dtype=np.float64),
+            str(k): np.asarray(v) for k, v in raw.items() if str(k).startswith(OBSERVATION)
+        }
+        obs |= {
             "action_spec": (
                 tuple(str(name) for name in raw["action_names"]),
                 np.asarray(raw["hold"], dtype=np.float64),
@@ -81,8 +85,8 @@ def observation(message: dict[str, Any]) -> dict[str, Any]:
         }
     except (KeyError, TypeError, ValueError) as error:
         raise WireError(f"an observation without a valid {error}") from None
-    if "tcp_pose" in raw:
-        obs["tcp_pose"] = np.asarray(raw["tcp_pose"], dtype=np.float64)
+    if "observation.state" not in obs:
+        raise WireError("an observation without observation.state")
     if "task_state" in raw:
         obs["task_state"] = {str(k): np.asarray(v) for k, v in dict(raw["task_state"]).items()}
     return obs

@@ -13,11 +13,13 @@ type        from       fields
 ==========  =========  ===========================================================
 
 The server sends ``hello`` first, once per connection; each connection is one episode and
-gets a policy of its own. An observation holds ``joint_positions`` (float64 array),
+gets a policy of its own. An observation holds every ``observation.*`` key of openral's one
+observation (arrays: ``observation.state`` and ``observation.velocity`` float64, each
+``observation.images.<slot>`` HxWx3 uint8, ``observation.tcp_pose`` x, y, z [m] and the
+quaternion w, x, y, z where the robot has a TCP, the state sensors' fields …),
 ``action_names`` (list of str) and ``hold`` (float64 array: the action that keeps the robot
-still), ``time_s`` (float), ``images`` (slot → HxWx3 uint8 array), and where the episode
-offers them ``tcp_pose`` (x, y, z [m], quaternion w, x, y, z) and ``task_state`` (name →
-float64 array).
+still), ``time_s`` (float), and for a policy that needs privileged state ``task_state``
+(name → float64 array).
 
 A numpy array travels as msgpack extension type :data:`ARRAY_EXT`: a msgpack list
 ``[dtype, shape, bytes]`` (dtype as numpy spells it, little-endian; C order). Only bool,
@@ -32,8 +34,9 @@ import msgpack
 import numpy as np
 import numpy.typing as npt
 
-PROTOCOL = 1
-"""The protocol version a hello carries."""
+PROTOCOL = 2
+"""The protocol version a hello carries (2: the observation by openral's one observation's
+keys; 1 had ``joint_positions`` and ``images``)."""
 ARRAY_EXT = 42
 """msgpack extension type code of a numpy array."""
 KINDS = "biuf"
