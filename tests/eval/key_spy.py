@@ -1,6 +1,6 @@
-"""A policy that writes what it sees: each step's keys, each key's shape and dtype, and its
-joint state, one JSON line per step into the file ``log`` (it may run in a sweep's worker
-or in ``openral rskill run``'s process). It holds the robot still."""
+"""A policy that writes what it sees: each step's keys, each key's shape and dtype, and
+its joint state, velocities and TCP, one JSON line per step into the file ``log`` (it may
+run in a sweep's worker or in ``openral rskill run``'s process). It holds the robot still."""
 
 from __future__ import annotations
 
@@ -30,7 +30,8 @@ class KeySpy:
             for key, value in obs.items()
             if key.startswith("observation.")
         }
-        line = {"keys": seen, "state": np.asarray(obs["observation.state"]).tolist()}
+        vectors = ("observation.state", "observation.velocity", "observation.tcp_pose")
+        line = {"keys": seen, **{k: np.asarray(obs[k]).tolist() for k in vectors if k in obs}}
         with Path(self.log).open("a", encoding="utf-8") as out:
             out.write(json.dumps(line) + "\n")
         return np.asarray(obs["action_spec"][1], dtype=np.float64)

@@ -5,6 +5,7 @@ refused in one line with nothing left behind."""
 from __future__ import annotations
 
 import gc
+import json
 import os
 import weakref
 from collections.abc import Callable, Iterator
@@ -17,7 +18,7 @@ import numpy.typing as npt
 import pyarrow.parquet as pq
 import pytest
 from openral_core.errors import OpenralError
-from openral_eval import lerobot_dataset
+from openral_eval import lerobot_video
 from openral_eval.lerobot_dataset import (
     DatasetEpisode,
     DatasetLayout,
@@ -86,11 +87,11 @@ def test_the_mpeg4_encoder_stands_in_without_libx264(
     )
     fake.chmod(0o755)
     monkeypatch.setattr(imageio_ffmpeg, "get_ffmpeg_exe", lambda: str(fake))
-    lerobot_dataset._video_codec.cache_clear()
+    lerobot_video.video_codec.cache_clear()
     try:
         write_dataset(tmp_path / "mpeg4", LAYOUT, EPISODES[:2])
     finally:
-        lerobot_dataset._video_codec.cache_clear()
+        lerobot_video.video_codec.cache_clear()
     features = _info(tmp_path / "mpeg4")["features"]
     assert isinstance(features, dict)
     assert features["observation.images.front"]["info"]["video.codec"] == "mpeg4"
@@ -165,7 +166,49 @@ BAD_INPUTS: dict[str, tuple[Callable[[], tuple[DatasetLayout, list[DatasetEpisod
         "with H and W even",
     ),
     "empty task": (lambda: (LAYOUT, _with(1, task=" ")), "episode 1: task is ' '; expected"),
+    "extra missing": (
+        lambda: (replace(LAYOUT, extra={"observation.velocity": ("a", "b")}), EPISODES),
+        "episode 0: extra has features []; expected exactly layout.extra ['observation.velocity']",
+    ),
+    "extra width": (
+        lambda: (
+            replace(LAYOUT, extra={"observation.velocity": ("a", "b")}),
+            [
+                replace(e, extra={"observation.velocity": np.zeros((len(e.success), 3))})
+                for e in EPISODES
+            ],
+        ),
+        "episode 0: extra['observation.velocity'] is float64 (12, 3); expected real numbers of "
+        "shape (12, 2)",
+    ),
+    "extra images": (
+        lambda: (replace(LAYOUT, extra={"observation.images.x": ("a",)}), EPISODES),
+        "layout.extra has 'observation.images.x'; expected observation.* keys other than",
+    ),
 }
+
+
+def test_extra_features_are_columns_with_names_and_stats(tmp_path: Path) -> None:
+    layout = replace(LAYOUT, extra={"observation.velocity": ("a", "b")})
+    speeds = [np.arange(2 * len(e.success), dtype=np.float32).reshape(-1, 2) for e in EPISODES]
+    episodes = [
+        replace(e, extra={"observation.velocity": v}) for e, v in zip(EPISODES, speeds, strict=True)
+    ]
+    write_dataset(tmp_path / "d", layout, episodes)
+    features = _info(tmp_path / "d")["features"]
+    assert isinstance(features, dict)
+    assert features["observation.velocity"] == {
+        "dtype": "float32",
+        "shape": [2],
+        "names": ["a", "b"],
+    }
+    rows = pq.read_table(tmp_path / "d" / "data" / "chunk-000" / "file-000.parquet").to_pydict()
+    np.testing.assert_array_equal(np.array(rows["observation.velocity"]), np.concatenate(speeds))
+    stats = json.loads((tmp_path / "d" / "meta" / "stats.json").read_text())
+    assert stats["observation.velocity"]["max"] == [
+        float(np.concatenate(speeds)[:, 0].max()),
+        float(np.concatenate(speeds)[:, 1].max()),
+    ]
 
 
 def _ffmpeg_children() -> list[str]:

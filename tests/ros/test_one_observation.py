@@ -1,8 +1,9 @@
 """One policy file, three paths, one observation: the same class runs unchanged in the
-gymnasium env's loop (:func:`~openral_eval.env_policy.policy_observation`), in ``openral sim
-sweep`` (with ``--dataset``) and in ``openral rskill run`` against ``openral deploy sim``,
-and sees the same keys, each with the same shape and dtype; the dataset's rows hold the
-joint state the policy saw at each step (``tests/eval/key_spy.py`` writes what it sees)."""
+gymnasium env's loop (:func:`~openral_eval.env_policy.policy_observation`), in ``openral
+sim sweep`` (with ``--dataset``) and in ``openral rskill run`` against ``openral deploy
+sim``, and sees the same keys, each with the same shape and dtype; the dataset's rows hold
+the joint state, velocities and TCP pose the policy saw at each step
+(``tests/eval/key_spy.py`` writes what it sees)."""
 
 from __future__ import annotations
 
@@ -91,5 +92,6 @@ def test_one_policy_file_sees_the_same_keys_in_the_env_a_sweep_and_rskill_run(
     for key in set.intersection(*(set(keys) for keys in kinds.values())):  # type: ignore[arg-type]
         assert len({json.dumps(keys[key]) for keys in kinds.values()}) == 1, key  # type: ignore[index]
     rows = pq.read_table(dataset / "data" / "chunk-000" / "file-000.parquet").to_pydict()
-    saw = np.array([line["state"] for line in seen["sweep"]], dtype=np.float32)
-    np.testing.assert_array_equal(np.array(rows["observation.state"], dtype=np.float32), saw)
+    for key in ("observation.state", "observation.velocity", "observation.tcp_pose"):
+        saw = np.array([line[key] for line in seen["sweep"]], dtype=np.float32)
+        np.testing.assert_array_equal(np.array(rows[key], dtype=np.float32), saw, err_msg=key)

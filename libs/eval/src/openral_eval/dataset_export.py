@@ -4,7 +4,10 @@ Each episode of the sweep keeps its steps in a staging folder
 (:mod:`openral_eval.episode_frames`); once the sweep has run, :func:`export_dataset`
 streams them, in the order of the plan (scene by scene, seed by seed), into
 :func:`~openral_eval.lerobot_dataset.write_dataset`: ``observation.state`` is the joint
-positions in manifest order and units, ``action`` the action as the env took it (in the
+positions in manifest order and units, the other vectors the policy saw beside it by their
+observation keys (``observation.velocity``, ``observation.tcp_pose``, the state sensors'
+fields, ``observation.environment_state`` for a privileged policy; each value named), ``action``
+the action as the env took it (in the
 policy's action mode, e.g. ``ee_delta_pose``), ``next.success`` the scene's success after
 the step, one video per camera that has a VLA slot (``observation.images.<slot>``), fps the
 control rate, and the task text the scene file's ``task`` (else its id). Episodes that
@@ -23,7 +26,7 @@ from openral_core.errors import OpenralError
 from openral_core.loader import load_scene
 
 from openral_eval.episode import EpisodeSpec, env_for, scene_for
-from openral_eval.episode_frames import dataset_cameras, load_episode
+from openral_eval.episode_frames import dataset_cameras, extra_names, load_episode
 from openral_eval.lerobot_dataset import (
     DatasetEpisode,
     DatasetLayout,
@@ -74,8 +77,9 @@ def check_dataset_folder(folder: Path, robot: str, resume: bool) -> None:
 
 
 def layout_of(spec: EpisodeSpec, mode: str) -> DatasetLayout:
-    """The dataset's features for the sweep's first episode, whose policy acts in ``mode``
-    (every scene of a dataset has the same robot and the policy one action mode)."""
+    """The dataset's features for the sweep's first kept episode, whose policy acts in
+    ``mode`` (every scene of a dataset has the same robot and the policy one action mode),
+    and what else its policy saw (the episode's file names it)."""
     hal, robot = scene_for(spec.scene)
     env = env_for(spec, (), mode)
     return DatasetLayout(
@@ -84,6 +88,7 @@ def layout_of(spec: EpisodeSpec, mode: str) -> DatasetLayout:
         state_names=hal.read_state().names,
         action_names=tuple(env.action_names),
         cameras=tuple(dataset_cameras(robot, hal.env.camera_names)),
+        extra=extra_names(Path(spec.dataset)) if spec.dataset else {},
     )
 
 

@@ -238,10 +238,8 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None, ru
                 step_count.value = run.steps
             run.frames += len(hal.last_observation().images)
             run.success = bool(info["success"])
-            if keep is not None:
-                seen_state = obs[keys.STATE]  # a dataset row holds what the policy saw
-                assert isinstance(seen_state, np.ndarray)
-                keep.add(seen_state, action, run.success, frames)
+            if keep is not None:  # a dataset row holds what the policy saw
+                _keep_step(keep, obs, (action, run.success), frames, hal.read_state().names)
             done = terminated or truncated
         video.add(hal.last_observation())
         if keep is not None:
@@ -252,6 +250,21 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None, ru
             policy.close()
     digest.update(hal.read_state().positions.tobytes())
     run.sim_time_s = float(hal.read_state().sim_time_s or 0.0) - float(started or 0.0)
+
+
+def _keep_step(
+    keep: EpisodeFrames,
+    obs: Observation,
+    taken: tuple[np.ndarray, bool],
+    frames: dict[str, np.ndarray],
+    joints: tuple[str, ...],
+) -> None:
+    """One dataset row: the state and the other vectors the policy saw (``obs``; ``joints``
+    names the joints), the action taken and success after it, the cameras' frames."""
+    state = keys.vector_of(obs, keys.STATE)
+    assert state is not None
+    action, success = taken
+    keep.add(state, action, success, frames, keys.named_vectors(obs, joints))
 
 
 def _clamped(wanted: object, clipped: np.ndarray) -> bool:

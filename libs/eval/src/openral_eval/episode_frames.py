@@ -10,6 +10,7 @@ latest frame, as a real camera's latest image is what a policy sees at each step
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -51,6 +52,10 @@ class EpisodeFrames:
     actions: list[npt.NDArray[np.float32]] = field(default_factory=list)
     success: list[bool] = field(default_factory=list)
     frames: dict[str, list[npt.NDArray[np.uint8]]] = field(default_factory=dict)
+    extra: dict[str, list[npt.NDArray[np.float32]]] = field(default_factory=dict)
+    """More of what the policy saw, by key (``observation.velocity`` …)."""
+    names: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    """The names of each extra key's values."""
 
     def add(
         self,
@@ -58,9 +63,11 @@ class EpisodeFrames:
         action: npt.NDArray[np.float64],
         succeeded: bool,
         images: dict[str, npt.NDArray[np.uint8]],
+        extra: Mapping[str, tuple[tuple[str, ...], npt.NDArray[np.float64]]] | None = None,
     ) -> None:
         """One control step: the state the policy saw, the action taken, success after it,
-        and the latest image of each camera.
+        the latest image of each camera, and more of what the policy saw (key → its
+        values' names and the values).
 
         Raises:
             ValueError: A dataset camera has no frame yet (the scene does not render it).
@@ -68,6 +75,9 @@ class EpisodeFrames:
         self.states.append(np.asarray(state, dtype=np.float32))
         self.actions.append(np.asarray(action, dtype=np.float32))
         self.success.append(bool(succeeded))
+        for key, (names, values) in (extra or {}).items():
+            self.names.setdefault(key, names)
+            self.extra.setdefault(key, []).append(np.asarray(values, dtype=np.float32))
         for slot, camera in self.cameras.items():
             if camera not in images:
                 raise ValueError(f"the scene renders no frame of {camera} (dataset slot {slot})")
@@ -83,6 +93,8 @@ class EpisodeFrames:
             "success": np.array(self.success, dtype=np.bool_),
         }
         arrays.update({f"frames.{slot}": np.stack(f) for slot, f in self.frames.items()})
+        arrays.update({f"extra.{key}": np.stack(v) for key, v in self.extra.items()})
+        arrays.update({f"names.{key}": np.array(n, dtype=np.str_) for key, n in self.names.items()})
         with self.path.open("wb") as file:
             np.savez(file, allow_pickle=False, **arrays)
 
@@ -95,10 +107,26 @@ def load_episode(path: Path, task: str) -> DatasetEpisode:
             for key in saved.files
             if key.startswith("frames.")
         }
+        extra = {
+            key.removeprefix("extra."): saved[key]
+            for key in saved.files
+            if key.startswith("extra.")
+        }
         return DatasetEpisode(
             task=task,
             states=saved["states"],
             actions=saved["actions"],
             success=saved["success"],
             frames=frames,
+            extra=extra,
         )
+
+
+def extra_names(path: Path) -> dict[str, tuple[str, ...]]:
+    """The extra keys of the episode saved at ``path`` and their values' names."""
+    with np.load(path) as saved:
+        return {
+            key.removeprefix("names."): tuple(str(name) for name in saved[key])
+            for key in saved.files
+            if key.startswith("names.")
+        }

@@ -21,14 +21,10 @@ import json
 import math
 import secrets
 import shutil
-import subprocess
-import tempfile
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
-from fractions import Fraction
-from functools import cache
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Final
+from typing import Final
 
 import numpy as np
 import numpy.typing as npt
@@ -37,6 +33,7 @@ import pyarrow.parquet as pq
 from openral_core.errors import OpenralError
 
 from openral_eval import lerobot_stats
+from openral_eval.lerobot_video import VideoStream, video_codec
 
 CODEBASE_VERSION: Final = "v3.0"
 CHUNKS_SIZE: Final = 1000
@@ -56,6 +53,7 @@ class DatasetEpisode:
     actions: npt.NDArray[np.float32]  # (T, n_action) action per frame
     success: npt.NDArray[np.bool_]  # (T,) next.success per frame
     frames: Mapping[str, npt.NDArray[np.uint8]]  # slot -> (T, H, W, 3) RGB, H and W even
+    extra: Mapping[str, npt.NDArray[np.float32]] = field(default_factory=dict)  # key -> (T, n)
 
 
 @dataclass(frozen=True)
@@ -67,6 +65,8 @@ class DatasetLayout:
     state_names: tuple[str, ...]  # names of observation.state's entries
     action_names: tuple[str, ...]  # names of action's entries
     cameras: tuple[str, ...]  # slots; each is the feature "observation.images.<slot>"
+    extra: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    """More float32 features of the frames (``observation.velocity`` …) and their names."""
 
 
 @dataclass(frozen=True)
@@ -116,10 +116,18 @@ def write_dataset(
 def _check_layout(layout: DatasetLayout) -> None:
     if not (math.isfinite(layout.fps) and layout.fps > 0):
         raise OpenralError(f"layout.fps is {layout.fps}; expected a finite rate > 0 [Hz]")
-    for field in ("state_names", "action_names"):
-        names: tuple[str, ...] = getattr(layout, field)
+    named = {"layout.state_names": layout.state_names, "layout.action_names": layout.action_names}
+    for key, names in layout.extra.items():
+        if not key.startswith("observation.") or key.startswith(
+            ("observation.images.", "observation.state")
+        ):
+            raise OpenralError(
+                f"layout.extra has {key!r}; expected observation.* keys other than state and images"
+            )
+        named[f"layout.extra[{key!r}]"] = names
+    for where, names in named.items():
         if not names or len(set(names)) != len(names):
-            raise OpenralError(f"layout.{field} is {names!r}; expected distinct names, at least 1")
+            raise OpenralError(f"{where} is {names!r}; expected distinct names, at least 1")
     slots = layout.cameras
     if len(set(slots)) != len(slots) or any(not s or "/" in s for s in slots):
         raise OpenralError(f"layout.cameras is {slots!r}; expected distinct slot names without /")
@@ -164,6 +172,30 @@ def _episode_arrays(
     return states.astype(np.float32), actions.astype(np.float32), success.astype(np.bool_)
 
 
+def _episode_extra(
+    episode: DatasetEpisode, layout: DatasetLayout, index: int, length: int
+) -> dict[str, npt.NDArray[np.float32]]:
+    """``episode``'s extra features, checked against ``layout.extra`` (keys, shapes, finite)."""
+    where = f"episode {index}"
+    if set(episode.extra) != set(layout.extra):
+        raise OpenralError(
+            f"{where}: extra has features {sorted(episode.extra)}; expected exactly "
+            f"layout.extra {sorted(layout.extra)}"
+        )
+    out = {}
+    for key, names in layout.extra.items():
+        values = np.asarray(episode.extra[key])
+        if values.shape != (length, len(names)) or values.dtype.kind not in "fiu":
+            raise OpenralError(
+                f"{where}: extra[{key!r}] is {values.dtype} {values.shape}; expected real "
+                f"numbers of shape {(length, len(names))}"
+            )
+        if not np.all(np.abs(values.astype(np.float64)) <= np.finfo(np.float32).max):
+            raise OpenralError(f"{where}: extra[{key!r}] has non-finite values; expected finite")
+        out[key] = values.astype(np.float32)
+    return out
+
+
 def _episode_frames(
     episode: DatasetEpisode, layout: DatasetLayout, index: int, sizes: dict[str, tuple[int, int]]
 ) -> dict[str, npt.NDArray[np.uint8]]:
@@ -190,7 +222,7 @@ def _episode_frames(
 
 
 def _vectors(layout: DatasetLayout) -> dict[str, tuple[str, ...]]:
-    return {"observation.state": layout.state_names, "action": layout.action_names}
+    return {"observation.state": layout.state_names, **layout.extra, "action": layout.action_names}
 
 
 def _data_schema(layout: DatasetLayout) -> pa.Schema:
@@ -208,7 +240,7 @@ def _features(layout: DatasetLayout, sizes: Mapping[str, tuple[int, int]]) -> di
     }
     features["next.success"] = {"dtype": "bool", "shape": [1], "names": None}
     for key, (height, width) in sizes.items():
-        video = {"video.height": height, "video.width": width, "video.codec": _video_codec()[0]}
+        video = {"video.height": height, "video.width": width, "video.codec": video_codec()[0]}
         video |= {"video.pix_fmt": "yuv420p", "video.is_depth_map": False}
         video |= {"video.fps": _json_fps(layout.fps), "video.channels": 3, "has_audio": False}
         features[key] = {
@@ -222,64 +254,6 @@ def _features(layout: DatasetLayout, sizes: Mapping[str, tuple[int, int]]) -> di
     return features
 
 
-@cache
-def _video_codec() -> tuple[str, tuple[str, ...]]:
-    """(codec named in info.json, ffmpeg options): libx264 if imageio-ffmpeg's ffmpeg has it,
-    else MPEG-4 part 2; a keyframe every 2 frames (as LeRobot's) keeps seeking to a frame cheap."""
-    import imageio_ffmpeg
-
-    exe = imageio_ffmpeg.get_ffmpeg_exe()
-    run = subprocess.run([exe, "-hide_banner", "-encoders"], capture_output=True, text=True)
-    encoders = {line.split()[1] for line in run.stdout.splitlines() if len(line.split()) > 1}
-    if "libx264" in encoders:
-        return "h264", ("-c:v", "libx264", "-preset", "medium", "-crf", "23", "-g", "2")
-    return "mpeg4", ("-c:v", "mpeg4", "-q:v", "2", "-g", "2")
-
-
-class _VideoStream:
-    """One camera's MP4: an ffmpeg process reading raw RGB frames from a pipe."""
-
-    def __init__(self, path: Path, size: tuple[int, int], fps: float) -> None:
-        import imageio_ffmpeg
-
-        path.parent.mkdir(parents=True, exist_ok=True)
-        rate = Fraction(fps).limit_denominator(10_000)
-        command = [imageio_ffmpeg.get_ffmpeg_exe(), "-hide_banner", "-loglevel", "error"]
-        command += ["-f", "rawvideo", "-pix_fmt", "rgb24", "-s", f"{size[1]}x{size[0]}"]
-        command += ["-framerate", f"{rate.numerator}/{rate.denominator}", "-i", "-", "-an"]
-        command += [*_video_codec()[1], "-pix_fmt", "yuv420p", str(path)]
-        self.path, self.frames = path, 0
-        self._log: IO[bytes] = tempfile.TemporaryFile()  # noqa: SIM115 (closed by close/kill)
-        self._process = subprocess.Popen(
-            command, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=self._log
-        )
-
-    def write(self, frames: npt.NDArray[np.uint8]) -> None:
-        """Append ``(T, H, W, 3)`` frames."""
-        assert self._process.stdin is not None
-        try:
-            for frame in frames:
-                self._process.stdin.write(np.ascontiguousarray(frame).data)
-        except BrokenPipeError:
-            self.close()  # raises with ffmpeg's own words
-        self.frames += len(frames)
-
-    def close(self, finish: bool = True) -> None:
-        """Finish the file (ffmpeg's failure is an :class:`OpenralError`), or stop ffmpeg."""
-        if self._log.closed:
-            return
-        if not finish:
-            self._process.kill()
-        elif self._process.stdin is not None and not self._process.stdin.closed:
-            self._process.stdin.close()
-        failed = self._process.wait() != 0 and finish
-        self._log.seek(0)
-        said = self._log.read().decode(errors="replace").strip().splitlines() or ["?"]
-        self._log.close()
-        if failed:
-            raise OpenralError(f"ffmpeg could not write {self.path.name}: {said[-1]}")
-
-
 class _Writer:
     """The files of one dataset being written (see the module doc)."""
 
@@ -288,7 +262,7 @@ class _Writer:
         self.rows: list[dict[str, object]] = []
         self.tasks: dict[str, int] = {}
         self.sizes: dict[str, tuple[int, int]] = {}
-        self.videos: dict[str, _VideoStream] = {}
+        self.videos: dict[str, VideoStream] = {}
         self.stats: dict[str, lerobot_stats.FeatureStats] = {}
         self.schema = _data_schema(layout)
         data = root / DATA_PATH.format(chunk_index=0, file_index=0)
@@ -304,6 +278,7 @@ class _Writer:
         steps = np.arange(length, dtype=np.int64)
         columns: dict[str, npt.NDArray[np.generic]] = {
             "observation.state": states,
+            **_episode_extra(episode, self.layout, index, length),
             "action": actions,
             "next.success": success,
             "timestamp": (steps / self.layout.fps).astype(np.float32),
@@ -333,7 +308,7 @@ class _Writer:
         """Append a camera's frames to its MP4; the episode's video columns (times in s)."""
         if key not in self.videos:
             path = self.root / VIDEO_PATH.format(video_key=key, chunk_index=0, file_index=0)
-            self.videos[key] = _VideoStream(path, self.sizes[key], self.layout.fps)
+            self.videos[key] = VideoStream(path, self.sizes[key], self.layout.fps)
         stream = self.videos[key]
         start = stream.frames / self.layout.fps
         stream.write(images)

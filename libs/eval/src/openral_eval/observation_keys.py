@@ -112,3 +112,30 @@ def environment_names(task_state: Mapping[str, npt.ArrayLike]) -> tuple[str, ...
     return tuple(
         f"{key}.{i}" for key in sorted(task_state) for i in range(np.asarray(task_state[key]).size)
     )
+
+
+TCP_NAMES = ("x", "y", "z", "qw", "qx", "qy", "qz")
+BASE_NAMES = {BASE_POSE: ("x", "y", "yaw"), BASE_TWIST: ("vx", "vy", "wz")}
+"""The names of the values of ``observation.tcp_pose`` and of the base's odometry."""
+
+
+def named_vectors(
+    obs: Mapping[str, object], joints: tuple[str, ...]
+) -> dict[str, tuple[tuple[str, ...], FloatArray]]:
+    """Every vector of ``obs`` but ``observation.state`` (key → its values' names and the
+    values), as a dataset keeps them beside it: the joints' velocities (``joints`` names
+    them), the TCP, the base, the state sensors' fields and the environment state (named
+    by ``obs["task_state"]``'s entries); images, depth and scans are not vectors."""
+    task = obs.get(TASK_STATE)
+    named: dict[str, tuple[str, ...]] = {VELOCITY: joints, TCP_POSE: TCP_NAMES, **BASE_NAMES}
+    if isinstance(task, Mapping):
+        named[ENVIRONMENT_STATE] = environment_names(task)
+    out = {}
+    for key in obs:
+        vector = vector_of(obs, key) if key in named or key.startswith(SENSORS) else None
+        if vector is None or vector.ndim != 1:
+            continue
+        names = named.get(key) or tuple(f"{key.rsplit('.', 1)[-1]}.{i}" for i in range(vector.size))
+        if len(names) == vector.size:
+            out[key] = (names, vector)
+    return out
