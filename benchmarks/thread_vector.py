@@ -11,7 +11,8 @@ from collections.abc import Callable
 from typing import Any
 
 import mujoco
-from openral_eval.scene_env import make_env, make_process_vector_env, make_thread_vector_env
+from openral_eval.scene_env import make_env
+from openral_eval.vector_envs import make_process_vector_env, make_thread_vector_env
 from rich.table import Table
 
 from benchmarks.step_rate import best_rates

@@ -4,7 +4,10 @@ actions, gymnasium's own checker, and a vector env that matches single envs."""
 from __future__ import annotations
 
 import hashlib
+import os
 import re
+import subprocess
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import ClassVar
@@ -17,7 +20,8 @@ from openral_eval.episode import EpisodeSpec, close_scenes, run_episode
 from openral_eval.episode_frames import as_stored
 from openral_eval.policies import POLICIES, PolicyEntry
 from openral_eval.policy import Observation
-from openral_eval.scene_env import ENV_ID, SceneEnv, make_env, make_vector_env
+from openral_eval.scene_env import ENV_ID, SceneEnv, make_env
+from openral_eval.vector_envs import make_vector_env
 from openral_eval.wave import WaveConfig
 from openral_mujoco.errors import ActionRejected
 
@@ -179,6 +183,31 @@ def test_a_vector_env_with_cameras_runs_in_fresh_processes() -> None:
         assert not np.array_equal(first[0], first[1])  # two seeds, two cube placements
     finally:
         vector.close()
+
+
+ASYNC_WITH_CAMERAS = """
+import gymnasium, numpy as np
+import openral_eval.scene_env
+config = {"scene": %r, "sensors": ["agentview"]}
+make = lambda: gymnasium.make("openral/Scene-v0", config=config)
+vector = gymnasium.vector.AsyncVectorEnv([make] * 2)
+obs, _ = vector.reset(seed=[1, 2])
+frames = obs["observation.images.camera1"]
+print(frames.shape, frames.std() > 5, not np.array_equal(frames[0], frames[1]))
+vector.close()
+"""
+
+
+def test_gymnasiums_own_async_vector_env_with_cameras_forks_and_renders() -> None:
+    """A user's script that never rendered: gymnasium builds a first env in it to learn the
+    spaces, then forks its workers (its default start method here). The env lays out its
+    spaces without rendering, so the forked workers can render."""
+    done = subprocess.run(
+        [sys.executable, "-c", ASYNC_WITH_CAMERAS % str(TABLETOP)],
+        capture_output=True, text=True, timeout=300, env={**os.environ, "MUJOCO_GL": "egl"},
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split("\n")[-2] == "(2, 128, 128, 3) True True"
 
 
 def test_a_robosuite_vector_env_without_cameras_observes_none_and_does_not_hang() -> None:

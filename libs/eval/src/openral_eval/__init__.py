@@ -13,10 +13,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from openral_eval.scene_env import (
-        EnvConfig,
-        SceneEnv,
-        make_env,
+    from openral_eval.scene_env import EnvConfig, SceneEnv, make_env
+    from openral_eval.vector_envs import (
         make_process_vector_env,
         make_thread_vector_env,
         make_vector_env,
@@ -33,10 +31,12 @@ __all__ = [
 
 
 def __getattr__(name: str) -> object:
-    """``make_env``, ``make_vector_env``, ``SceneEnv`` and ``EnvConfig`` from
-    :mod:`openral_eval.scene_env`."""
+    """``make_env``, ``SceneEnv`` and ``EnvConfig`` from :mod:`openral_eval.scene_env`, the
+    vector envs from :mod:`openral_eval.vector_envs`."""
     if name in __all__:
-        from openral_eval import scene_env
+        from openral_eval import scene_env, vector_envs
 
-        return getattr(scene_env, name)
+        return getattr(
+            vector_envs if name.startswith("make_") and name != "make_env" else scene_env, name
+        )
     raise AttributeError(f"module 'openral_eval' has no attribute {name!r}")

@@ -16,14 +16,16 @@ would. A sensor that is not there has no key.
 
 from __future__ import annotations
 
-from dataclasses import fields
+from dataclasses import fields, replace
 
 import numpy as np
 import numpy.typing as npt
 from gymnasium import spaces
 from openral_core.loaded import LoadedRobot
 from openral_mujoco.state import JointStateSample
+from openral_sim.depth_cloud import DepthFrame
 from openral_sim.observation import Observation as SceneObservation
+from openral_sim.rollout import SensorSuite
 from openral_sim.state_sensors import Reading
 
 from openral_eval import observation_keys as keys
@@ -171,6 +173,36 @@ class FlatLayout:
     def flat(self, obs: EnvObservation) -> npt.NDArray[np.float64]:
         """``obs``'s kept keys as one vector."""
         return np.concatenate([np.asarray(obs[key], dtype=np.float64).ravel() for key in self.keys])
+
+
+def blank_frames(
+    sensors: SensorSuite, observed: frozenset[str] | None, like: SceneObservation
+) -> SceneObservation:
+    """``like`` (an observation of a native scene that rendered nothing) with a black frame
+    of every camera and depth sensor of ``observed`` (None: all) at the size the scene
+    renders, and a scan and a reading of each lidar and state sensor (no renderer needed).
+
+    An env lays out its spaces from this, so building one opens no OpenGL context: a
+    process that built an env to learn the spaces (gymnasium's ``AsyncVectorEnv`` does)
+    can still fork workers that render."""
+
+    def chosen(name: str) -> bool:
+        return observed is None or name in observed
+
+    height, width = sensors.camera_size()
+    images = {
+        n: np.zeros((height, width, 3), np.uint8) for n in sensors.camera_sensors() if chosen(n)
+    }
+    depth = {
+        n: DepthFrame(
+            np.zeros((s.height, s.width), np.float32), np.zeros((0, 3), np.float32), like.time_s
+        )
+        for n, s in sensors.depth_sensors().items()
+        if chosen(n)
+    }
+    scans = {n: sensors.scan(n) for n in sensors.lidar_sensors() if chosen(n)}
+    readings = {n: sensors.read_sensor(n) for n in sensors.state_sensors() if chosen(n)}
+    return replace(like, images=images, depth=depth, scans=scans, readings=readings)
 
 
 def kept_keys(space: spaces.Dict, wanted: tuple[str, ...] | None) -> tuple[str, ...]:

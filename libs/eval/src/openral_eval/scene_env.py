@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Mapping
-from functools import partial
 from pathlib import Path
 from typing import Any, SupportsFloat, cast
 
@@ -45,7 +44,6 @@ import numpy.typing as npt
 from gymnasium import spaces
 from openral_core.loaded import LoadedRobot
 from openral_core.loader import load_scene
-from openral_core.models import Backend
 from openral_core.paths import repo_root
 from openral_core.scene_index import read_scene_index
 from openral_hal.factory import HalMode, build_hal
@@ -64,10 +62,9 @@ from openral_eval.env_observation import (
     EnvObservation,
     FlatLayout,
     ObservationLayout,
+    blank_frames,
     kept_keys,
 )
-from openral_eval.process_vector_env import ProcessVectorEnv
-from openral_eval.thread_vector_env import ThreadVectorEnv
 
 __all__ = [
     "ENV_ID",
@@ -77,8 +74,6 @@ __all__ = [
     "attached_hal",
     "has_dense_reward",
     "make_env",
-    "make_thread_vector_env",
-    "make_vector_env",
     "scene_horizon",
 ]
 
@@ -130,7 +125,7 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
     def _build(self) -> None:
         """Connect the HAL and lay out the spaces (see :meth:`__init__`)."""
         self._observed = self._chosen_sensors()
-        self._choose_sensors()
+        self._choose_sensors(render=False)  # laid out unrendered: see blank_frames
         self.hal.env_reset_seed = 0
         self.hal.release_estop()
         if self.hal.connected:
@@ -138,9 +133,11 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         else:
             self.hal.connect()
         self._ee = ee_command(self.hal, self.robot)
+        scene = self.hal.env if isinstance(self.hal.env, SceneRollout) else None
+        first = self.hal.last_observation()
         self.layout = ObservationLayout(
             self.robot,
-            self.hal.last_observation(),
+            first if scene is None else blank_frames(scene.sensors, self._observed, first),
             self.hal.read_state(),
             privileged=self.config.privileged,
             tcp_pose=self.tcp_pose(),
@@ -302,13 +299,13 @@ class SceneEnv(gymnasium.Env[EnvObservation, npt.NDArray[np.float64]]):
         states = {sensor.name for _, sensor in state_sensors_of(self.robot.description)}
         return frozenset(names) | states
 
-    def _choose_sensors(self) -> None:
-        """Let a native scene render the chosen sensors into its observations (a HAL
-        shared with another env may have been told otherwise)."""
+    def _choose_sensors(self, *, render: bool = True) -> None:
+        """Let a native scene render the chosen sensors into its observations, or nothing
+        (a HAL shared with another env may have been told otherwise)."""
         scene = self.hal.env if isinstance(self.hal.env, SceneRollout) else None
         if scene is not None:
             scene.observed = self._observed
-            scene.render_observations = True
+            scene.render_observations = render
 
 
 def attached_hal(scene_file: str) -> tuple[SimAttachedHAL, LoadedRobot]:
@@ -335,55 +332,6 @@ def scene_horizon(hal: SimAttachedHAL) -> int | None:
 def make_env(scene: str | Path, **config: object) -> SceneEnv:
     """The env of ``scene``; ``config``: the other :class:`EnvConfig` fields."""
     return SceneEnv({"scene": str(scene), **config})
-
-
-def make_vector_env(
-    scene: str | Path, num_envs: int, **config: object
-) -> gymnasium.vector.AsyncVectorEnv:
-    """``num_envs`` envs of ``scene`` (``config``: as :func:`make_env`), each in a process
-    of its own: forked from this one when nothing is rendered, else started afresh with
-    ``forkserver`` (a process forked after this one has rendered cannot render, see
-    :mod:`openral_sim.gl_guard`; a robosuite scene always renders). Call it under ``if
-    __name__ == "__main__":`` when rendering (a fresh process imports the main module).
-
-    Raises:
-        ValueError: ``num_envs`` below 1 (a bad config fails in the first env, built
-            here to learn the spaces).
-    """
-    if num_envs < 1:
-        raise ValueError(f"num_envs is {num_envs}; expected at least 1")
-    renders = (
-        config.get("sensors", True) is not False
-        or config.get("render_mode") is not None
-        or load_scene(Path(scene)).scene.backend is Backend.robosuite  # renders regardless
-    )
-    build = partial(make_env, str(scene), **config)
-    return gymnasium.vector.AsyncVectorEnv(
-        [build] * num_envs, context="forkserver" if renders else "fork"
-    )
-
-
-def make_thread_vector_env(scene: str | Path, num_envs: int, **config: object) -> ThreadVectorEnv:
-    """``num_envs`` envs of ``scene`` (``config``: as :func:`make_env`) in this process,
-    stepped at once on threads of their own (:mod:`openral_eval.thread_vector_env`).
-
-    Raises:
-        ValueError: ``num_envs`` below 1.
-    """
-    if num_envs < 1:
-        raise ValueError(f"num_envs is {num_envs}; expected at least 1")
-    return ThreadVectorEnv([partial(make_env, str(scene), **config)] * num_envs)
-
-
-def make_process_vector_env(scene: str | Path, num_envs: int, **config: object) -> ProcessVectorEnv:
-    """``num_envs`` envs of ``scene`` (``config``: as :func:`make_env`): the first in this
-    process, each other in a worker process, all stepped at once
-    (:mod:`openral_eval.process_vector_env`; it scales with cores).
-
-    Raises:
-        ValueError: ``num_envs`` below 1.
-    """
-    return ProcessVectorEnv(partial(make_env, str(scene), **config), num_envs)
 
 
 gymnasium.register(id=ENV_ID, entry_point=f"{__name__}:SceneEnv")
