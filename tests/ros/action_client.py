@@ -12,8 +12,10 @@ from builtin_interfaces.msg import Duration
 from control_msgs.action import FollowJointTrajectory
 from control_msgs.msg import JointTolerance
 from openral_bridge.topics import FOLLOW_JOINT_TRAJECTORY
+from openral_nodes.trajectory_action import FEEDBACK_DEPTH
 from rclpy.action import ActionClient
 from rclpy.node import Node
+from rclpy.qos import QoSProfile
 from trajectory_msgs.msg import JointTrajectoryPoint
 
 from tests.ros.ros_helpers import wait_until
@@ -96,7 +98,12 @@ class TrajectoryActionClient:
     """FollowJointTrajectory on a node spun by the caller."""
 
     def __init__(self, node: Node, timeout_s: float = 30.0) -> None:
-        self.client = _AtomicActionClient(node, FollowJointTrajectory, FOLLOW_JOINT_TRAJECTORY)
+        self.client = _AtomicActionClient(
+            node,
+            FollowJointTrajectory,
+            FOLLOW_JOINT_TRAJECTORY,
+            feedback_sub_qos_profile=QoSProfile(depth=FEEDBACK_DEPTH),  # every tick's, kept
+        )
         assert self.client.wait_for_server(timeout_sec=timeout_s), "no action server"
 
     def send(self, message: Any, timeout_s: float = 10.0) -> Sent:

@@ -45,6 +45,7 @@ from openral_core.models import TrajectoryRules
 from openral_hal.protocol import RobotHal
 from openral_mujoco.state import JointStateSample
 from rclpy.action.server import CancelResponse, GoalResponse
+from rclpy.qos import QoSProfile
 from trajectory_msgs.msg import JointTrajectoryPoint
 
 from openral_nodes.graph_names import graph_name
@@ -62,6 +63,9 @@ VIOLATIONS = {
     Outcome.PATH_TOLERANCE_VIOLATED: Result.PATH_TOLERANCE_VIOLATED,
     Outcome.GOAL_TOLERANCE_VIOLATED: Result.GOAL_TOLERANCE_VIOLATED,
 }
+FEEDBACK_DEPTH = 100
+"""Feedback messages kept for a client that reads late (1 s at a 100 Hz state rate; rclpy's
+default, 10, lost 8 of 301 to a client held up for a moment in a fresh clone's run)."""
 
 
 @dataclass(eq=False)
@@ -117,6 +121,7 @@ class TrajectoryAction:
             handle_accepted_callback=self._on_accepted,
             cancel_callback=self._on_cancel,
             result_timeout=RESULT_TIMEOUT_S,
+            feedback_pub_qos_profile=QoSProfile(depth=FEEDBACK_DEPTH),  # type: ignore[no-untyped-call]
         )
 
     def destroy(self) -> None:
