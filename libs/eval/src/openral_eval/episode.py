@@ -43,6 +43,7 @@ from openral_sim.sensor_schedule import sensor_rates
 
 from openral_eval import observation_keys as keys
 from openral_eval.env_actions import ActionMode
+from openral_eval.env_policy import policy_observation
 from openral_eval.episode_frames import EpisodeFrames, as_stored, dataset_cameras
 from openral_eval.policies import make_policy
 from openral_eval.policy import Observation, PolicyAdapter, action_mode
@@ -222,7 +223,7 @@ def _drive(spec: EpisodeSpec, digest: hashlib._Hash, watch: StepWatch | None, ru
             state = hal.read_state()
             digest.update(state.positions.tobytes())
             video.add(hal.last_observation())
-            obs = inputs.observation(seen, run.steps)
+            obs = inputs.observation(env, seen)
             # float32, as a dataset stores it, in every episode: a sweep with --dataset, one
             # without and `sim export`'s rerun of it apply the same values (same digest)
             asked = policy.act(obs)
@@ -332,17 +333,16 @@ class _Inputs:
         wanted = {*self.slots.values(), *([video_camera] if video_camera else [])}
         return tuple(sorted(wanted))
 
-    def observation(self, seen: Mapping[str, object], step: int) -> Observation:
-        """The policy's observation at ``step``: the env's observation ``seen`` (every
-        policy sees what a trainer on the env sees, by the same keys), the action spec and
-        the time, and what a privileged policy asks for."""
+    def observation(self, env: SceneEnv, seen: Mapping[str, object]) -> Observation:
+        """The policy's observation at ``env``'s step: the env's observation ``seen`` as
+        :func:`~openral_eval.env_policy.policy_observation` gives it to a policy in the
+        env's own loop (the same keys, the action spec, the time), and what a privileged
+        policy asks for."""
         hal = self.hal
         missing = [cam for slot, cam in self.slots.items() if keys.image_key(slot) not in seen]
         if missing:
             raise ValueError(f"the scene renders no frame of {missing}")
-        obs: Observation = dict(seen)
-        obs[keys.ACTION_SPEC] = (hal.action_names, hal.hold_action())
-        obs[keys.TIME_S] = step * hal.control_period_s
+        obs = policy_observation(env, seen)
         if self.policy.needs_privileged:
             scene_obs = hal.last_observation()
             obs[keys.ENVIRONMENT_STATE] = keys.environment_state(scene_obs.task_state)

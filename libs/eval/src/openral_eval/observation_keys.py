@@ -63,7 +63,6 @@ PRIVILEGED = "privileged"
 """(a privileged policy's only, native scenes) The simulation itself
 (:class:`~openral_eval.privileged.Privileged`)."""
 
-Array: TypeAlias = npt.NDArray[np.generic]
 FloatArray: TypeAlias = npt.NDArray[np.float64]
 
 
@@ -83,15 +82,6 @@ def scan_key(sensor: str) -> str:
 def sensor_key(sensor: str, field: str) -> str:
     """The key of one field of a state sensor's reading (``wrist_ft``, ``force``)."""
     return f"{SENSORS}{sensor}.{field}"
-
-
-def images_of(obs: Mapping[str, object]) -> dict[str, npt.NDArray[np.uint8]]:
-    """VLA slot → frame, of every ``observation.images.<slot>`` in ``obs``."""
-    return {
-        key.removeprefix(IMAGES): np.asarray(value, dtype=np.uint8)
-        for key, value in obs.items()
-        if key.startswith(IMAGES)
-    }
 
 
 def vector_of(obs: Mapping[str, object], key: str) -> FloatArray | None:
