@@ -11,6 +11,7 @@ import pytest
 from openral_core.models import LimitedJoint
 from openral_eval.scene_env import SceneEnv, make_env
 from openral_mujoco.errors import ActionRejected
+from openral_sim import tcp_pose, tcp_sensors
 
 from tests.conftest import ROBOTS
 
@@ -160,23 +161,39 @@ def test_an_ee_pose_without_an_orientation_is_refused_and_nothing_moves() -> Non
         env.close()
 
 
-@pytest.mark.parametrize("scene", [TABLETOP, ROBOTS / "panda_mobile" / "scenes" / "room.yaml"])
-def test_the_observed_tcp_pose_is_the_iks_own_tcp_in_the_base_frame(scene: object) -> None:
-    """``tcp_vector`` (MuJoCo's pose routines on rows of the data, in every observation)
-    against mink's composition the IK itself uses (base frame inverse times the TCP frame
-    and flange), on random arm poses; panda_mobile's arm root is offset from its base."""
+@pytest.mark.parametrize(
+    "scene",
+    [
+        TABLETOP,
+        ROBOTS / "panda_mobile" / "scenes" / "room.yaml",
+        ROBOTS / "so101" / "scenes" / "tabletop.yaml",
+    ],
+)
+@pytest.mark.parametrize("read", ["sensors", "composed"])
+def test_the_observed_tcp_pose_is_the_iks_own_tcp_in_the_base_frame(
+    scene: object, read: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``tcp_vector`` (in every observation) against mink's composition the IK itself uses
+    (base frame inverse times the TCP frame and flange), on random arm poses: read from the
+    scene's TCP sensors, and composed from rows of the data as for a model without them.
+    panda_mobile's arm root is offset from its base and moves; so101's TCP is on a site."""
+    if read == "composed":  # a model without the sensors: the reader finds none
+        monkeypatch.setattr(tcp_pose, "TCP_SENSORS", ("no_such_sensor", "nor_this_one"))
     env = make_env(scene, action_mode="ee_pose", sensors=False)
     try:
         env.reset(seed=0)
         command = env.actions.ee
         assert command is not None
         model, data = env.hal.mujoco_handles()
+        reader = tcp_pose.TcpReader(command.ee, command.frames, data)
+        assert (reader._sensors is not None) is (read == "sensors")
         arm = command.ee._arm_qpos
         rng = np.random.default_rng(3)
         for _ in range(20):
             data.qpos[arm] = model.qpos0[arm] + rng.uniform(-0.5, 0.5, len(arm))
-            mujoco.mj_kinematics(model, data)
+            mujoco.mj_forward(model, data)  # what every scene step ends with
             mine = command.tcp_vector(data)
+            np.testing.assert_array_equal(mine, reader.read())
             theirs = (
                 command.base(data)
                 .inverse()
@@ -185,5 +202,18 @@ def test_the_observed_tcp_pose_is_the_iks_own_tcp_in_the_base_frame(scene: objec
             np.testing.assert_allclose(mine[:3], theirs.translation(), atol=1e-12)
             quat = theirs.rotation().wxyz  # a rotation has two quaternions: q and -q
             assert min(np.abs(mine[3:] - quat).max(), np.abs(mine[3:] + quat).max()) < 1e-12
+    finally:
+        env.close()
+
+
+def test_the_tcp_site_is_drawn_by_no_camera() -> None:
+    """The TCP's site sits in a group MuJoCo's default visual options leave out, so the
+    scene's pictures are what they were before it."""
+    env = make_env(TABLETOP, sensors=False)
+    try:
+        model, _ = env.hal.mujoco_handles()
+        site = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, tcp_sensors.TCP_SITE)
+        assert site >= 0
+        assert mujoco.MjvOption().sitegroup[model.site_group[site]] == 0
     finally:
         env.close()

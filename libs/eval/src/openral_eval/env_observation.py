@@ -53,12 +53,12 @@ _FIELDS: dict[type, tuple[str, ...]] = {}
 """Vector fields of each reading type (its time stamp is the observation's)."""
 
 
-def _reading(reading: Reading) -> dict[str, npt.NDArray[np.float64]]:
+def _reading_fields(reading: Reading) -> tuple[str, ...]:
     """A state-sensor reading's vector fields."""
     kind = type(reading)
     if kind not in _FIELDS:
         _FIELDS[kind] = tuple(f.name for f in fields(reading) if f.name != "sim_time_s")
-    return {name: np.asarray(getattr(reading, name), dtype=np.float64) for name in _FIELDS[kind]}
+    return _FIELDS[kind]
 
 
 class ObservationLayout:
@@ -83,6 +83,8 @@ class ObservationLayout:
         self.privileged = privileged
         self._latest: dict[str, object] = {}
         """Key → the newest frame of a sensor."""
+        self._readings: dict[str, tuple[tuple[str, str], ...]] = {}
+        """State sensor → (field, key) of each of its vector fields."""
         sample = self.observe(first, joints, tcp_pose)
         state = first.task_state if privileged else {}
         self.environment_names = keys.environment_names(state)
@@ -145,11 +147,25 @@ class ObservationLayout:
             news += [(n, keys.depth_key(n), _depth_image(f.depth_m)) for n, f in obs.depth.items()]
         if obs.scans:
             news += [(n, keys.scan_key(n), scan.ranges) for n, scan in obs.scans.items()]
-        for name, reading in (obs.readings or {}).items():
-            news += [(name, keys.sensor_key(name, f), v) for f, v in _reading(reading).items()]
         for sensor, key, frame in news:
             if self.only is None or sensor in self.only:
                 self._latest[key] = frame
+        for name, reading in (obs.readings or {}).items():
+            for field, key in self._reading_keys(name, reading):
+                self._latest[key] = np.asarray(getattr(reading, field), dtype=np.float64)
+
+    def _reading_keys(self, name: str, reading: Reading) -> tuple[tuple[str, str], ...]:
+        """(field, key) of each vector field of sensor ``name``'s reading (none when
+        ``only`` leaves the sensor out), looked up once per sensor: readings come every
+        step."""
+        found = self._readings.get(name)
+        if found is None:
+            kept = self.only is None or name in self.only
+            found = tuple(
+                (field, keys.sensor_key(name, field)) for field in _reading_fields(reading) if kept
+            )
+            self._readings[name] = found
+        return found
 
 
 class FlatLayout:

@@ -28,6 +28,7 @@ from openral_mujoco.state import FloatArray
 
 from openral_sim.end_effector import EndEffector
 from openral_sim.frame_tree import FrameTree
+from openral_sim.tcp_pose import TcpReader
 
 DELTA_WIDTH = 7
 POSE_WIDTH = 8
@@ -52,10 +53,6 @@ class DeltaPreset:
         """The normalised gripper command (0 closed, 1 open) of a value in [-1, 1]."""
         return (1.0 - value * self.closes) / 2.0
 
-
-_Rows = tuple[mujoco.MjData, FloatArray, FloatArray, FloatArray | None, FloatArray | None]
-"""An MjData, its root body's position and quaternion rows and the TCP body's (None: the
-TCP is on a site)."""
 
 PRESETS = {
     "robosuite": DeltaPreset(translation_m=0.05, rotation_rad=0.5, closes=1.0),
@@ -86,8 +83,7 @@ class EeCommand:
         self.ee, self.frames, self.dt = ee, frames, dt
         self.reference = mink.SE3.identity()
         """The TCP pose the deltas add up in (base frame)."""
-        self._scratch = (np.empty(3), np.empty(4), np.empty(3), np.empty(4))
-        self._rows: _Rows | None = None
+        self._reader: TcpReader | None = None
 
     def base(self, data: mujoco.MjData) -> mink.SE3:
         """The base frame's pose in the world."""
@@ -95,22 +91,13 @@ class EeCommand:
         return mink.SE3.from_rotation_and_translation(mink.SO3(quat), position)
 
     def tcp_vector(self, data: mujoco.MjData) -> FloatArray:
-        """The TCP's pose in the base frame as 7 values: position [m], quaternion w, x, y, z.
-
-        What :func:`~openral_sim.frame_tree.pose_in_frame` of the base's and the TCP's world
-        poses gives, composed as root-in-base · root⁻¹ · TCP frame · flange with MuJoCo's
-        pose routines on rows of ``data`` looked up once: it is in every observation."""
-        rows = self._rows if self._rows is not None and self._rows[0] is data else self._bind(data)
-        _, root, root_quat, frame, frame_quat = rows
-        a, a_quat, b, b_quat = self._scratch
-        if frame is None or frame_quat is None:  # a site: its orientation is a matrix
-            frame, frame_quat = self.ee.frame_pose(data)
-        out = np.empty(7)
-        mujoco.mju_negPose(a, a_quat, root, root_quat)
-        mujoco.mju_mulPose(b, b_quat, a, a_quat, frame, frame_quat)
-        mujoco.mju_mulPose(a, a_quat, *self.frames.root_in_base, b, b_quat)
-        mujoco.mju_mulPose(out[:3], out[3:], a, a_quat, self.ee.offset, self.ee.flange_quat)
-        return out
+        """The TCP's pose in the base frame as 7 values: position [m], quaternion w, x, y, z
+        (:class:`~openral_sim.tcp_pose.TcpReader`, bound to ``data`` once: it is in every
+        observation)."""
+        reader = self._reader
+        if reader is None or reader.data is not data:
+            reader = self._reader = TcpReader(self.ee, self.frames, data)
+        return reader.read()
 
     def reach_box(
         self, model: mujoco.MjModel, data: mujoco.MjData
@@ -124,13 +111,6 @@ class EeCommand:
         reach = sum(float(np.linalg.norm(b - a)) for a, b in itertools.pairwise(points))
         centre = self.base(data).inverse().apply(points[0])
         return centre - reach, centre + reach
-
-    def _bind(self, data: mujoco.MjData) -> _Rows:
-        """The rows of ``data`` the TCP pose reads (views: they follow ``data``)."""
-        root = self.frames.tree.root
-        frame = self.ee.frame_pose(data) if self.ee.kind != "site" else (None, None)
-        self._rows = (data, data.xpos[root], data.xquat[root], *frame)
-        return self._rows
 
     def reset(self, data: mujoco.MjData, commanded: FloatArray) -> None:
         """Start the reference where the arm's ``commanded`` targets put the TCP (where

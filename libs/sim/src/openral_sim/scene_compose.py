@@ -45,6 +45,7 @@ from openral_sim.scene_checks import check_object_names, check_weld
 from openral_sim.scene_geometry import BASE_WELD, lowest_static_point, yaw_quat
 from openral_sim.scene_lighting import add_scene_lights, balance_lights
 from openral_sim.state_sensors import add_state_sensors
+from openral_sim.tcp_sensors import add_tcp_sensors
 
 DEFAULT_TABLE_HEIGHT_M = 0.75
 PHYSICS_OPTIONS = tuple(key for key in dir(mujoco.MjSpec().option) if not key.startswith("_"))
@@ -125,6 +126,7 @@ def _compile(
     add_mounted_cameras(spec, robot, cameras)
     add_sensor_sites(spec, robot)
     add_state_sensors(spec, robot)
+    add_tcp_sensors(spec, robot, child_model)
     if pose is not None and pose.weld:
         _add_base_weld(spec, child_model, robot)
     add_fixed_cameras(spec, robot, cameras)
