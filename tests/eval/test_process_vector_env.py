@@ -9,9 +9,11 @@ import signal
 from functools import partial
 
 import gymnasium
+import numpy as np
 import pytest
 from openral_eval import make_process_vector_env
 from openral_eval.process_env import ProcessEnv, WorkerError
+from openral_eval.process_vector_env import ProcessVectorEnv
 from openral_eval.scene_env import make_env
 
 from tests.conftest import ROBOTS
@@ -73,8 +75,6 @@ def test_a_worker_whose_env_raises_or_dies_is_one_line() -> None:
 
 def test_the_same_step_autoreset_mode_is_refused_in_one_line() -> None:
     with pytest.raises(ValueError, match="takes the next_step or disabled autoreset mode"):
-        from openral_eval.process_vector_env import ProcessVectorEnv
-
         ProcessVectorEnv(partial(make_env, FRANKA, sensors=False), 2, autoreset_mode="SameStep")
     with pytest.raises(ValueError, match="num_envs is 0"):
         make_process_vector_env(FRANKA, 0)
@@ -110,3 +110,72 @@ def test_a_worker_ends_when_the_process_that_made_it_is_killed() -> None:
             return
         time.sleep(0.1)
     pytest.fail(f"worker {worker} outlived the process that made it")
+
+
+class _Counting(gymnasium.Env):  # type: ignore[type-arg]
+    """Infos that change on some steps and not on others, plain numbers of three types,
+    then an array too (gymnasium's own batching); with ``breaks``, step 7 raises."""
+
+    observation_space = gymnasium.spaces.Box(-1e9, 1e9, (2,), np.float64)
+    action_space = gymnasium.spaces.Box(-1.0, 1.0, (1,), np.float64)
+
+    def __init__(self, breaks: bool = False) -> None:
+        self.count, self.breaks = 0, breaks
+
+    def reset(self, *, seed=None, options=None):  # type: ignore[no-untyped-def]
+        self.count = 0
+        return np.zeros(2), {"seed": seed}
+
+    def step(self, action):  # type: ignore[no-untyped-def]
+        self.count += 1
+        if self.breaks and self.count == 7:
+            raise ValueError("the seventh step broke")
+        info = {"even": self.count % 4 < 2, "quarter": self.count // 4, "x": self.count / 2}
+        if self.count > 8:
+            info["array"] = np.full(3, self.count)
+        obs = np.array([self.count, float(action[0])])
+        return obs, float(self.count), False, False, info
+
+
+def test_infos_and_observations_arrive_whether_they_changed_or_not() -> None:
+    """A worker sends an info again only when it changed; what arrives is what a
+    SyncVectorEnv of the same envs gives, step for step."""
+    processes = ProcessVectorEnv(_Counting, 3)
+    plain = gymnasium.vector.SyncVectorEnv([_Counting] * 3)
+    try:
+        _equal(processes.reset(seed=1)[1], plain.reset(seed=1)[1])
+        for step in range(1, 13):
+            action = np.full((3, 1), step / 100)
+            a, ra, _, _, ia = processes.step(action)
+            b, rb, _, _, ib = plain.step(action)
+            np.testing.assert_array_equal(a, b)
+            np.testing.assert_array_equal(ra, rb)
+            _equal(ia, ib)
+    finally:
+        processes.close()
+        plain.close()
+
+
+def test_when_the_first_env_raises_the_workers_step_is_not_left_for_the_next() -> None:
+    """Env 0 steps in the caller's process: its error comes through as it is, and the
+    workers' results of that step are taken then, so the next step returns the next step."""
+    processes = ProcessVectorEnv(partial(_Counting, breaks=True), 2)
+    try:
+        processes.reset(seed=1)
+        for step in range(1, 10):
+            if step == 7:
+                with pytest.raises(ValueError, match="the seventh step broke"):
+                    processes.step(np.zeros((2, 1)))
+                continue
+            obs, *_ = processes.step(np.full((2, 1), step / 100))
+            assert obs[:, 0].tolist() == [step, step]
+            assert obs[:, 1].tolist() == [step / 100] * 2
+    finally:
+        processes.close()
+
+
+def _equal(mine: dict, theirs: dict) -> None:  # type: ignore[type-arg]
+    assert list(mine) == list(theirs)
+    for key, value in theirs.items():
+        assert mine[key].dtype == value.dtype, key
+        np.testing.assert_array_equal(mine[key], value, err_msg=key)

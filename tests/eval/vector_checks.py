@@ -11,8 +11,9 @@ import numpy as np
 
 def steps_like_sync_vector_env(vector: Any, plain: gymnasium.vector.SyncVectorEnv) -> None:
     """Reset both with one seed per env, then 9 steps of the same random actions (the envs'
-    limit is 6 steps: every env resets on the 7th); observations, rewards, ends and
-    successes must be equal."""
+    limit is 6 steps: every env resets on the 7th), then a reset of the first env only;
+    observations (every key), rewards, ends and infos (values, dtypes and masks) must be
+    equal."""
     seeds = [3 + i for i in range(vector.num_envs)]
     a, a_info = vector.reset(seed=seeds)
     b, b_info = plain.reset(seed=seeds)
@@ -25,9 +26,22 @@ def steps_like_sync_vector_env(vector: Any, plain: gymnasium.vector.SyncVectorEn
         action = vector.action_space.sample()
         a, ra, ta, ua, ia = vector.step(action)
         b, rb, tb, ub, ib = plain.step(action)
-        np.testing.assert_array_equal(a["observation.state"], b["observation.state"])
+        _equal(a, b)
         np.testing.assert_array_equal(ra, rb)
         assert (ta == tb).all() and (ua == ub).all()
-        assert list(ia["is_success"]) == list(ib["is_success"])
+        _equal(ia, ib)
         ends.append(bool(ua.all()))
     assert ends == [False] * 5 + [True] + [False] * 3
+    mask = np.arange(vector.num_envs) == 0
+    a, a_info = vector.reset(seed=99, options={"reset_mask": mask})
+    b, b_info = plain.reset(seed=99, options={"reset_mask": mask})
+    _equal(a, b)
+    _equal(a_info, b_info)
+
+
+def _equal(mine: dict[str, Any], theirs: dict[str, Any]) -> None:
+    """The same keys, in the same order, with equal arrays of the same dtype."""
+    assert list(mine) == list(theirs)
+    for key, value in theirs.items():
+        assert mine[key].dtype == value.dtype, key
+        np.testing.assert_array_equal(mine[key], value, err_msg=key)

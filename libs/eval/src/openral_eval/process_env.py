@@ -31,6 +31,8 @@ from gymnasium.vector.utils import (
     read_from_shared_memory,
 )
 
+from openral_eval.batch_slots import BatchSlots
+
 EnvFn = Callable[[], gymnasium.Env[Any, Any]]
 INFO_BYTES = 1 << 20
 """Room for one pickled info (or a reset's seed and options, or an error) [bytes]."""
@@ -42,7 +44,8 @@ SPIN_S = 0.002
 """How long a wait polls before it sleeps [s]: a step's answer (or the next step) usually
 comes within it, and a sleeping process takes tens of microseconds to wake."""
 STEP, RESET, CLOSE = 1, 2, 3
-FAILED = -1
+FAILED, SAME_INFO = -1, 1
+"""A worker's status besides 0: its env raised; its info is the one it sent last."""
 
 
 class WorkerError(RuntimeError):
@@ -72,7 +75,31 @@ class _Shared:
         self.length.value = len(data)
 
     def take(self) -> Any:
-        return pickle.loads(bytes(memoryview(self.buffer).cast("B")[: self.length.value]))
+        return pickle.loads(self.taken())
+
+    def taken(self) -> bytes:
+        """The bytes :meth:`put` wrote last."""
+        return bytes(memoryview(self.buffer).cast("B")[: self.length.value])
+
+
+class _InfoSender:
+    """A worker's infos to the caller: pickled, and not written again when they are the
+    bytes sent last (the caller keeps those: most steps' infos are the last step's)."""
+
+    def __init__(self, shared: _Shared) -> None:
+        self.shared, self.last = shared, b""
+
+    def send(self, info: object, numbers: np.ndarray) -> None:
+        data = pickle.dumps(info, protocol=pickle.HIGHEST_PROTOCOL)
+        if data == self.last:
+            numbers[3] = SAME_INFO
+            return
+        self.shared.put(info)  # bytes too many raise before anything is written
+        self.last = data
+
+    def forget(self) -> None:
+        """The buffer now holds something else (an error, a caller's reset arguments)."""
+        self.last = b""
 
 
 def _watch(caller: int) -> None:
@@ -94,8 +121,9 @@ def _serve(make: EnvFn, shared: _Shared, caller: int) -> None:
     watch.start()
     env = make()
     observation_space, action_space = shared.spaces
-    actions = read_from_shared_memory(action_space, shared.action, n=1)  # views, made once
-    observations = read_from_shared_memory(observation_space, shared.observation, n=1)
+    actions = BatchSlots(read_from_shared_memory(action_space, shared.action, n=1))  # views
+    observations = BatchSlots(read_from_shared_memory(observation_space, shared.observation, n=1))
+    numbers, infos = np.frombuffer(shared.numbers, dtype=np.float64), _InfoSender(shared)
     while True:
         if not _polled(shared.go):
             shared.go.acquire()
@@ -107,17 +135,19 @@ def _serve(make: EnvFn, shared: _Shared, caller: int) -> None:
                 return
             if command == RESET:
                 seed, options = shared.take()
+                infos.forget()
                 observation, info = env.reset(seed=seed, options=options)
                 reward: SupportsFloat = 0.0
                 terminated, truncated = False, False
             else:
-                action = copied(actions, 0)
+                action = actions.row(0)
                 observation, reward, terminated, truncated, info = env.step(action)
-            place(observations, 0, observation)
-            shared.numbers[:] = [float(reward), float(terminated), float(truncated), 0.0]
-            shared.put(dict(info))
+            observations.write(0, observation)
+            numbers[:] = (float(reward), float(terminated), float(truncated), 0.0)
+            infos.send(dict(info), numbers)
         except Exception as error:  # told to the caller in one line
-            shared.numbers[3] = FAILED
+            numbers[3] = FAILED
+            infos.forget()
             shared.put(f"{type(error).__name__}: {error}")
         shared.done.release()
 
@@ -136,10 +166,16 @@ class ProcessEnv(gymnasium.Env[Any, Any]):
         context: Any = multiprocessing.get_context(start_method)
         self.observation_space, self.action_space = spaces
         self._shared = _Shared(context, spaces)
-        self._observations = read_from_shared_memory(
-            self.observation_space, self._shared.observation, n=1
+        self._observations = BatchSlots(
+            read_from_shared_memory(self.observation_space, self._shared.observation, n=1)
         )
-        self._actions = read_from_shared_memory(self.action_space, self._shared.action, n=1)
+        self._actions = BatchSlots(
+            read_from_shared_memory(self.action_space, self._shared.action, n=1)
+        )
+        self._numbers = np.frombuffer(self._shared.numbers, dtype=np.float64)
+        """Reward, terminated, truncated and the worker's status (a view)."""
+        self._info = b""
+        """The worker's info as it sent it last (pickled)."""
         self._process = context.Process(
             target=_serve, args=(make, self._shared, os.getpid()), daemon=True
         )
@@ -158,7 +194,7 @@ class ProcessEnv(gymnasium.Env[Any, Any]):
 
     def post_step(self, action: Any) -> None:
         """Start a step with ``action`` in the worker; :meth:`collect` its result."""
-        place(self._actions, 0, action)
+        self._actions.write(0, action)
         self._post(STEP)
 
     def post_reset(self, seed: int | None, options: dict[str, Any] | None) -> None:
@@ -173,13 +209,29 @@ class ProcessEnv(gymnasium.Env[Any, Any]):
         Raises:
             WorkerError: The env raised, or its process died.
         """
+        reward, terminated, truncated, info = self._collected()
+        return self._observations.row(0), reward, terminated, truncated, info
+
+    def collect_into(self, batch: BatchSlots, i: int) -> tuple[float, bool, bool, dict[str, Any]]:
+        """:meth:`collect`, the observation copied straight into row ``i`` of ``batch``;
+        (reward, terminated, truncated, info).
+
+        Raises:
+            WorkerError: As :meth:`collect`.
+        """
+        outcome = self._collected()
+        batch.copy_row(self._observations, 0, i)
+        return outcome
+
+    def _collected(self) -> tuple[float, bool, bool, dict[str, Any]]:
         shared = self._shared
         self._wait()
-        if shared.numbers[3] == FAILED:
+        reward, terminated, truncated, status = self._numbers.tolist()
+        if status == FAILED:
             raise WorkerError(f"the env in process {self._process.pid} raised {shared.take()}")
-        reward, terminated, truncated, _ = shared.numbers
-        observation = copied(self._observations, 0)
-        return observation, reward, bool(terminated), bool(truncated), shared.take()
+        if status != SAME_INFO:
+            self._info = shared.taken()
+        return reward, bool(terminated), bool(truncated), pickle.loads(self._info)
 
     def close(self) -> None:
         if self._process.is_alive():
@@ -212,25 +264,3 @@ def _polled(semaphore: Any) -> bool:
         if semaphore.acquire(False):
             return True
     return False
-
-
-def place(batch: Any, i: int, value: Any) -> None:
-    """Write one env's ``value`` into slot ``i`` of a batch (dicts, tuples, arrays)."""
-    if isinstance(batch, dict):
-        for key, part in batch.items():
-            place(part, i, value[key])
-    elif isinstance(batch, tuple):
-        for part, item in zip(batch, value, strict=True):
-            place(part, i, item)
-    else:
-        batch[i] = value
-
-
-def copied(batch: Any, i: int | None = None) -> Any:
-    """A copy of a batch (dicts, tuples, arrays), or of its slot ``i`` only (a batch read
-    from shared memory: the next step overwrites it)."""
-    if isinstance(batch, dict):
-        return {key: copied(part, i) for key, part in batch.items()}
-    if isinstance(batch, tuple):
-        return tuple(copied(part, i) for part in batch)
-    return np.array(batch if i is None else batch[i], copy=True)
