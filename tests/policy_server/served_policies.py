@@ -1,8 +1,10 @@
 """Policies a policy server serves in the tests: plain classes, no openral import (the
 separate venv has none), each as ``file.py:Class`` also runnable in-process."""
 
+import json
 import os
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -17,6 +19,16 @@ class Sway:
         _, hold = obs["action_spec"]
         phase = obs["time_s"] + 0.1 * float(np.sum(obs["observation.state"][:2]))
         return np.asarray(hold, dtype=np.float64) + 0.05 * np.sin(2.0 * phase)
+
+
+class SwayLogged(Sway):
+    """Sway that appends the keys it is shown, a line per action, to the file
+    ``$OPENRAL_TEST_SWAY_LOG``."""
+
+    def act(self, obs):
+        with Path(os.environ["OPENRAL_TEST_SWAY_LOG"]).open("a", encoding="utf-8") as log:
+            log.write(json.dumps(sorted(obs)) + "\n")
+        return super().act(obs)
 
 
 class Swirl(Sway):

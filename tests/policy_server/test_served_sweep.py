@@ -105,3 +105,37 @@ def test_a_policy_file_is_executed_again_in_each_forked_worker(tmp_path: Path) -
     workers: each must execute it again, so what it opens at import is its own."""
     code, rows = _sweep(f"{POLICIES}:OpenedHere", tmp_path / "out", "0:4")
     assert code == 0 and all(row["error"] is None for row in rows), rows
+
+
+def test_rskill_run_drives_deploy_sim_with_a_policy_served_from_its_own_venv(
+    served, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``rskill run --policy ws://…`` against a live deploy sim: the graph's observation
+    (joints, TCP, and both cameras by slot once their first frames came: the policy needs
+    none to begin) goes to the served policy, and each of its answers is one action on
+    ``/openral/safe_action``."""
+    from openral_nodes.runtime import claim_domain_id
+
+    from tests.ros.lifecycle_client import deploy_output, deploy_sim
+
+    log = tmp_path / "seen.jsonl"
+    monkeypatch.setenv("OPENRAL_TEST_SWAY_LOG", str(log))  # the server inherits it
+    address, domain = served("SwayLogged"), claim_domain_id()
+    with deploy_sim(SCENE, domain, tmp_path) as process:
+        runner = subprocess.run(
+            [str(OPENRAL), "rskill", "run", "--robot", "franka_panda", "--policy", address,
+             "--duration", "3", "--domain-id", str(domain)],
+            capture_output=True, text=True, timeout=180, env={**os.environ, "COLUMNS": "400"},
+        )  # fmt: skip
+        assert runner.returncode == 0, (runner.stderr, deploy_output(tmp_path))
+        assert process.poll() is None
+    said = runner.stdout.strip().splitlines()[-1]
+    assert said.startswith(f"{address} on franka_panda: "), said
+    actions = int(said.split(": ")[1].split(" action")[0])
+    seen = [json.loads(line) for line in log.read_text(encoding="utf-8").splitlines()]
+    assert actions >= 10 and len(seen) == actions, (said, len(seen))
+    shown = {"observation.state", "observation.velocity", "observation.tcp_pose"}
+    shown |= {"observation.images.camera1", "observation.images.camera2", "action_spec"}
+    first = next(i for i, keys in enumerate(seen) if shown <= set(keys))  # frames come later
+    assert all(shown <= set(keys) for keys in seen[first:]), seen  # and are never dropped
+    assert first < len(seen) / 2, (first, len(seen))

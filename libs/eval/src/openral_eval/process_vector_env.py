@@ -55,6 +55,8 @@ class ProcessVectorEnv(ThreadVectorEnv):
         envs = [local, *(ProcessEnv(make, spaces) for _ in range(num_envs - 1))]
         self._slots: BatchSlots | None = None
         self._worker_envs: list[tuple[int, ProcessEnv]] | None = None
+        self._box_actions = isinstance(spaces[1], gymnasium.spaces.Box)
+        """A Box action space: a batch of actions is an array, one row per env."""
         super().__init__([_given(env) for env in envs], **kwargs)
 
     def reset(
@@ -85,7 +87,7 @@ class ProcessVectorEnv(ThreadVectorEnv):
         """Step every env at once with its action (autoreset as ``SyncVectorEnv``). While
         the workers step, env 0 steps here and its row of the batch is written; each
         worker's row is then copied straight out of its shared memory."""
-        batch = list(iterate(self.action_space, actions))
+        batch = actions if self._box_actions else list(iterate(self.action_space, actions))
         resetting = {i: self._posted(i, env, batch[i]) for i, env in self._workers()}
         try:
             parts = [(0, part) for part in self._step_one(0, batch[0])]
