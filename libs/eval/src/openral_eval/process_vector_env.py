@@ -4,10 +4,10 @@ of its own (:class:`~openral_eval.process_env.ProcessEnv`), all stepping at once
 A step posts every worker's action (shared memory, a semaphore), steps the first env here
 meanwhile, then collects the workers' results; one thread does it all, so Python's lock
 never holds a worker back and no thread waits for it. Measured on the franka tabletop,
-cameras off, on 2 cores (``just bench-env``, three runs): 1.74-1.81x one env's steps per
-second, where two bare ``mj_step`` threads reach 1.98-1.99x in the same runs; gymnasium's
-``AsyncVectorEnv`` (pipes) 1.37x, the threaded
-:class:`~openral_eval.thread_vector_env.ThreadVectorEnv` 1.13x.
+cameras off, on 2 cores (``just bench-env``, two runs): 1.83-1.85x one env's steps per
+second, where two bare ``mj_step`` threads reach 1.96-1.99x in the same runs; gymnasium's
+``AsyncVectorEnv`` (pipes) 1.32-1.36x, the threaded
+:class:`~openral_eval.thread_vector_env.ThreadVectorEnv` 1.11-1.13x.
 
 It is gymnasium's ``SyncVectorEnv`` otherwise (spaces, seeding, info batching), with the
 ``next_step`` (default) and ``disabled`` autoreset modes, and gives the same results for the
