@@ -5,7 +5,9 @@
 - The UR10e reads the model's own ``force``/``torque`` sensors at its TCP site.
 - g1 and h1, welded in their default scenes: the pelvis IMU reads 9.81 ± 0.05 m/s² along
   its up axis and an angular velocity within ±0.01 rad/s; its orientation is the pelvis's.
-- Reading changes nothing: two runs, one reading every step, are bit for bit equal.
+- Reading changes nothing: two runs, one reading every step, are bit for bit equal; nor
+  does skipping the sensors between control periods (the scene computes them once, at
+  the end of each).
 - ``robot check`` names a wrong MJCF sensor (unknown, wrong type, elsewhere, or named at a
   site the scene creates) at its line and column, with the closest names.
 """
@@ -200,3 +202,44 @@ def test_robot_check_locates_a_wrong_mjcf_sensor(write_manifest: ManifestWriter,
     ]
     assert [row[2:5] for row in rows] == expected
     assert all(row[1].startswith(f"{Path('robot.yaml')}:") for row in rows)
+
+
+def test_skipping_the_sensors_between_control_periods_changes_nothing(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A scene computes its sensors only at the end of a control period: the state and
+    every sensor value then are bit for bit those of a scene that computed them at every
+    physics step (a mobile base too: g1's IMU, panda_mobile's base drive)."""
+    import contextlib
+
+    from openral_sim import native_scene
+
+    for robot_id in ("franka_panda", "g1", "panda_mobile"):
+        skipping = scene(robot_id)
+        monkeypatch.setattr(native_scene, "sensors_skipped", lambda _: contextlib.nullcontext())
+        every_step = scene(robot_id)
+        monkeypatch.undo()
+        rng = np.random.default_rng(0)
+        hold = skipping.hold_action()
+        for _ in range(10):
+            action = hold + rng.uniform(-0.05, 0.05, hold.shape)
+            skipping.step(action)
+            every_step.step(action)
+            for field in ("qpos", "qvel", "qacc_warmstart", "sensordata"):
+                mine, theirs = getattr(skipping.data, field), getattr(every_step.data, field)
+                assert np.array_equal(mine, theirs), (robot_id, field)
+        assert int(skipping.model.opt.disableflags) == int(every_step.model.opt.disableflags)
+
+
+def test_a_model_with_its_sensors_off_keeps_them_off_and_an_error_restores_the_flags() -> None:
+    from openral_mujoco.sensor_skip import sensors_skipped
+
+    model = mujoco.MjModel.from_xml_string("<mujoco><worldbody/></mujoco>")
+    off = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+    with sensors_skipped(model):
+        assert model.opt.disableflags & off
+    assert not model.opt.disableflags & off
+    model.opt.disableflags = off | int(mujoco.mjtDisableBit.mjDSBL_GRAVITY)
+    with pytest.raises(RuntimeError), sensors_skipped(model):
+        raise RuntimeError("a step diverged")
+    assert model.opt.disableflags == off | int(mujoco.mjtDisableBit.mjDSBL_GRAVITY)

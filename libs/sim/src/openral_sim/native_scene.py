@@ -36,6 +36,7 @@ from openral_mujoco.errors import HalError
 from openral_mujoco.joint_driver import JointDriver
 from openral_mujoco.robot_addresses import RobotAddresses, locate_robot
 from openral_mujoco.robot_bodies import robot_bodies, root_body
+from openral_mujoco.sensor_skip import sensors_skipped
 from openral_mujoco.state import FloatArray, JointStateSample
 
 from openral_sim.base_drive import BASE_UPDATE_STEPS, BaseDrive
@@ -377,18 +378,19 @@ class NativeScene:
         :data:`BASE_UPDATE_STEPS` of them (the joint driver slews in chunks of that size
         too, so chunking changes nothing of the arm's motion)."""
         base, model, data = self.base, self.model, self.data
-        if base is None:
-            self.driver.advance(model, data, steps)
         timestep = float(model.opt.timestep)
-        while base is not None and steps > 0:
-            chunk = min(steps, BASE_UPDATE_STEPS)
-            base.update(chunk * timestep)
-            self.driver.advance(model, data, chunk)
-            steps -= chunk
-        # mj_step leaves the poses (bodies, sites, cameras) and the sensor readings of the
-        # state *before* its last step: compute them for the state the data now holds, so
-        # that /tf, cameras, lidars and sensors show the instant they are stamped with
-        # (15 us on the Panda; the trajectory is bit for bit the same).
+        with sensors_skipped(model):  # read only after the last step: see sensor_skip
+            if base is None:
+                self.driver.advance(model, data, steps)
+            while base is not None and steps > 0:
+                chunk = min(steps, BASE_UPDATE_STEPS)
+                base.update(chunk * timestep)
+                self.driver.advance(model, data, chunk)
+                steps -= chunk
+        # mj_step leaves the poses (bodies, sites, cameras) of the state *before* its last
+        # step: compute them, and the sensors, for the state the data now holds, so that
+        # /tf, cameras, lidars and sensors show the instant they are stamped with (15 us
+        # on the Panda; the trajectory is bit for bit the same).
         mujoco.mj_forward(model, data)
 
     def _place_floating_base(self) -> None:
