@@ -156,6 +156,28 @@ def test_infos_and_observations_arrive_whether_they_changed_or_not() -> None:
         plain.close()
 
 
+def test_an_observation_once_returned_is_never_written_again() -> None:
+    """With ``copy`` (the default) every step and reset returns a batch of its own; with
+    ``copy=False`` the same batch, rewritten in place, as gymnasium's own vector envs do."""
+    processes = ProcessVectorEnv(_Counting, 2)
+    shared = ProcessVectorEnv(_Counting, 2, copy=False)
+    try:
+        kept = [(obs, obs.copy()) for obs in (processes.reset(seed=0)[0],)]
+        for step in range(1, 5):
+            obs = processes.step(np.full((2, 1), step / 100))[0]
+            kept.append((obs, obs.copy()))
+        obs = processes.reset(seed=0, options={"reset_mask": np.array([True, False])})[0]
+        kept.append((obs, obs.copy()))
+        processes.step(np.zeros((2, 1)))
+        for held, then in kept:
+            np.testing.assert_array_equal(held, then)
+        first = shared.reset(seed=0)[0]
+        assert shared.step(np.zeros((2, 1)))[0] is first and first[0, 0] == 1.0
+    finally:
+        processes.close()
+        shared.close()
+
+
 def test_when_the_first_env_raises_the_workers_step_is_not_left_for_the_next() -> None:
     """Env 0 steps in the caller's process: its error comes through as it is, and the
     workers' results of that step are taken then, so the next step returns the next step."""

@@ -74,6 +74,14 @@ class BatchSlots:
             return self._array[i].copy()
         return copied(self.batch, i)
 
+    def fresh(self) -> BatchSlots:
+        """The rows of a new batch of the same layout (its values not yet written)."""
+        if self._arrays is not None:
+            return BatchSlots({key: np.empty_like(array) for key, array in self._arrays})
+        if self._array is not None:
+            return BatchSlots(np.empty_like(self._array))
+        return BatchSlots(copied(self.batch))
+
     def copy(self) -> Any:
         """A copy of the whole batch."""
         if self._arrays is not None:

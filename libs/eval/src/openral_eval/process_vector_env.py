@@ -63,9 +63,12 @@ class ProcessVectorEnv(ThreadVectorEnv):
         self, *, seed: int | list[int | None] | None = None, options: Info | None = None
     ) -> tuple[Any, Info]:
         """Reset every env at once (``seed``: as ``SyncVectorEnv`` takes it)."""
-        if options is not None and "reset_mask" in options:  # the rest keep their rows
-            for i, _ in self._workers():
-                self._env_obs[i] = self._rows().row(i)
+        rows = self._rows()
+        for i, _ in self._workers():  # a masked reset keeps the others' rows
+            self._env_obs[i] = rows.row(i)
+        if self.copy:  # the batch a caller holds is never written again
+            self._observations = rows.fresh().batch
+        if options is not None and "reset_mask" in options:
             return super().reset(seed=seed, options=options)
         seeds = _seeds(seed, self.num_envs)
         for i, env in self._workers():
@@ -86,7 +89,9 @@ class ProcessVectorEnv(ThreadVectorEnv):
     def step(self, actions: Any) -> StepBatch:
         """Step every env at once with its action (autoreset as ``SyncVectorEnv``). While
         the workers step, env 0 steps here and its row of the batch is written; each
-        worker's row is then copied straight out of its shared memory."""
+        worker's row is then copied straight out of its shared memory. With ``copy`` (the
+        default) each step fills a new batch, which is returned as it is (nothing here
+        writes into a batch a caller was given)."""
         batch = actions if self._box_actions else list(iterate(self.action_space, actions))
         resetting = {i: self._posted(i, env, batch[i]) for i, env in self._workers()}
         try:
@@ -94,16 +99,17 @@ class ProcessVectorEnv(ThreadVectorEnv):
         except BaseException:  # the workers' results of this step are not left for the next
             self._drain()
             raise
-        rows = self._rows()
+        rows = self._rows().fresh() if self.copy else self._rows()  # a new batch: no copy
         rows.write(0, self._env_obs[0])
         for i, env in self._workers():
             reward, terminated, truncated, info = env.collect_into(rows, i)
             self._rewards[i] = 0.0 if resetting[i] else reward
             self._terminations[i], self._truncations[i] = terminated, truncated
             parts.append((i, info))
+        self._slots, self._observations = rows, rows.batch
         self._autoreset_envs = np.logical_or(self._terminations, self._truncations)
         return (
-            self._observations_out(),
+            self._observations,
             np.copy(self._rewards),
             np.copy(self._terminations),
             np.copy(self._truncations),
