@@ -42,7 +42,7 @@ def steady(remote: Remote, seconds: float = 2.0) -> None:
     wait_until(is_steady, 60.0, "a steady stream from the robot")
 
 
-def _released(remote: Remote, release: Any) -> None:
+def released(remote: Remote, release: Any) -> None:
     """Release deploy real's E-stop; a release refused because the readings were stale at
     that instant (the same two-period rule) is asked again once the stream is steady, at
     most :data:`RELEASES` times."""
@@ -62,7 +62,7 @@ def release_and_move(remote: Remote, release: Any, follow: Any, turn_rad: float)
     from action_msgs.msg import GoalStatus
 
     for attempt in range(1, RELEASES + 1):
-        _released(remote, release)
+        released(remote, release)
         start = arm_joints(remote.probe.latest(ROBOT_STATES))
         target = [start[0] + turn_rad, *start[1:]]
         status, result = ended(follow, goal(PANDA_ARM, [(2.0, target)]))
