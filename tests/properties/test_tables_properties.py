@@ -50,11 +50,21 @@ def _distinct_joints(joints: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 
 def _repair_real(document: dict[str, Any]) -> None:
-    """Wire a drawn Feetech bus to the drawn joints (rules 20-26), so the rules can pass:
-    one motor per joint, ids 1..n, protocol 0, 1 Mbaud, revolute joints within one turn."""
+    """Wire a drawn real section to the drawn joints (rules 20-29), so the rules can pass:
+    a Feetech bus with one motor per joint, ids 1..n, protocol 0, 1 Mbaud, revolute joints
+    within one turn; or a ros2_control driver whose E-stop and shutdown hold the arm."""
     real = document.get("real")
     if real is None:
         return
+    if real.get("driver") == "ros2_control":
+        real.pop("feetech", None)
+        real["estop"], real["shutdown"] = "hold", "hold"
+        names = real.get("ros2_control", {}).get("joint_names")
+        if names is not None:  # distinct driver names of the drawn joints (rule 29)
+            joints = [j["name"] for j in document["joints"]]
+            real["ros2_control"]["joint_names"] = {j: f"driver_{j}" for j in joints[: len(names)]}
+        return
+    real.pop("ros2_control", None)
     bus = real.setdefault("feetech", {"servo_model": "sts3215", "motors": []})
     joints = document["joints"]
     bus["motors"] = [{"joint": j["name"], "id": i + 1} for i, j in enumerate(joints)]
@@ -65,6 +75,22 @@ def _repair_real(document: dict[str, Any]) -> None:
         joint.update(type="revolute", position_limits=[low, low + 1.0])
 
 
+def _repair_base(document: dict[str, Any]) -> None:
+    """A mobile base and ``base: mobile`` together (rules 11 and 12), its base frame named
+    by the mobile base only (rule 14); a sensor's mount position on a named body (13)."""
+    legged = bool(document.get("sim", {}).get("floating_base"))
+    if "mobile_base" in document and not legged:
+        document["base"] = "mobile"
+        document.get("frames", {}).pop("base", None)
+    else:
+        document.pop("mobile_base", None)
+        if document.get("base") == "mobile" and not legged:
+            document["base"] = "fixed"
+    for sensor in document.get("sensors", []):
+        if "mount_body" not in sensor:
+            sensor.pop("mount_position_m", None)
+
+
 def _repair(document: dict[str, Any]) -> dict[str, Any]:
     """Point a drawn sim block's joint references at the drawn joints, so rules can pass."""
     document["joints"] = _distinct_joints(document["joints"])
@@ -72,6 +98,7 @@ def _repair(document: dict[str, Any]) -> dict[str, Any]:
         if "position_limits" in joint:
             joint["position_limits"] = _ordered(joint["position_limits"])
     _repair_real(document)
+    _repair_base(document)
     for extra in document.get("frames", {}).get("extra_links", []):
         extra["quat_wxyz"] = [1.0, 0.0, 0.0, 0.0]  # rule 27
     sim = document.get("sim")
@@ -82,6 +109,15 @@ def _repair(document: dict[str, Any]) -> dict[str, Any]:
         if field in sim:
             values = list(sim[field].values())
             sim[field] = dict(zip(joints, values, strict=False))
+    tcp = sim.get("tcp")
+    if tcp is not None:  # one body or one site, a unit quaternion (rules 19 and 27)
+        if "body" in tcp or "site" not in tcp:
+            tcp["body"] = tcp.get("body", "hand")
+            tcp.pop("site", None)
+        tcp.pop("quat_wxyz", None)
+    if "start_pose" in sim:  # joints of this robot only
+        values = list(sim["start_pose"].values())
+        sim["start_pose"] = dict(zip(joints, values, strict=False))
     grippers = sim.get("grippers", [])[: len(joints)]
     for gripper, joint in zip(grippers, reversed(joints), strict=False):
         gripper["joint"] = joint
