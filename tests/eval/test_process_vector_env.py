@@ -17,7 +17,7 @@ from openral_eval.process_vector_env import ProcessVectorEnv
 from openral_eval.scene_env import make_env
 
 from tests.conftest import ROBOTS
-from tests.eval.vector_checks import steps_like_sync_vector_env
+from tests.eval.vector_checks import assert_same_batch, steps_like_sync_vector_env
 
 FRANKA = str(ROBOTS / "franka_panda" / "scenes" / "tabletop.yaml")
 
@@ -143,14 +143,14 @@ def test_infos_and_observations_arrive_whether_they_changed_or_not() -> None:
     processes = ProcessVectorEnv(_Counting, 3)
     plain = gymnasium.vector.SyncVectorEnv([_Counting] * 3)
     try:
-        _equal(processes.reset(seed=1)[1], plain.reset(seed=1)[1])
+        assert_same_batch(processes.reset(seed=1)[1], plain.reset(seed=1)[1])
         for step in range(1, 13):
             action = np.full((3, 1), step / 100)
             a, ra, _, _, ia = processes.step(action)
             b, rb, _, _, ib = plain.step(action)
             np.testing.assert_array_equal(a, b)
             np.testing.assert_array_equal(ra, rb)
-            _equal(ia, ib)
+            assert_same_batch(ia, ib)
     finally:
         processes.close()
         plain.close()
@@ -194,10 +194,3 @@ def test_when_the_first_env_raises_the_workers_step_is_not_left_for_the_next() -
             assert obs[:, 1].tolist() == [step / 100] * 2
     finally:
         processes.close()
-
-
-def _equal(mine: dict, theirs: dict) -> None:  # type: ignore[type-arg]
-    assert list(mine) == list(theirs)
-    for key, value in theirs.items():
-        assert mine[key].dtype == value.dtype, key
-        np.testing.assert_array_equal(mine[key], value, err_msg=key)

@@ -26,20 +26,20 @@ def steps_like_sync_vector_env(vector: Any, plain: gymnasium.vector.SyncVectorEn
         action = vector.action_space.sample()
         a, ra, ta, ua, ia = vector.step(action)
         b, rb, tb, ub, ib = plain.step(action)
-        _equal(a, b)
+        assert_same_batch(a, b)
         np.testing.assert_array_equal(ra, rb)
         assert (ta == tb).all() and (ua == ub).all()
-        _equal(ia, ib)
+        assert_same_batch(ia, ib)
         ends.append(bool(ua.all()))
     assert ends == [False] * 5 + [True] + [False] * 3
     mask = np.arange(vector.num_envs) == 0
     a, a_info = vector.reset(seed=99, options={"reset_mask": mask})
     b, b_info = plain.reset(seed=99, options={"reset_mask": mask})
-    _equal(a, b)
-    _equal(a_info, b_info)
+    assert_same_batch(a, b)
+    assert_same_batch(a_info, b_info)
 
 
-def _equal(mine: dict[str, Any], theirs: dict[str, Any]) -> None:
+def assert_same_batch(mine: dict[str, Any], theirs: dict[str, Any]) -> None:
     """The same keys, in the same order, with equal arrays of the same dtype."""
     assert list(mine) == list(theirs)
     for key, value in theirs.items():

@@ -64,11 +64,11 @@ class ProcessVectorEnv(ThreadVectorEnv):
     ) -> tuple[Any, Info]:
         """Reset every env at once (``seed``: as ``SyncVectorEnv`` takes it)."""
         rows = self._rows()
-        for i, _ in self._workers():  # a masked reset keeps the others' rows
-            self._env_obs[i] = rows.row(i)
         if self.copy:  # the batch a caller holds is never written again
             self._observations = rows.fresh().batch
         if options is not None and "reset_mask" in options:
+            for i, _ in self._workers():  # the envs it leaves keep their rows
+                self._env_obs[i] = rows.row(i)
             return super().reset(seed=seed, options=options)
         seeds = _seeds(seed, self.num_envs)
         for i, env in self._workers():

@@ -76,10 +76,10 @@ class ThreadVectorEnv(SyncVectorEnv):
     def step(self, actions: Any) -> StepBatch:
         """Step every env at once with its action (autoreset as ``SyncVectorEnv``)."""
         batch = list(iterate(self.action_space, actions))
-        infos: Info = {}
-        for i, parts in enumerate(self._pool.map(self._step_one, range(self.num_envs), batch)):
-            for part in parts:
-                infos = self._add_info(infos, part, i)
+        stepped = self._pool.map(self._step_one, range(self.num_envs), batch)
+        infos = self._batched_infos(
+            [(i, part) for i, parts in enumerate(stepped) for part in parts]
+        )
         self._observations = concatenate(
             self.single_observation_space, self._env_obs, self._observations
         )

@@ -2,13 +2,12 @@
 
 It is in every env observation and every ``/openral/tcp_pose`` message. A native scene
 composes a site at the TCP and two MuJoCo sensors of its pose in the robot's root body
-(:mod:`openral_sim.tcp_sensors`). MuJoCo computes them with the rest of the state in C, so a read is
-one copy of 7 values of ``sensordata``, composed with the root's pose in the base frame
-when the root is not the base itself.
+(:mod:`openral_sim.tcp_sensors`). MuJoCo computes them with the rest of the state in C,
+so a read is one copy of 7 values of ``sensordata``, composed with the root's pose in the
+base frame when the root is not the base itself.
 
-Without those sensors (a robosuite scene, a model composed otherwise) the reader composes
-the pose from rows of ``data`` looked up once: world → base (a constant when nothing lets
-the root move: no joint up to the world, no mocap), the TCP's body or site, the flange.
+Without those sensors (a model composed otherwise) the reader composes the pose from rows
+of ``data`` looked up once: world → base, the TCP's body or site, the flange.
 """
 
 from __future__ import annotations
@@ -25,24 +24,6 @@ Pose = tuple[FloatArray, FloatArray]
 """A position [m] and a quaternion (w, x, y, z)."""
 
 _IDENTITY = (np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
-
-
-def static_world_pose(model: mujoco.MjModel, body: int) -> Pose | None:
-    """``body``'s world pose composed from the model's own body frames, or None when a
-    joint or a mocap body on its way up to the world lets it move."""
-    chain = []
-    while body > 0:
-        if model.body_jntnum[body] > 0 or model.body_mocapid[body] >= 0:
-            return None
-        chain.append(body)
-        body = int(model.body_parentid[body])
-    position, quat = _IDENTITY
-    for link in reversed(chain):
-        out, out_quat = np.empty(3), np.empty(4)
-        local = model.body_pos[link], model.body_quat[link]
-        mujoco.mju_mulPose(out, out_quat, position, quat, *local)
-        position, quat = out, out_quat
-    return position, quat
 
 
 def _sensed(model: mujoco.MjModel, root: int) -> int | None:
@@ -77,8 +58,6 @@ class TcpReader:
             None if ee.kind == "site" else (data.xpos[ee.frame], data.xquat[ee.frame])
         )
         self._a, self._a_quat = np.empty(3), np.empty(4)
-        fixed = static_world_pose(data.model, root)
-        self._world_in_base = None if fixed is None else self._compose_world_in_base(*fixed)
 
     def read(self) -> FloatArray:
         """The TCP's pose in the base frame: position [m], quaternion w, x, y, z, as of the
@@ -91,7 +70,7 @@ class TcpReader:
         if sensors is not None:
             mujoco.mju_mulPose(out[:3], out[3:], *self._root_in_base, sensors[:3], sensors[3:])
             return out
-        world_in_base = self._world_in_base or self._compose_world_in_base(*self._root)
+        world_in_base = self._compose_world_in_base(*self._root)
         frame, frame_quat = self._frame or self.ee.frame_pose(self.data)
         a, a_quat = self._a, self._a_quat
         mujoco.mju_mulPose(a, a_quat, *world_in_base, frame, frame_quat)
